@@ -1,0 +1,198 @@
+// PIC — Points with Implicit Connectivity.
+//
+// A PIC object is an adaptive octree over a root cube. Leaves are white (outside), black
+// (inside) or gray; a gray leaf holds one representative vertex and the in/out signs of its
+// eight corners. The surface is recovered by dual contouring (SurfaceNets) of the octree.
+// Reference: Zhang, Qu, Kaufman, "CSG Operations on Point Models with Implicit Connectivity".
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pic {
+
+using Vec3 = std::array<double, 3>;
+
+/// @name Errors thrown at the library boundary.
+///@{
+/// Bad user input: a malformed mesh, an open mesh, NaN coordinates, bad options.
+class InvalidInput : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+/// A file could not be read or written, or a .pic file is corrupted / foreign.
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+///@}
+
+/// Indexed triangle mesh, counter-clockwise triangles seen from outside.
+struct TriMesh {
+  std::vector<Vec3> positions;
+  std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+/// The root cube: minimum corner and side length, in the input's own coordinates.
+struct Cube {
+  Vec3 origin{0, 0, 0};
+  double size = 1.0;
+  friend bool operator==(const Cube&, const Cube&) = default;
+};
+
+/// Deepest level any octree may reach (lattice of 2^kMaxLevel points per axis).
+inline constexpr int kMaxLevel = 20;
+
+enum class CellKind : uint8_t { White = 0, Black = 1, Gray = 2, Internal = 3 };
+
+/// One octree node: 8 bytes. Children of an internal node are stored contiguously.
+struct Node {
+  uint32_t index = 0;  ///< Internal: first child. Gray: index into Octree::vertices.
+  CellKind kind = CellKind::White;
+  uint8_t signs = 0;   ///< Gray: bit c set = corner c inside; corner c = (c&1, c>>1&1, c>>2&1).
+  uint8_t flags = 0;   ///< bit 0: leaf accepted only because the depth cap was reached.
+  uint8_t reserved = 0;
+};
+inline constexpr uint8_t kFlagCapped = 1;
+
+/// A PIC object. Plain data: nodes[0] is the root; vertices are stored in cell-local
+/// coordinates in [0,1]^3 (so float keeps ~1e-7 of the *cell* size at every level).
+struct Octree {
+  Cube cube;
+  int max_depth = 12;
+  std::vector<Node> nodes{Node{}};
+  std::vector<std::array<float, 3>> vertices;
+  /// CSG timestamps per node (paper 5.2.1). Not part of the value: never saved.
+  mutable std::vector<uint32_t> stamps;
+};
+
+/// Options for sampling a closed triangle mesh (paper section 4).
+struct SampleOptions {
+  int depth = 12;          ///< maximum octree level, 1..kMaxLevel
+  double error = 1e-8;     ///< QEF residual threshold delta^2, in root-cube units squared
+  std::optional<Cube> cube;  ///< root cube; default: bounding cube plus a margin
+  double margin = 1.0 / 16;  ///< automatic cube: margin on each side, relative to the extent
+  bool parallel = true;      ///< build subtrees with TBB (output identical to serial)
+};
+
+/// Statistics of a sampling run.
+struct SampleStats {
+  size_t triangles_in = 0;
+  size_t pics = 0;
+  size_t capped = 0;  ///< leaves accepted at the depth cap although a refinement rule failed
+  double seconds = 0;
+};
+
+/// Adaptively samples a closed, consistently oriented triangle mesh into a PIC object.
+/// \throws InvalidInput for an empty or open mesh, non-finite coordinates, bad options, or a
+///         mesh that does not fit strictly inside the given cube.
+Octree sample(const TriMesh& mesh, const SampleOptions& options = {}, SampleStats* stats = nullptr);
+
+/// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.
+Cube bounding_cube(const TriMesh& mesh, double margin = 1.0 / 16);
+
+/// Extracts the closed surface by dual contouring, in the input's coordinates.
+TriMesh contour(const Octree& tree);
+
+enum class CsgOp { Union, Intersect, Subtract };
+std::string to_string(CsgOp op);
+/// Parses "union", "intersect"/"intersection", "subtract"/"difference".
+std::optional<CsgOp> parse_csg_op(const std::string& s);
+
+struct CsgOptions {
+  double error = 1e-8;  ///< QEF residual threshold for new vertices
+};
+
+struct CsgStats {
+  double seconds = 0;
+  double contour_a_seconds = 0;  ///< partial contour of A
+  double contour_b_seconds = 0;  ///< partial contour of B
+  double csg_seconds = 0;        ///< the octree recursion itself
+  size_t cells_visited = 0;      ///< cell pairs visited by the recursion
+  size_t cells_stamped = 0;      ///< operand cells stamped as overlap
+  size_t gray_pairs = 0;         ///< gray/gray evaluations (GraycellCSG)
+  size_t forced_subdivisions = 0;
+  size_t repaired = 0;           ///< uniform leaves turned gray to keep the surface closed
+  uint32_t stamp = 0;            ///< this operation's timestamp
+  bool resampled_b = false;      ///< B was re-expressed in A's cube
+};
+
+/// Boolean of two PIC objects computed on the octrees (paper section 5). If the cubes or
+/// depths differ, B is first resampled from its contour into A's cube.
+Octree csg(const Octree& a, const Octree& b, CsgOp op, const CsgOptions& options = {},
+           CsgStats* stats = nullptr);
+
+/// The same Boolean written into `a` (A := A op B). Only the overlap region is rebuilt;
+/// untouched subtrees stay where they are, so a sculpting stroke costs what it touches.
+void csg_inplace(Octree& a, const Octree& b, CsgOp op, const CsgOptions& options = {},
+                 CsgStats* stats = nullptr);
+
+/// @name The .pic file (docs/pic-format.md).
+///@{
+/// Writes atomically (temp file + rename). \throws IoError.
+void save(const Octree& tree, const std::filesystem::path& path);
+/// \throws IoError for a missing, truncated, corrupted or foreign file.
+Octree load(const std::filesystem::path& path);
+std::vector<uint8_t> serialize(const Octree& tree);
+Octree deserialize(const std::vector<uint8_t>& bytes);
+///@}
+
+/// @name Mesh files: OBJ, STL, PLY, OFF, glTF/GLB (assimp), duplicate vertices welded.
+///@{
+/// \throws IoError (missing/unreadable/unknown format) or InvalidInput (empty, non-finite).
+TriMesh read_mesh(const std::filesystem::path& path);
+/// Format from the extension; atomic write. \throws IoError.
+void write_mesh(const TriMesh& mesh, const std::filesystem::path& path);
+///@}
+
+/// Writes a text file atomically (temp file + rename). \throws IoError.
+void write_text(const std::filesystem::path& path, const std::string& text);
+
+/// Topology of a triangle mesh (exact vertex indices; no position merging).
+struct MeshTopology {
+  size_t vertices = 0, triangles = 0;
+  size_t boundary_edges = 0;       ///< edges with one triangle
+  size_t nonmanifold_edges = 0;    ///< edges with more than two triangles
+  size_t inconsistent_edges = 0;   ///< edges whose two triangles disagree on orientation
+  size_t nonmanifold_vertices = 0; ///< vertices whose triangle fan is not a single disk
+  size_t degenerate_triangles = 0; ///< repeated vertex index
+  bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
+  bool manifold() const { return closed() && nonmanifold_vertices == 0 && inconsistent_edges == 0; }
+};
+MeshTopology analyze_topology(const TriMesh& mesh);
+/// Signed volume (positive for outward orientation).
+double volume(const TriMesh& mesh);
+
+/// A leaf as seen by visitors: its cell in the input's coordinates.
+struct LeafView {
+  uint32_t node = 0;
+  int level = 0;
+  Vec3 cell_min{0, 0, 0};  ///< input coordinates
+  double cell_size = 0;    ///< input units
+  CellKind kind = CellKind::White;
+  uint8_t signs = 0;
+  Vec3 vertex{0, 0, 0};    ///< gray leaves: representative vertex, input coordinates
+};
+/// Calls `visit` for every leaf, depth-first in child order.
+void for_each_leaf(const Octree& tree, const std::function<void(const LeafView&)>& visit);
+
+/// Cell counts of an octree (`pic info`).
+struct OctreeStats {
+  struct Level {
+    size_t white = 0, black = 0, gray = 0, internal = 0;
+  };
+  std::vector<Level> levels;  ///< index = level
+  size_t pics = 0, nodes = 0, capped = 0;
+  size_t memory_bytes = 0;    ///< nodes + vertices in memory
+  Vec3 bbox_min{0, 0, 0}, bbox_max{0, 0, 0};  ///< of the gray leaves' vertices
+};
+OctreeStats analyze(const Octree& tree);
+
+}  // namespace pic

@@ -1,0 +1,656 @@
+// CSG on two PIC octrees (paper section 5), computed in place on A.
+//
+// Stages, each a function below:
+//   tag            stamp the overlap cells of both operands with this operation's timestamp
+//   partial_contour  dual-contour only around stamped cells; keep each PIC's triangle fan
+//   combine        the paired recursion: trivial cases, GraycellCSG, forced subdivision
+//   repair         make sure no uniform leaf borders a sign change (keeps the surface closed)
+//
+// Topology comes from signs alone: each operand's sign is a single-valued function of the
+// lattice point (stored corner signs first; inside a gray leaf, crossing parity along a fixed
+// path from the leaf's corner 0 through its triangle fan), and the result's sign is
+// op(sign_A, sign_B). Vertex positions only decide accuracy.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <unordered_map>
+
+#include "contour.h"
+#include "sample.h"
+
+namespace pic {
+namespace detail {
+namespace {
+
+using Lat = std::array<int64_t, 3>;
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::atomic<uint32_t> g_timestamp{0};
+
+uint64_t lat_key(const Lat& p) { return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42; }
+
+bool apply(CsgOp op, bool a, bool b) {
+  switch (op) {
+    case CsgOp::Union: return a || b;
+    case CsgOp::Intersect: return a && b;
+    case CsgOp::Subtract: return a && !b;
+  }
+  return false;
+}
+uint8_t apply_mask(CsgOp op, uint8_t a, uint8_t b) {
+  switch (op) {
+    case CsgOp::Union: return a | b;
+    case CsgOp::Intersect: return a & b;
+    case CsgOp::Subtract: return a & uint8_t(~b);
+  }
+  return 0;
+}
+
+/// One operand during an operation: its tree, partial contour and sign memo.
+struct Operand {
+  const Octree& t;
+  std::vector<ITri> tris;                                    // partial contour, grid units
+  std::unordered_map<uint32_t, std::vector<uint32_t>> fans;  // stamped gray leaf -> triangles
+  std::unordered_map<uint64_t, bool> memo;                   // signs of non-corner points
+
+  explicit Operand(const Octree& tree) : t(tree) {}
+
+  const std::vector<uint32_t>& fan(uint32_t leaf) const {
+    static const std::vector<uint32_t> kEmpty;
+    const auto it = fans.find(leaf);
+    return it == fans.end() ? kEmpty : it->second;
+  }
+
+  struct Hit {
+    int state = 0;  // 0 none, 1 corner/uniform (sign known), 2 inside a gray leaf
+    bool sign = false;
+    uint32_t leaf = 0;
+    Cell cell;
+  };
+
+  static bool contains(const Cell& c, const Lat& p) {
+    const int64_t s = c.span();
+    for (int k = 0; k < 3; ++k)
+      if (p[k] < c.lat[k] || p[k] > c.lat[k] + s) return false;
+    return true;
+  }
+  static int corner_of(const Cell& c, const Lat& p) {
+    const int64_t s = c.span();
+    int k = 0;
+    for (int a = 0; a < 3; ++a) {
+      if (p[a] == c.lat[a] + s) k |= 1 << a;
+      else if (p[a] != c.lat[a]) return -1;
+    }
+    return k;
+  }
+
+  Hit find(uint32_t node, const Cell& cell, const Lat& p) const {
+    const Node& n = t.nodes[node];
+    const int k = corner_of(cell, p);
+    if (k >= 0) {
+      if (n.kind == CellKind::Internal) return find(n.index + k, cell.child(k), p);
+      const bool s = n.kind == CellKind::Gray ? ((n.signs >> k) & 1) : n.kind == CellKind::Black;
+      return {1, s, node, cell};
+    }
+    if (n.kind == CellKind::White || n.kind == CellKind::Black) return {1, n.kind == CellKind::Black, node, cell};
+    if (n.kind == CellKind::Gray) return {2, false, node, cell};
+    Hit gray;
+    for (int c = 0; c < 8; ++c) {
+      const Cell cc = cell.child(c);
+      if (!contains(cc, p)) continue;
+      const Hit h = find(n.index + c, cc, p);
+      if (h.state == 1) return h;
+      if (h.state == 2 && gray.state == 0) gray = h;
+    }
+    return gray;
+  }
+
+  /// sign_X(p): single-valued by construction (a pure function of the tree and p).
+  bool sign(const Lat& p) {
+    const Hit h = find(0, Cell{}, p);
+    if (h.state != 2) return h.sign;
+    const uint64_t key = lat_key(p);
+    if (const auto it = memo.find(key); it != memo.end()) return it->second;
+    // Crossing parity along x, then y, then z from the leaf's corner 0.
+    const Node& n = t.nodes[h.leaf];
+    bool s = n.signs & 1;
+    const auto& idx = fan(h.leaf);
+    I3 a = lattice_to_grid(h.cell.lat);
+    const I3 g = lattice_to_grid(p);
+    for (int axis = 0; axis < 3; ++axis) {
+      const i64 len = g[axis] - a[axis];
+      if (len > 0) s ^= count_crossings(tris, idx, a, axis, len) & 1;
+      a[axis] = g[axis];
+    }
+    memo.emplace(key, s);
+    return s;
+  }
+};
+
+/// Sampler source over an operand's partial contour (forced subdivision, paper 5.2.3).
+class FanSource : public SurfaceSource {
+ public:
+  explicit FanSource(Operand& x) : x_(x) { tris_ = &x.tris; }
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g) const override {
+    const int64_t h = cell.span() / 2;
+    for (int i = 0; i < 27; ++i) {
+      const int a = i % 3, b = (i / 3) % 3, c = i / 9;
+      if (a != 1 && b != 1 && c != 1) continue;  // parent corner, known
+      g[i] = x_.sign({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
+    }
+  }
+
+ private:
+  Operand& x_;
+};
+
+/// An operand's state over the current cell.
+struct Side {
+  enum Kind { Uniform, Internal, Gray } kind = Uniform;
+  bool inside = false;  // Uniform
+  uint32_t node = 0;    // Internal: the node; Gray: the leaf
+  bool real = false;    // Gray: the cell is the leaf's own cell
+  uint8_t signs = 0;    // Gray: signs at this cell's corners
+  std::vector<uint32_t> idx;  // Gray: fan triangles overlapping this cell
+};
+
+class Combiner {
+ public:
+  Combiner(Octree& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
+           CsgStats& stats)
+      : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
+        stats_(stats), original_nodes_(out.nodes.size()) {}
+
+  void run() {
+    Side sa = side_of(a_, 0, Cell{});
+    Side sb = side_of(b_, 0, Cell{});
+    set(0, combine(Cell{}, sa, sb, 0));
+    for (const auto& [slot, node] : pending_) out_.nodes[slot] = node;
+  }
+
+ private:
+  // ---- output ---------------------------------------------------------------------------
+  void set(uint32_t slot, const Node& n) {
+    if (slot < original_nodes_) pending_.push_back({slot, n});
+    else out_.nodes[slot] = n;
+  }
+  uint32_t alloc8() {
+    const auto first = static_cast<uint32_t>(out_.nodes.size());
+    out_.nodes.resize(first + 8);
+    out_.stamps.resize(first + 8, stamp_);
+    return first;
+  }
+  Node gray(const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
+    const Vec3 m = cell.min_unit();
+    const double inv = double(int64_t{1} << cell.level);
+    std::array<float, 3> local;
+    for (int k = 0; k < 3; ++k) local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
+    out_.vertices.push_back(local);
+    return Node{static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray, signs, flags, 0};
+  }
+  static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
+
+  /// Copies a subtree of `src` into the output, complemented if `invert`.
+  Node copy_subtree(const Octree& src, uint32_t node, bool invert) {
+    const Node n = src.nodes[node];
+    switch (n.kind) {
+      case CellKind::White:
+      case CellKind::Black: return uniform((n.kind == CellKind::Black) != invert);
+      case CellKind::Gray:
+        out_.vertices.push_back(src.vertices[n.index]);
+        return Node{static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray,
+                    invert ? uint8_t(~n.signs) : n.signs, n.flags, 0};
+      case CellKind::Internal: {
+        const uint32_t first = alloc8();
+        for (int c = 0; c < 8; ++c) out_.nodes[first + c] = copy_subtree(src, n.index + c, invert);
+        return Node{first, CellKind::Internal, 0, 0, 0};
+      }
+    }
+    return n;
+  }
+
+  /// Resamples a (virtual) gray cell of operand x from its partial contour.
+  Node resample(Operand& x, const Cell& cell, const Side& s, bool invert) {
+    FanSource src(x);
+    SampleParams p;
+    p.max_depth = max_depth_;
+    p.error = error_;
+    p.invert = invert;
+    Builder sub;
+    sub.nodes.resize(1);
+    size_t capped = 0;
+    sample_cell(src, p, cell, s.signs, s.idx, sub, 0, capped);
+    ++stats_.forced_subdivisions;
+    return append(sub);
+  }
+  Node append(const Builder& sub) {
+    const auto offset = static_cast<uint32_t>(out_.nodes.size()) - 1;
+    const auto vbase = static_cast<uint32_t>(out_.vertices.size());
+    Node root{};
+    for (size_t k = 0; k < sub.nodes.size(); ++k) {
+      Node n = sub.nodes[k];
+      if (n.kind == CellKind::Internal) n.index += offset;
+      if (n.kind == CellKind::Gray) n.index += vbase;
+      if (k == 0) root = n;
+      else out_.nodes.push_back(n);
+    }
+    out_.stamps.resize(out_.nodes.size(), stamp_);
+    out_.vertices.insert(out_.vertices.end(), sub.vertices.begin(), sub.vertices.end());
+    return root;
+  }
+
+  // ---- operand states -------------------------------------------------------------------
+  Side side_of(Operand& x, uint32_t node, const Cell& cell) {
+    const Node& n = x.t.nodes[node];
+    Side s;
+    s.node = node;
+    if (n.kind == CellKind::Internal) {
+      s.kind = Side::Internal;
+    } else if (n.kind == CellKind::Gray) {
+      s.kind = Side::Gray;
+      s.real = true;
+      s.signs = n.signs;
+      filter_tris(x.tris, x.fan(node), cell, s.idx);
+    } else {
+      s.inside = n.kind == CellKind::Black;
+    }
+    return s;
+  }
+
+  Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
+    const Cell cc = cell.child(c);
+    if (s.kind == Side::Uniform) return s;
+    if (s.kind == Side::Internal) return side_of(x, x.t.nodes[s.node].index + c, cc);
+    Side v;
+    v.kind = Side::Gray;
+    v.node = s.node;
+    v.real = false;
+    for (int k = 0; k < 8; ++k) {
+      const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
+      bool sign;
+      if (gx != 1 && gy != 1 && gz != 1) {
+        sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
+      } else {
+        sign = x.sign(cc.corner(k));
+      }
+      v.signs |= uint8_t(sign) << k;
+    }
+    filter_tris(x.tris, s.idx, cc, v.idx);
+    if (v.idx.empty() && (v.signs == 0 || v.signs == 0xff)) {
+      Side u;
+      u.inside = v.signs != 0;
+      return u;
+    }
+    return v;
+  }
+
+  // ---- the recursion ----------------------------------------------------------------------
+  Node copy_side(Operand& x, const Side& s, const Cell& cell, bool invert, bool is_a) {
+    switch (s.kind) {
+      case Side::Uniform: return uniform(s.inside != invert);
+      case Side::Internal:
+        if (is_a && !invert) return x.t.nodes[s.node];  // unchanged subtree of A, in place
+        return copy_subtree(x.t, s.node, invert);
+      case Side::Gray:
+        if (s.real) {
+          if (is_a && !invert) return x.t.nodes[s.node];
+          return copy_subtree(x.t, s.node, invert);
+        }
+        return resample(x, cell, s, invert);
+    }
+    return uniform(false);
+  }
+
+  Node combine(const Cell& cell, const Side& a, const Side& b, uint32_t slot_hint) {
+    (void)slot_hint;
+    ++stats_.cells_visited;
+    const bool sub = op_ == CsgOp::Subtract;
+    if (a.kind == Side::Uniform) {
+      if (b.kind == Side::Uniform) return uniform(apply(op_, a.inside, b.inside));
+      // white | X = X, black & X = X, black - X = not X; the rest are uniform.
+      if (op_ == CsgOp::Union) return a.inside ? uniform(true) : copy_side(b_, b, cell, false, false);
+      if (op_ == CsgOp::Intersect) return a.inside ? copy_side(b_, b, cell, false, false) : uniform(false);
+      return a.inside ? copy_side(b_, b, cell, true, false) : uniform(false);
+    }
+    if (b.kind == Side::Uniform) {
+      if (op_ == CsgOp::Union) return b.inside ? uniform(true) : copy_side(a_, a, cell, false, true);
+      if (op_ == CsgOp::Intersect) return b.inside ? copy_side(a_, a, cell, false, true) : uniform(false);
+      return b.inside ? uniform(false) : copy_side(a_, a, cell, false, true);
+    }
+    (void)sub;
+    if (a.kind == Side::Internal || b.kind == Side::Internal) return subdivide(cell, a, b);
+    return gray_cell(cell, a, b);
+  }
+
+  Node subdivide(const Cell& cell, const Side& a, const Side& b) {
+    // Children of A's internal node are written in place; otherwise new slots.
+    uint32_t first;
+    if (a.kind == Side::Internal) {
+      first = a_.t.nodes[a.node].index;
+    } else {
+      first = alloc8();
+      if (a.kind == Side::Gray && a.real) ++stats_.forced_subdivisions;
+    }
+    if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
+    bool all_uniform = true;
+    std::array<Node, 8> kids;
+    for (int c = 0; c < 8; ++c) {
+      const Side ca = child_side(a_, a, cell, c);
+      const Side cb = child_side(b_, b, cell, c);
+      kids[c] = combine(cell.child(c), ca, cb, first + c);
+      set(first + c, kids[c]);
+      all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
+                    kids[c].kind == kids[0].kind;
+    }
+    if (all_uniform) return uniform(kids[0].kind == CellKind::Black);  // collapse
+    return Node{first, CellKind::Internal, 0, 0, 0};
+  }
+
+  struct EdgeCrossing {
+    bool change;
+    double t;
+    int count;
+  };
+  EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axis, i64 len, int c0, int c1) {
+    EdgeCrossing r{(((s.signs >> c0) ^ (s.signs >> c1)) & 1) != 0, 0.5, 0};
+    for (uint32_t k : s.idx) {
+      if (crosses(x.tris[k], a, axis, len)) {
+        if (r.count == 0) r.t = crossing_param(x.tris[k], a, axis, len);
+        ++r.count;
+      }
+    }
+    return r;
+  }
+
+  Node gray_cell(const Cell& cell, const Side& a, const Side& b) {
+    ++stats_.gray_pairs;
+    const uint8_t sr = apply_mask(op_, a.signs, b.signs);
+    const bool at_cap = cell.level >= max_depth_;
+    const bool r_uniform = sr == 0 || sr == 0xff;
+    bool must_split = false;
+    // A virtual cell with no sign change still holds surface: refine until it resolves.
+    if ((!a.real && (a.signs == 0 || a.signs == 0xff)) || (!b.real && (b.signs == 0 || b.signs == 0xff)))
+      must_split = true;
+
+    // Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
+    // Table 1): two result crossings on one edge force a subdivision.
+    bool vis_a = false, vis_b = false;
+    const I3 lo = lattice_to_grid(cell.lat);
+    const i64 len = lattice_to_grid(cell.span());
+    for (int e = 0; e < 12 && !must_split; ++e) {
+      const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+      const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
+      const EdgeCrossing ea = edge_crossing(a_, a, p, axis, len, c0, c1);
+      const EdgeCrossing eb = edge_crossing(b_, b, p, axis, len, c0, c1);
+      if ((!a.real && ea.count >= 2) || (!b.real && eb.count >= 2)) {
+        must_split = true;
+        break;
+      }
+      if (!ea.change && !eb.change) continue;
+      const bool a0 = (a.signs >> c0) & 1, b0 = (b.signs >> c0) & 1;
+      auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
+      auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
+      int n_r = 0;
+      if (ea.change && eb.change && ea.t == eb.t) {
+        n_r = apply(op_, a0, b0) != apply(op_, !a0, !b0);
+        vis_a = vis_b = vis_a || n_r;
+      } else {
+        if (ea.change) {
+          const bool vis = apply(op_, a0, in_b(ea.t)) != apply(op_, !a0, in_b(ea.t));
+          n_r += vis;
+          vis_a = vis_a || vis;
+        }
+        if (eb.change) {
+          const bool vis = apply(op_, in_a(eb.t), b0) != apply(op_, in_a(eb.t), !b0);
+          n_r += vis;
+          vis_b = vis_b || vis;
+        }
+      }
+      if (n_r >= 2) must_split = true;
+    }
+
+    Qef qa, qb;
+    cell_qef(a_.tris, a.idx, cell, qa);
+    cell_qef(b_.tris, b.idx, cell, qb);
+    Qef q = qa;
+    q += qb;
+    auto vertex_of = [&](const Operand& x, const Side& s, const Qef& qs) {
+      if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
+      return cell_vertex(qs, cell).position;
+    };
+    bool meets = false;
+    if (!must_split) {
+      for (size_t i = 0; i < a.idx.size() && !meets; ++i)
+        for (size_t j = 0; j < b.idx.size() && !meets; ++j)
+          meets = triangles_meet_in_box(a_.tris[a.idx[i]], b_.tris[b.idx[j]], cell.box());
+      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
+      if (!meets) {
+        // Triangle-fan culling: the surfaces do not meet here, so the result is one operand's
+        // cell, or uniform, when the signs agree.
+        if (!vis_a && !vis_b && r_uniform) return uniform(sr != 0);
+        if (vis_a && !vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
+        if (vis_b && !vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
+      } else {
+        // Q_sum = Q_A + Q_B minimized from the average of the two vertices (paper eq. 3).
+        const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
+        const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
+        Qef::Solution sol = q.solve(seed);
+        if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell);
+        if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr))
+          return gray(cell, sr, sol.position, 0);
+      }
+    }
+    if (at_cap) {
+      if (r_uniform) return uniform(sr != 0);
+      const Vec3 seed = q.empty() ? Vec3{cell.min_unit()[0] + cell.size() / 2, cell.min_unit()[1] + cell.size() / 2,
+                                          cell.min_unit()[2] + cell.size() / 2}
+                                  : cell_vertex(q, cell).position;
+      return gray(cell, sr, seed, kFlagCapped);
+    }
+    return subdivide(cell, a, b);
+  }
+
+  Octree& out_;
+  Operand& a_;
+  Operand& b_;
+  CsgOp op_;
+  double error_;
+  int max_depth_;
+  uint32_t stamp_;
+  CsgStats& stats_;
+  size_t original_nodes_;
+  std::vector<std::pair<uint32_t, Node>> pending_;
+};
+
+/// Stamps the overlap: pairs of cells where neither operand is uniform (paper 5.2.1).
+void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, uint32_t stamp, size_t& count) {
+  const Node& x = a.nodes[na];
+  const Node& y = b.nodes[nb];
+  const bool ux = x.kind == CellKind::White || x.kind == CellKind::Black;
+  const bool uy = y.kind == CellKind::White || y.kind == CellKind::Black;
+  if (ux || uy) return;
+  if (a.stamps[na] != stamp) {
+    a.stamps[na] = stamp;
+    ++count;
+  }
+  if (b.stamps[nb] != stamp) {
+    b.stamps[nb] = stamp;
+    ++count;
+  }
+  if (x.kind != CellKind::Internal && y.kind != CellKind::Internal) return;
+  for (int c = 0; c < 8; ++c)
+    tag(a, x.kind == CellKind::Internal ? x.index + c : na, b, y.kind == CellKind::Internal ? y.index + c : nb,
+        stamp, count);
+}
+
+/// Triangle fans of the stamped PICs (the partial contour).
+void partial_contour(Operand& x, uint32_t stamp) {
+  const Octree& t = x.t;
+  std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
+  std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
+    std::array<I3, 4> g;
+    for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
+    auto add = [&](int i, int j, int k) {
+      const auto id = static_cast<uint32_t>(x.tris.size());
+      x.tris.push_back(make_itri(g[i], g[j], g[k]));
+      for (int m = 0; m < poly.count; ++m)
+        if (t.stamps[poly.leaf[m]] == stamp) x.fans[poly.leaf[m]].push_back(id);
+    };
+    if (poly.count == 3) {
+      add(0, 1, 2);
+      return;
+    }
+    for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]})) add(tri[0], tri[1], tri[2]);
+  };
+  dual_walk(t, &active, emit);
+}
+
+/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
+/// edge's midpoint), so the contour stays closed whatever the geometry decided.
+size_t repair(Octree& t, uint32_t stamp) {
+  size_t fixed = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    DualStats ds;
+    std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
+    std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
+    dual_walk(t, &active, emit, &ds);
+    if (ds.cracks == 0) break;
+    std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
+    std::unordered_map<uint32_t, Cell> cells;
+    for (size_t k = 0; k < ds.crack_leaves.size(); ++k) {
+      auto& [sum, n] = mid_sum[ds.crack_leaves[k]];
+      for (int a = 0; a < 3; ++a) sum[a] += ds.crack_points[k][a];
+      ++n;
+      cells[ds.crack_leaves[k]] = ds.crack_cells[k];
+    }
+    for (const auto& [node, ms] : mid_sum) {
+      Node& n = t.nodes[node];
+      if (n.kind == CellKind::Gray) continue;
+      const Cell& cell = cells[node];
+      const auto& [sum, cnt] = ms;
+      constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
+      const Vec3 x{sum[0] * k / (2 * cnt), sum[1] * k / (2 * cnt), sum[2] * k / (2 * cnt)};
+      const uint8_t signs = n.kind == CellKind::Black ? 0xff : 0;
+      const Vec3 m = cell.min_unit();
+      const double inv = double(int64_t{1} << cell.level);
+      std::array<float, 3> local;
+      for (int a = 0; a < 3; ++a) local[a] = static_cast<float>(std::clamp((x[a] - m[a]) * inv, 0.0, 1.0));
+      t.vertices.push_back(local);
+      n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, signs, 0, 0};
+      ++fixed;
+    }
+  }
+  return fixed;
+}
+
+/// Drops unreachable nodes and vertices (left behind by in-place replacement).
+void compact(Octree& t) {
+  Octree c;
+  c.cube = t.cube;
+  c.max_depth = t.max_depth;
+  c.nodes.clear();
+  c.nodes.reserve(t.nodes.size());
+  c.nodes.push_back(Node{});
+  c.stamps.assign(1, t.stamps.empty() ? 0 : t.stamps[0]);
+  std::function<void(uint32_t, uint32_t)> copy = [&](uint32_t from, uint32_t to) {
+    Node n = t.nodes[from];
+    if (n.kind == CellKind::Gray) {
+      c.vertices.push_back(t.vertices[n.index]);
+      n.index = static_cast<uint32_t>(c.vertices.size() - 1);
+    } else if (n.kind == CellKind::Internal) {
+      const auto first = static_cast<uint32_t>(c.nodes.size());
+      c.nodes.resize(first + 8);
+      c.stamps.resize(first + 8, 0);
+      for (int k = 0; k < 8; ++k) {
+        c.stamps[first + k] = t.stamps[n.index + k];
+        copy(n.index + k, first + k);
+      }
+      n.index = first;
+    }
+    c.nodes[to] = n;
+  };
+  copy(0, 0);
+  t.nodes = std::move(c.nodes);
+  t.vertices = std::move(c.vertices);
+  t.stamps = std::move(c.stamps);
+}
+
+}  // namespace
+
+size_t reachable_nodes(const Octree& t) {
+  size_t n = 0;
+  std::function<void(uint32_t)> walk = [&](uint32_t i) {
+    ++n;
+    if (t.nodes[i].kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) walk(t.nodes[i].index + c);
+  };
+  walk(0);
+  return n;
+}
+
+}  // namespace detail
+
+void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& options, CsgStats* stats_out) {
+  using namespace detail;
+  const auto t0 = Clock::now();
+  CsgStats stats;
+  // One frame: re-express B in A's cube when they differ (resample its contour).
+  std::optional<Octree> resampled;
+  if (!(a.cube == b_in.cube)) {
+    SampleOptions so;
+    so.cube = a.cube;
+    so.depth = std::max(a.max_depth, b_in.max_depth);
+    so.error = options.error;
+    try {
+      resampled = sample(contour(b_in), so);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(std::string("operand B cannot be expressed in A's cube: ") + e.what());
+    }
+    stats.resampled_b = true;
+  } else if (&a == &b_in) {
+    resampled = b_in;
+  }
+  const Octree& b = resampled ? *resampled : b_in;
+  const int depth = std::max(a.max_depth, b.max_depth);
+
+  const uint32_t stamp = ++g_timestamp;
+  stats.stamp = stamp;
+  if (a.stamps.size() != a.nodes.size()) a.stamps.resize(a.nodes.size(), 0);
+  if (b.stamps.size() != b.nodes.size()) b.stamps.resize(b.nodes.size(), 0);
+  tag(a, 0, b, 0, stamp, stats.cells_stamped);
+
+  Operand oa(a), ob(b);
+  auto tc = Clock::now();
+  partial_contour(oa, stamp);
+  stats.contour_a_seconds = since(tc);
+  tc = Clock::now();
+  partial_contour(ob, stamp);
+  stats.contour_b_seconds = since(tc);
+
+  tc = Clock::now();
+  const size_t before = a.nodes.size();
+  {
+    Octree& out = a;  // in place; original slots are written only after the recursion
+    Combiner comb(out, oa, ob, op, options.error, depth, stamp, stats);
+    comb.run();
+  }
+  a.max_depth = depth;
+  stats.repaired = repair(a, stamp);
+  stats.csg_seconds = since(tc);
+  // Amortized garbage collection of replaced subtrees.
+  if (a.nodes.size() > 2 * std::max<size_t>(before, 4096) || a.nodes.size() > before + 65536) {
+    if (a.nodes.size() > 2 * reachable_nodes(a)) compact(a);
+  }
+  stats.seconds = since(t0);
+  if (stats_out) *stats_out = stats;
+}
+
+Octree csg(const Octree& a, const Octree& b, CsgOp op, const CsgOptions& options, CsgStats* stats) {
+  Octree r = a;
+  csg_inplace(r, b, op, options, stats);
+  if (r.nodes.size() > a.nodes.size() + 1024 || r.nodes.size() > 2 * detail::reachable_nodes(r)) detail::compact(r);
+  return r;
+}
+
+}  // namespace pic

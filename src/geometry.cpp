@@ -1,0 +1,273 @@
+#include "geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pic::detail {
+namespace {
+
+int sgn(i128 v) { return (v > 0) - (v < 0); }
+
+// Sign of f(p + delta) for the plane function f(p) = n.p - d, delta = (e, e^2, e^3).
+int perturbed_plane_sign(const ITri& t, const I3& p) {
+  const i128 f = t.n[0] * p[0] + t.n[1] * p[1] + t.n[2] * p[2] - t.d;
+  if (f != 0) return sgn(f);
+  if (t.n[0] != 0) return sgn(t.n[0]);
+  if (t.n[1] != 0) return sgn(t.n[1]);
+  return sgn(t.n[2]);
+}
+
+// Orientation of (u, w, q + delta) in the (i, j) projection, perturbed (never 0 unless u == w).
+int perturbed_orient(const I3& u, const I3& w, const I3& q, int i, int j) {
+  const i128 o = i128(w[i] - u[i]) * (q[j] - u[j]) - i128(w[j] - u[j]) * (q[i] - u[i]);
+  if (o != 0) return sgn(o);
+  if (u[j] != w[j]) return u[j] > w[j] ? 1 : -1;  // coefficient of delta_i
+  return w[i] > u[i] ? 1 : (w[i] < u[i] ? -1 : 0);  // coefficient of delta_j
+}
+
+struct Poly {
+  std::array<Vec3, 12> p;
+  int n = 0;
+};
+
+// Clip against the half-space sign*(x[axis] - value) <= 0, snapping new points onto the plane.
+void clip(Poly& poly, int axis, double value, bool keep_below) {
+  Poly out;
+  for (int k = 0; k < poly.n; ++k) {
+    const Vec3& a = poly.p[k];
+    const Vec3& b = poly.p[(k + 1) % poly.n];
+    const double da = keep_below ? a[axis] - value : value - a[axis];
+    const double db = keep_below ? b[axis] - value : value - b[axis];
+    if (da <= 0) out.p[out.n++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      const double s = da / (da - db);
+      Vec3 x{a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])};
+      x[axis] = value;
+      out.p[out.n++] = x;
+    }
+  }
+  poly = out;
+}
+
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+std::array<uint8_t, 256> make_component_table() {
+  std::array<uint8_t, 256> table{};
+  for (int m = 0; m < 256; ++m) {
+    if (m == 0 || m == 255) continue;
+    auto connected = [&](bool inside) {
+      int seen = 0, stack = 0;
+      int first = -1;
+      for (int c = 0; c < 8; ++c)
+        if (((m >> c) & 1) == inside) first = first < 0 ? c : first;
+      seen = 1 << first;
+      stack = 1 << first;
+      while (stack) {
+        const int c = __builtin_ctz(stack);
+        stack &= stack - 1;
+        for (int a = 0; a < 3; ++a) {
+          const int nb = c ^ (1 << a);
+          if (((m >> nb) & 1) == inside && !((seen >> nb) & 1)) {
+            seen |= 1 << nb;
+            stack |= 1 << nb;
+          }
+        }
+      }
+      for (int c = 0; c < 8; ++c)
+        if (((m >> c) & 1) == inside && !((seen >> c) & 1)) return false;
+      return true;
+    };
+    table[m] = connected(true) && connected(false);
+  }
+  return table;
+}
+
+}  // namespace
+
+ITri make_itri(const I3& a, const I3& b, const I3& c) {
+  ITri t;
+  t.v = {a, b, c};
+  const i128 e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const i128 e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  t.n = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  t.d = t.n[0] * a[0] + t.n[1] * a[1] + t.n[2] * a[2];
+  for (int k = 0; k < 3; ++k) {
+    t.lo[k] = std::min({a[k], b[k], c[k]});
+    t.hi[k] = std::max({a[k], b[k], c[k]});
+  }
+  return t;
+}
+
+bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
+  const int i = axis == 0 ? 1 : 0;
+  const int j = axis == 2 ? 1 : 2;
+  // Bounding-box rejection; the perturbation moves q by +delta, so q == hi is outside.
+  if (a[i] < t.lo[i] || a[i] >= t.hi[i] || a[j] < t.lo[j] || a[j] >= t.hi[j]) return false;
+  if (a[axis] + len < t.lo[axis] || a[axis] > t.hi[axis]) return false;
+  if (t.n[axis] == 0) return false;  // parallel to the segment: never crossed after perturbation
+  const int orient = sgn(i128(t.v[1][i] - t.v[0][i]) * (t.v[2][j] - t.v[0][j]) -
+                         i128(t.v[1][j] - t.v[0][j]) * (t.v[2][i] - t.v[0][i]));
+  for (int e = 0; e < 3; ++e) {
+    if (perturbed_orient(t.v[e], t.v[(e + 1) % 3], a, i, j) != orient) return false;
+  }
+  I3 b = a;
+  b[axis] += len;
+  return perturbed_plane_sign(t, a) != perturbed_plane_sign(t, b);
+}
+
+int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
+                    int axis, i64 len) {
+  int n = 0;
+  for (uint32_t k : idx) n += crosses(tris[k], a, axis, len);
+  return n;
+}
+
+bool overlaps_box(const ITri& t, const I3& lo, const I3& hi) {
+  for (int k = 0; k < 3; ++k)
+    if (t.hi[k] < lo[k] || t.lo[k] > hi[k]) return false;
+  i128 fmin = -t.d, fmax = -t.d;
+  for (int k = 0; k < 3; ++k) {
+    const i128 x = t.n[k] * lo[k], y = t.n[k] * hi[k];
+    fmin += std::min(x, y);
+    fmax += std::max(x, y);
+  }
+  return fmin <= 0 && fmax >= 0;
+}
+
+double clipped_area(const ITri& t, const IBox& box) {
+  for (int k = 0; k < 3; ++k)
+    if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return -1;
+  Poly poly;
+  poly.n = 3;
+  for (int k = 0; k < 3; ++k) poly.p[k] = to_unit(t.v[k]);
+  const Vec3 lo = to_unit(box.lo), hi = to_unit(box.hi);
+  for (int k = 0; k < 3 && poly.n > 0; ++k) {
+    clip(poly, k, hi[k], true);
+    if (poly.n > 0) clip(poly, k, lo[k], false);
+  }
+  if (poly.n == 0) return -1;
+  for (int k = 0; k < 3; ++k) {
+    bool all_low = true;
+    for (int q = 0; q < poly.n && all_low; ++q) all_low = poly.p[q][k] == lo[k];
+    if (all_low) return -1;  // lies in a low face: the perturbation hands it to the neighbour
+  }
+  Vec3 acc{0, 0, 0};
+  for (int q = 1; q + 1 < poly.n; ++q) {
+    const Vec3 c = cross(sub(poly.p[q], poly.p[0]), sub(poly.p[q + 1], poly.p[0]));
+    acc = {acc[0] + c[0], acc[1] + c[1], acc[2] + c[2]};
+  }
+  return 0.5 * std::sqrt(dot(acc, acc));
+}
+
+double crossing_param(const ITri& t, const I3& a, int axis, i64 len) {
+  const i128 f = t.n[0] * a[0] + t.n[1] * a[1] + t.n[2] * a[2] - t.d;
+  const double den = static_cast<double>(t.n[axis]) * static_cast<double>(len);
+  if (den == 0) return 0.5;
+  return std::clamp(-static_cast<double>(f) / den, 0.0, 1.0);
+}
+
+bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
+  for (int k = 0; k < 3; ++k) {
+    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+  }
+  const std::array<Vec3, 3> pa = {to_unit(a.v[0]), to_unit(a.v[1]), to_unit(a.v[2])};
+  const std::array<Vec3, 3> pb = {to_unit(b.v[0]), to_unit(b.v[1]), to_unit(b.v[2])};
+  const Vec3 na = cross(sub(pa[1], pa[0]), sub(pa[2], pa[0]));
+  const Vec3 nb = cross(sub(pb[1], pb[0]), sub(pb[2], pb[0]));
+  const double la = std::sqrt(dot(na, na)), lb = std::sqrt(dot(nb, nb));
+  if (la == 0 || lb == 0) return false;
+  const Vec3 lo = to_unit(box.lo), hi = to_unit(box.hi);
+  // Signed distances of each triangle's vertices to the other's plane.
+  std::array<double, 3> da, db;
+  for (int k = 0; k < 3; ++k) {
+    db[k] = dot(nb, sub(pa[k], pb[0])) / lb;  // a's vertices vs plane b
+    da[k] = dot(na, sub(pb[k], pa[0])) / la;  // b's vertices vs plane a
+  }
+  constexpr double kEps = 1e-13;  // root-cube units: snap near-zero distances to the plane
+  for (auto* d : {&da, &db})
+    for (double& x : *d)
+      if (std::abs(x) < kEps) x = 0;
+  auto same_side = [](const std::array<double, 3>& d) {
+    return (d[0] > 0 && d[1] > 0 && d[2] > 0) || (d[0] < 0 && d[1] < 0 && d[2] < 0);
+  };
+  if (same_side(da) || same_side(db)) return false;
+  const bool coplanar = da[0] == 0 && da[1] == 0 && da[2] == 0;
+  if (coplanar) {
+    // Coplanar overlapping sheets (e.g. coincident box faces): count as meeting when the
+    // bounding boxes overlap inside the cell; the QEF then sees one plane twice.
+    for (int k = 0; k < 3; ++k) {
+      const double l = std::max({lo[k], std::min({pa[0][k], pa[1][k], pa[2][k]}),
+                                 std::min({pb[0][k], pb[1][k], pb[2][k]})});
+      const double h = std::min({hi[k], std::max({pa[0][k], pa[1][k], pa[2][k]}),
+                                 std::max({pb[0][k], pb[1][k], pb[2][k]})});
+      if (l > h) return false;
+    }
+    return true;
+  }
+  // Segment where a triangle crosses the other's plane.
+  auto plane_segment = [](const std::array<Vec3, 3>& p, const std::array<double, 3>& d, Vec3& s0,
+                          Vec3& s1) {
+    int n = 0;
+    Vec3 pts[3];
+    for (int k = 0; k < 3 && n < 2; ++k) {
+      const int m = (k + 1) % 3;
+      if (d[k] == 0) {
+        pts[n++] = p[k];
+      } else if ((d[k] < 0 && d[m] > 0) || (d[k] > 0 && d[m] < 0)) {
+        const double s = d[k] / (d[k] - d[m]);
+        pts[n++] = {p[k][0] + s * (p[m][0] - p[k][0]), p[k][1] + s * (p[m][1] - p[k][1]),
+                    p[k][2] + s * (p[m][2] - p[k][2])};
+      }
+    }
+    if (n == 0) return false;
+    s0 = pts[0];
+    s1 = n > 1 ? pts[1] : pts[0];
+    return true;
+  };
+  Vec3 a0, a1, b0, b1;
+  if (!plane_segment(pa, db, a0, a1) || !plane_segment(pb, da, b0, b1)) return false;
+  const Vec3 dir = cross(na, nb);
+  const double ta0 = dot(dir, a0), ta1 = dot(dir, a1), tb0 = dot(dir, b0), tb1 = dot(dir, b1);
+  const double amin = std::min(ta0, ta1), amax = std::max(ta0, ta1);
+  const double bmin = std::min(tb0, tb1), bmax = std::max(tb0, tb1);
+  const double smin = std::max(amin, bmin), smax = std::min(amax, bmax);
+  if (smin > smax) return false;
+  // The common segment, as points on a's segment.
+  auto at = [&](double tv) {
+    const double span = ta1 - ta0;
+    const double s = span == 0 ? 0 : (tv - ta0) / span;
+    return Vec3{a0[0] + s * (a1[0] - a0[0]), a0[1] + s * (a1[1] - a0[1]), a0[2] + s * (a1[2] - a0[2])};
+  };
+  Vec3 p = at(smin), q = at(smax);
+  // Slab clip of segment p-q against the closed box.
+  double t0 = 0, t1 = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double d = q[k] - p[k];
+    if (d == 0) {
+      if (p[k] < lo[k] || p[k] > hi[k]) return false;
+      continue;
+    }
+    double u0 = (lo[k] - p[k]) / d, u1 = (hi[k] - p[k]) / d;
+    if (u0 > u1) std::swap(u0, u1);
+    t0 = std::max(t0, u0);
+    t1 = std::min(t1, u1);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+I3 to_grid(const Vec3& u) {
+  return {std::llround(u[0] * kGridScale), std::llround(u[1] * kGridScale),
+          std::llround(u[2] * kGridScale)};
+}
+
+bool one_component(uint8_t signs) {
+  static const std::array<uint8_t, 256> table = make_component_table();
+  return table[signs] != 0;
+}
+
+}  // namespace pic::detail

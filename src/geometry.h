@@ -1,0 +1,95 @@
+// Exact geometry on a fixed-point grid.
+//
+// Everything inside the library lives in root-cube units ([0,1]^3). Triangle vertices are
+// snapped to a grid of 2^-32 (2.3e-10 of the root cube, far below any tolerance) and kept as
+// int64, so the in/out predicates that decide corner signs are exact with __int128 products.
+// Lattice points of the octree (level <= kMaxLevel = 20) are exact on that grid.
+//
+// Sign convention (the tie-break the whole system relies on): a point p is classified as
+// p + (e, e^2, e^3) for an infinitesimal e — Simulation of Simplicity. A box face lying exactly
+// on an octree plane therefore gets one consistent answer from every cell and every level.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "pic/pic.h"
+
+namespace pic::detail {
+
+using i64 = int64_t;
+using i128 = __int128;
+using I3 = std::array<i64, 3>;
+
+inline constexpr int kGridBits = 32;
+inline constexpr double kGridScale = 4294967296.0;  // 2^32
+
+/// Lattice coordinate (level-kMaxLevel units) to grid units.
+inline i64 lattice_to_grid(int64_t l) { return l << (kGridBits - kMaxLevel); }
+inline I3 lattice_to_grid(const std::array<int64_t, 3>& l) {
+  return {lattice_to_grid(l[0]), lattice_to_grid(l[1]), lattice_to_grid(l[2])};
+}
+inline double grid_to_unit(i64 g) { return static_cast<double>(g) / kGridScale; }
+
+/// A triangle on the grid with its exact (unnormalized) normal and plane offset.
+struct ITri {
+  std::array<I3, 3> v;
+  std::array<i128, 3> n;  // (v1-v0) x (v2-v0), < 2^70 per component
+  i128 d;                 // n . v0
+  I3 lo, hi;              // bounding box
+};
+ITri make_itri(const I3& a, const I3& b, const I3& c);
+inline bool is_degenerate(const ITri& t) { return t.n[0] == 0 && t.n[1] == 0 && t.n[2] == 0; }
+
+/// Whether the axis-parallel segment from `a` to `a + len * e_axis` (len > 0) crosses `t`,
+/// under the symbolic perturbation above. Exact.
+bool crosses(const ITri& t, const I3& a, int axis, i64 len);
+
+/// Number of crossings of `tris[idx]` with the segment (exact, perturbed).
+int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
+                    int axis, i64 len);
+
+/// Conservative overlap of a triangle with the closed box [lo, hi] (bbox + plane test, exact).
+bool overlaps_box(const ITri& t, const I3& lo, const I3& hi);
+
+/// Cell box in grid units.
+struct IBox {
+  I3 lo, hi;
+};
+inline IBox cell_box(int level, const std::array<int64_t, 3>& lat) {
+  const int64_t s = int64_t{1} << (kMaxLevel - level);
+  return {lattice_to_grid(lat), lattice_to_grid({lat[0] + s, lat[1] + s, lat[2] + s})};
+}
+
+/// Area of the part of the triangle inside the box, under the perturbation convention:
+/// a piece that lies entirely in one of the box's low faces belongs to the neighbour below,
+/// so it counts as 0; a piece of zero area inside the box counts as a tiny positive weight.
+/// Returns < 0 when the triangle does not meet the box. Double precision (used for QEFs).
+double clipped_area(const ITri& t, const IBox& box);
+
+/// Parameter in [0,1] of the crossings of `t` on the segment (double; for directed distances).
+double crossing_param(const ITri& t, const I3& a, int axis, i64 len);
+
+/// Whether triangles a and b intersect inside the closed box (double precision).
+bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box);
+
+/// Unit-space position of a grid point.
+inline Vec3 to_unit(const I3& g) { return {grid_to_unit(g[0]), grid_to_unit(g[1]), grid_to_unit(g[2])}; }
+/// Snap a unit-space position to the grid.
+I3 to_grid(const Vec3& u);
+
+// Cube corner / edge tables. Corner c = (c&1, c>>1&1, c>>2&1).
+inline constexpr std::array<std::array<int, 2>, 12> kEdgeCorners = {{
+    {0, 1}, {2, 3}, {4, 5}, {6, 7},  // along x
+    {0, 2}, {1, 3}, {4, 6}, {5, 7},  // along y
+    {0, 4}, {1, 5}, {2, 6}, {3, 7},  // along z
+}};
+inline constexpr int edge_axis(int e) { return e / 4; }
+
+/// One surface component by corner signs: inside corners connected along cube edges and
+/// outside corners connected too (the 7 one-component Marching Cubes classes and their
+/// complements). Uniform sign masks return false.
+bool one_component(uint8_t signs);
+
+}  // namespace pic::detail

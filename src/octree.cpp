@@ -1,0 +1,61 @@
+#include <algorithm>
+
+#include "octree_util.h"
+
+namespace pic::detail {
+
+void Builder::set_gray(uint32_t slot, const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
+  const Vec3 m = cell.min_unit();
+  const double inv = double(int64_t{1} << cell.level);
+  std::array<float, 3> local;
+  for (int k = 0; k < 3; ++k)
+    local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
+  nodes[slot] = Node{static_cast<uint32_t>(vertices.size()), CellKind::Gray, signs, flags, 0};
+  vertices.push_back(local);
+}
+
+void Builder::splice(uint32_t slot, const Builder& sub) {
+  const auto offset = static_cast<uint32_t>(nodes.size()) - 1;
+  const auto vbase = static_cast<uint32_t>(vertices.size());
+  nodes.reserve(nodes.size() + sub.nodes.size());
+  for (size_t k = 0; k < sub.nodes.size(); ++k) {
+    Node n = sub.nodes[k];
+    if (n.kind == CellKind::Internal) n.index += offset;
+    if (n.kind == CellKind::Gray) n.index += vbase;
+    if (k == 0) {
+      nodes[slot] = n;
+    } else {
+      nodes.push_back(n);
+    }
+  }
+  if (track_stamps) {
+    stamps.resize(nodes.size(), 0);
+    if (!sub.stamps.empty()) {
+      stamps[slot] = sub.stamps[0];
+      std::copy(sub.stamps.begin() + 1, sub.stamps.end(), stamps.end() - (sub.nodes.size() - 1));
+    }
+  }
+  vertices.insert(vertices.end(), sub.vertices.begin(), sub.vertices.end());
+}
+
+}  // namespace pic::detail
+
+namespace pic {
+
+void for_each_leaf(const Octree& tree, const std::function<void(const LeafView&)>& visit) {
+  detail::visit_leaves(tree, 0, detail::Cell{}, [&](uint32_t node, const detail::Cell& cell) {
+    const Node& n = tree.nodes[node];
+    LeafView v;
+    v.node = node;
+    v.level = cell.level;
+    v.cell_min = detail::unit_to_world(tree.cube, cell.min_unit());
+    v.cell_size = cell.size() * tree.cube.size;
+    v.kind = n.kind;
+    v.signs = n.signs;
+    if (n.kind == CellKind::Gray)
+      v.vertex = detail::unit_to_world(tree.cube, detail::vertex_unit(cell, tree.vertices[n.index]));
+    visit(v);
+  });
+}
+
+}  // namespace pic

@@ -1,0 +1,62 @@
+#include "qef.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace pic::detail {
+
+void Qef::add_plane(const Vec3& n, double d, double w) {
+  a[0] += w * n[0] * n[0];
+  a[1] += w * n[0] * n[1];
+  a[2] += w * n[0] * n[2];
+  a[3] += w * n[1] * n[1];
+  a[4] += w * n[1] * n[2];
+  a[5] += w * n[2] * n[2];
+  b[0] += w * n[0] * d;
+  b[1] += w * n[1] * d;
+  b[2] += w * n[2] * d;
+  c += w * d * d;
+  weight += w;
+}
+
+Qef& Qef::operator+=(const Qef& o) {
+  for (int k = 0; k < 6; ++k) a[k] += o.a[k];
+  for (int k = 0; k < 3; ++k) b[k] += o.b[k];
+  c += o.c;
+  weight += o.weight;
+  return *this;
+}
+
+double Qef::error(const Vec3& x) const {
+  if (weight <= 0) return 0;
+  const double ax0 = a[0] * x[0] + a[1] * x[1] + a[2] * x[2];
+  const double ax1 = a[1] * x[0] + a[3] * x[1] + a[4] * x[2];
+  const double ax2 = a[2] * x[0] + a[4] * x[1] + a[5] * x[2];
+  const double q = x[0] * ax0 + x[1] * ax1 + x[2] * ax2 - 2 * (b[0] * x[0] + b[1] * x[1] + b[2] * x[2]) + c;
+  return std::max(q, 0.0) / weight;
+}
+
+Qef::Solution Qef::solve(const Vec3& seed) const {
+  if (weight <= 0) return {seed, 0, 0};
+  Eigen::Matrix3d m;
+  m << a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5];
+  const Eigen::Vector3d s(seed[0], seed[1], seed[2]);
+  const Eigen::Vector3d r = Eigen::Vector3d(b[0], b[1], b[2]) - m * s;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  const Eigen::Vector3d ev = eig.eigenvalues();
+  const double top = std::max({std::abs(ev[0]), std::abs(ev[1]), std::abs(ev[2])});
+  Eigen::Vector3d inv = Eigen::Vector3d::Zero();
+  int rank = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (top > 0 && std::abs(ev[k]) > kRelativeCutoff * top) {
+      inv[k] = 1.0 / ev[k];
+      ++rank;
+    }
+  }
+  const Eigen::Matrix3d& u = eig.eigenvectors();
+  const Eigen::Vector3d x = s + u * inv.asDiagonal() * (u.transpose() * r);
+  const Vec3 p{x[0], x[1], x[2]};
+  return {p, error(p), rank};
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,39 @@
+// Quadric error function Q(x) = x'Ax - 2b'x + c over weighted planes (paper eq. 1),
+// stored in compact symmetric form so two QEFs add (Q_sum = Q_A + Q_B, paper eq. 3).
+#pragma once
+
+#include <array>
+
+#include "pic/pic.h"
+
+namespace pic::detail {
+
+struct Qef {
+  std::array<double, 6> a{};  // xx xy xz yy yz zz
+  std::array<double, 3> b{};
+  double c = 0;
+  double weight = 0;  // sum of plane weights; the residual is reported per unit weight
+
+  /// Adds the plane n.x = d (n unit length) with weight w.
+  void add_plane(const Vec3& n, double d, double w);
+  Qef& operator+=(const Qef& o);
+  bool empty() const { return weight <= 0; }
+  /// Mean squared distance of x to the planes.
+  double error(const Vec3& x) const;
+
+  struct Solution {
+    Vec3 position;
+    double error;  // mean squared distance (root-cube units squared)
+    int rank;
+  };
+  /// x = seed + A+ (b - A seed), A+ by truncated eigendecomposition (Lindstrom 2000):
+  /// eigenvalues below kRelativeCutoff * largest are zeroed, so flat and creased patches
+  /// keep the vertex close to the seed along their free directions.
+  Solution solve(const Vec3& seed) const;
+};
+
+/// Relative eigenvalue cutoff of the pseudo-inverse. Singular values of A^(1/2) below 0.1 of
+/// the largest are dropped, as in Ju et al. 2002 (dual contouring).
+inline constexpr double kRelativeCutoff = 1e-2;
+
+}  // namespace pic::detail

@@ -1,0 +1,263 @@
+#include "sample.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+namespace pic::detail {
+
+void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
+                                  std::array<bool, 27>& g) const {
+  const int64_t h = lattice_to_grid(cell.span() / 2);
+  const I3 base = lattice_to_grid(cell.lat);
+  // Visit points by how many of their coordinates are mid (1): edge midpoints, face centres,
+  // then the centre; each is reached from an already known point along one axis.
+  for (int ones = 1; ones <= 3; ++ones) {
+    for (int i = 0; i < 27; ++i) {
+      const int a[3] = {i % 3, (i / 3) % 3, i / 9};
+      if ((a[0] == 1) + (a[1] == 1) + (a[2] == 1) != ones) continue;
+      const int axis = a[0] == 1 ? 0 : (a[1] == 1 ? 1 : 2);
+      const int from = i - (axis == 0 ? 1 : axis == 1 ? 3 : 9);  // same point, coordinate 0
+      const I3 start{base[0] + (from % 3) * h, base[1] + ((from / 3) % 3) * h, base[2] + (from / 9) * h};
+      g[i] = g[from] ^ (count_crossings(*tris_, idx, start, axis, h) & 1);
+    }
+  }
+}
+
+bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+              Qef& q) {
+  const IBox box = cell.box();
+  const double face = cell.size() * cell.size();
+  constexpr double kFloor = 1e-3;  // weight of a plane that only touches the cell
+  bool any = false;
+  for (uint32_t k : idx) {
+    const ITri& t = tris[k];
+    if (is_degenerate(t)) continue;
+    const double area = clipped_area(t, box);
+    if (area < 0) continue;
+    any = true;
+    const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const Vec3 n{nx / len, ny / len, nz / len};
+    const Vec3 v = to_unit(t.v[0]);
+    q.add_plane(n, n[0] * v[0] + n[1] * v[1] + n[2] * v[2], area / face + kFloor);
+  }
+  return any;
+}
+
+void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                 std::vector<uint32_t>& out) {
+  const IBox b = cell.box();
+  out.clear();
+  for (uint32_t k : idx)
+    if (overlaps_box(tris[k], b.lo, b.hi)) out.push_back(k);
+}
+
+bool inside_cell(const Vec3& x, const Cell& cell) {
+  const Vec3 m = cell.min_unit();
+  const double s = cell.size();
+  const double slack = 1e-9 * s;
+  for (int k = 0; k < 3; ++k)
+    if (x[k] < m[k] - slack || x[k] > m[k] + s + slack) return false;
+  return true;
+}
+
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell) {
+  const Vec3 m = cell.min_unit();
+  const double s = cell.size();
+  Qef::Solution sol = q.solve({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2});
+  if (inside_cell(sol.position, cell)) return sol;
+  // Reseed from the corner closest to the surface (smallest QEF value).
+  int best = 0;
+  double best_err = 1e300;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{m[0] + (c & 1) * s, m[1] + ((c >> 1) & 1) * s, m[2] + ((c >> 2) & 1) * s};
+    const double e = q.error(p);
+    if (e < best_err) {
+      best_err = e;
+      best = c;
+    }
+  }
+  const Vec3 p{m[0] + (best & 1) * s, m[1] + ((best >> 1) & 1) * s, m[2] + ((best >> 2) & 1) * s};
+  Qef::Solution again = q.solve(p);
+  return inside_cell(again.position, cell) ? again : sol;
+}
+
+namespace {
+
+bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
+                         const Cell& cell, uint8_t signs) {
+  const I3 lo = lattice_to_grid(cell.lat);
+  const int64_t s = lattice_to_grid(cell.span());
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0];
+    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
+    const bool change = ((signs >> c0) ^ (signs >> kEdgeCorners[e][1])) & 1;
+    if (count_crossings(tris, idx, a, edge_axis(e), s) >= (change ? 3 : 2)) return true;
+  }
+  return false;
+}
+
+constexpr uint8_t kAll = 0xff;
+
+}  // namespace
+
+void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
+                 std::vector<uint32_t> idx, Builder& out, uint32_t slot, size_t& capped) {
+  const uint8_t written = p.invert ? uint8_t(~signs) : signs;
+  const bool uniform = signs == 0 || signs == kAll;
+  if (idx.empty() && uniform) {
+    out.set_uniform(slot, (written & 1) != 0);
+    return;
+  }
+  Qef q;
+  const bool meets = cell_qef(src.tris(), idx, cell, q);
+  const bool at_cap = cell.level >= p.max_depth;
+  if (uniform) {
+    if (!meets || at_cap) {
+      if (meets) ++capped;  // a feature thinner than the deepest cell is dropped
+      out.set_uniform(slot, (written & 1) != 0);
+      return;
+    }
+  } else {
+    const Qef::Solution sol = cell_vertex(q, cell);
+    const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
+                    !has_double_crossing(src.tris(), idx, cell, signs);
+    if (ok || at_cap) {
+      if (!ok) ++capped;
+      out.set_gray(slot, cell, written, sol.position, ok ? 0 : kFlagCapped);
+      return;
+    }
+  }
+  // Subdivide: signs of the 27-point child grid, then each child with its own triangles.
+  std::array<bool, 27> grid{};
+  for (int k = 0; k < 8; ++k) grid[grid_index_of_corner(k)] = (signs >> k) & 1;
+  src.child_grid_signs(cell, idx, grid);
+  const uint32_t first = out.alloc_children();
+  out.nodes[slot] = Node{first, CellKind::Internal, 0, 0, 0};
+  if (cell.level < p.parallel_levels) {
+    std::array<Builder, 8> subs;
+    std::array<size_t, 8> caps{};
+    tbb::parallel_for(0, 8, [&](int c) {
+      std::vector<uint32_t> cidx;
+      filter_tris(src.tris(), idx, cell.child(c), cidx);
+      subs[c].nodes.resize(1);
+      sample_cell(src, p, cell.child(c), child_signs(grid, c), std::move(cidx), subs[c], 0, caps[c]);
+    });
+    for (int c = 0; c < 8; ++c) {
+      out.splice(first + c, subs[c]);
+      capped += caps[c];
+    }
+    return;
+  }
+  std::vector<uint32_t> cidx;
+  for (int c = 0; c < 8; ++c) {
+    filter_tris(src.tris(), idx, cell.child(c), cidx);
+    sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx, out, first + c, capped);
+  }
+}
+
+}  // namespace pic::detail
+
+namespace pic {
+
+using namespace detail;
+
+Cube bounding_cube(const TriMesh& mesh, double margin) {
+  if (mesh.positions.empty()) throw InvalidInput("mesh has no vertices");
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Vec3& p : mesh.positions)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(extent > 0) || !std::isfinite(extent)) throw InvalidInput("mesh has zero or non-finite extent");
+  const double side = extent * (1 + 2 * margin);
+  Cube c;
+  for (int k = 0; k < 3; ++k) c.origin[k] = (lo[k] + hi[k]) / 2 - side / 2;
+  c.size = side;
+  return c;
+}
+
+namespace {
+
+void validate_mesh(const TriMesh& mesh) {
+  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+  for (const Vec3& p : mesh.positions)
+    for (double x : p)
+      if (!std::isfinite(x)) throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
+  std::unordered_map<uint64_t, uint32_t> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles) {
+    for (uint32_t v : t)
+      if (v >= mesh.positions.size()) throw InvalidInput("mesh has a triangle with an invalid vertex index");
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int e = 0; e < 3; ++e) {
+      const uint64_t a = t[e], b = t[(e + 1) % 3];
+      ++edges[std::min(a, b) << 32 | std::max(a, b)];
+    }
+  }
+  size_t odd = 0;
+  for (const auto& [k, n] : edges) odd += n & 1;
+  if (odd > 0)
+    throw InvalidInput("mesh is not closed: " + std::to_string(odd) +
+                       " boundary edges (PIC sampling needs a closed, watertight mesh)");
+}
+
+}  // namespace
+
+Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (options.depth < 1 || options.depth > kMaxLevel)
+    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
+  if (!(options.error >= 0) || !std::isfinite(options.error)) throw InvalidInput("error must be a finite number >= 0");
+  validate_mesh(mesh);
+  const Cube cube = options.cube ? *options.cube : bounding_cube(mesh, options.margin);
+  if (!(cube.size > 0) || !std::isfinite(cube.size) || !std::isfinite(cube.origin[0]) ||
+      !std::isfinite(cube.origin[1]) || !std::isfinite(cube.origin[2]))
+    throw InvalidInput("root cube must have a finite origin and a positive size");
+
+  std::vector<I3> grid(mesh.positions.size());
+  for (size_t i = 0; i < grid.size(); ++i) {
+    grid[i] = to_grid(world_to_unit(cube, mesh.positions[i]));
+    for (int k = 0; k < 3; ++k)
+      if (grid[i][k] <= 0 || grid[i][k] >= (int64_t{1} << kGridBits))
+        throw InvalidInput("mesh does not fit strictly inside the root cube");
+  }
+  std::vector<ITri> tris;
+  tris.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) tris.push_back(make_itri(grid[t[0]], grid[t[1]], grid[t[2]]));
+  std::vector<uint32_t> idx(tris.size());
+  for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
+
+  MeshSource src(tris);
+  SampleParams p;
+  p.max_depth = options.depth;
+  p.error = options.error;
+  p.parallel_levels = options.parallel ? 2 : 0;
+  Builder b;
+  b.nodes.resize(1);
+  size_t capped = 0;
+  // Root corners are outside: the mesh lies strictly inside the cube.
+  sample_cell(src, p, Cell{}, 0, std::move(idx), b, 0, capped);
+
+  Octree tree;
+  tree.cube = cube;
+  tree.max_depth = options.depth;
+  tree.nodes = std::move(b.nodes);
+  tree.vertices = std::move(b.vertices);
+  if (stats) {
+    stats->triangles_in = mesh.triangles.size();
+    stats->pics = tree.vertices.size();
+    stats->capped = capped;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return tree;
+}
+
+}  // namespace pic
