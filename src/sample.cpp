@@ -34,17 +34,26 @@ bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, c
   const double face = cell.size() * cell.size();
   constexpr double kFloor = 1e-3;  // weight of a plane that only touches the cell
   bool any = false;
+  auto add = [&](const ITri& t, double w) {
+    const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const Vec3 n{nx / len, ny / len, nz / len};
+    const Vec3 v = to_unit(t.v[0]);
+    q.add_plane(n, n[0] * v[0] + n[1] * v[1] + n[2] * v[2], w);
+  };
   for (uint32_t k : idx) {
     const ITri& t = tris[k];
     if (is_degenerate(t)) continue;
     const double area = clipped_area(t, box);
     if (area < 0) continue;
     any = true;
-    const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    const Vec3 n{nx / len, ny / len, nz / len};
-    const Vec3 v = to_unit(t.v[0]);
-    q.add_plane(n, n[0] * v[0] + n[1] * v[1] + n[2] * v[2], area / face + kFloor);
+    add(t, area / face + kFloor);
+  }
+  if (!any) {
+    // The surface only grazes the cell (e.g. a mesh vertex exactly on a cell corner): the
+    // perturbation still puts a sliver inside, so use the planes that touch the closed cell.
+    for (uint32_t k : idx)
+      if (!is_degenerate(tris[k])) add(tris[k], kFloor);
   }
   return any;
 }

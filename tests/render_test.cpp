@@ -79,10 +79,10 @@ TEST(Shapes, ClosedOutwardAndWelded) {
   TriMesh sphere = make_uv_sphere({1, 2, 3}, 1.5, 48, 24);
   EXPECT_TRUE(closed_oriented(sphere));
   EXPECT_NEAR(signed_volume(sphere), 4.0 / 3 * pi * 1.5 * 1.5 * 1.5, 0.03 * 14.14);
-  TriMesh cyl = make_cylinder({0, 0, 0}, 1, 2, 64);
+  TriMesh cyl = make_cylinder_on({0, 0, 0}, 1, 2, 64);
   EXPECT_TRUE(closed_oriented(cyl));
   EXPECT_NEAR(signed_volume(cyl), pi * 2, 0.01 * pi * 2);
-  TriMesh torus = make_torus({0, 0, 0}, 2, 0.5, 64, 32);
+  TriMesh torus = make_torus_z({0, 0, 0}, 2, 0.5, 64, 32);
   EXPECT_TRUE(closed_oriented(torus));
   EXPECT_NEAR(signed_volume(torus), 2 * pi * pi * 2 * 0.25, 0.02 * 9.87);
 }
@@ -109,7 +109,7 @@ TEST(Render, SphereAndTorusSilhouettes) {
     EXPECT_NEAR(double(foreground(img)), pi * 4 * s2, 0.03 * pi * 4 * s2) << view;
   }
   // Seen from the top, the torus is an annulus: the hole must stay background.
-  TriMesh torus = make_torus({0, 0, 0}, 2.0, 0.75, 128, 48);
+  TriMesh torus = make_torus_z({0, 0, 0}, 2.0, 0.75, 128, 48);
   Image img = render(torus, nullptr, ortho("top"));
   const double annulus = pi * (2.75 * 2.75 - 1.25 * 1.25);
   EXPECT_NEAR(double(foreground(img)), annulus * s2, 0.03 * annulus * s2);
@@ -133,7 +133,7 @@ TEST(Render, DefaultFramingFitsTheObject) {
       o.height = 200;
       o.view = view;
       o.perspective = persp;
-      TriMesh m = make_cylinder({10, 20, 30}, 1.0, 5.0, 48);
+      TriMesh m = make_cylinder_on({10, 20, 30}, 1.0, 5.0, 48);
       Image img = render(m, nullptr, o);
       size_t border = 0;
       for (int x = 0; x < o.width; ++x)
@@ -248,7 +248,7 @@ TEST(Render, EmptyMeshGivesBackground) {
 }
 
 TEST(Render, MillionTrianglesIsFast) {
-  TriMesh torus = make_torus({0, 0, 0}, 2.0, 0.7, 1000, 500);  // 1,000,000 triangles
+  TriMesh torus = make_torus_z({0, 0, 0}, 2.0, 0.7, 1000, 500);  // 1,000,000 triangles
   ASSERT_EQ(torus.triangles.size(), 1000000u);
   RenderOptions o;  // 1024 x 1024, 2x2 supersampling
   auto t0 = std::chrono::steady_clock::now();
