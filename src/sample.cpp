@@ -32,7 +32,9 @@ bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, c
               Qef& q) {
   const IBox box = cell.box();
   const double face = cell.size() * cell.size();
-  constexpr double kFloor = 1e-3;  // weight of a plane that only touches the cell
+  // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
+  // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
+  constexpr double kFloor = 0.1;
   bool any = false;
   auto add = [&](const ITri& t, double w) {
     const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
