@@ -15,6 +15,7 @@
 #include <chrono>
 #include <unordered_map>
 
+#include "bvh.h"
 #include "contour.h"
 #include "sample.h"
 
@@ -50,16 +51,45 @@ uint8_t apply_mask(CsgOp op, uint8_t a, uint8_t b) {
 /// One operand during an operation: its tree, partial contour and sign memo.
 struct Operand {
   const Octree& t;
-  std::vector<ITri> tris;                                    // partial contour, grid units
-  std::unordered_map<uint32_t, std::vector<uint32_t>> fans;  // stamped gray leaf -> triangles
-  std::unordered_map<uint64_t, bool> memo;                   // signs of non-corner points
+  std::vector<ITri> tris;  // partial contour, grid units
+  TriangleBvh bvh;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
+  std::unordered_map<uint64_t, bool> memo;                        // signs of non-corner points
+  std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
   explicit Operand(const Octree& tree) : t(tree) {}
 
-  const std::vector<uint32_t>& fan(uint32_t leaf) const {
-    static const std::vector<uint32_t> kEmpty;
-    const auto it = fans.find(leaf);
-    return it == fans.end() ? kEmpty : it->second;
+  /// The corner of a gray leaf farthest from its contour triangles. A corner within the
+  /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
+  /// from the farthest corner keeps fresh signs consistent with the contour everywhere except
+  /// right next to such corners (cached per leaf).
+  int anchor_corner(uint32_t leaf, const Cell& cell) {
+    if (const auto it = anchors.find(leaf); it != anchors.end()) return it->second;
+    const auto& idx = triangles_in(leaf, cell);
+    int best = 0;
+    double best_d = -1;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
+      double d = 1e300;
+      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, tris[k]));
+      if (d > best_d) {
+        best_d = d;
+        best = c;
+      }
+    }
+    anchors.emplace(leaf, best);
+    return best;
+  }
+
+  /// Partial-contour triangles meeting a leaf's cell (cached per leaf).
+  const std::vector<uint32_t>& triangles_in(uint32_t leaf, const Cell& cell) {
+    auto [it, fresh] = leaf_tris.try_emplace(leaf);
+    if (fresh) {
+      const IBox b = cell.box();
+      bvh.query(tris, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());  // deterministic order
+    }
+    return it->second;
   }
 
   struct Hit {
@@ -112,15 +142,21 @@ struct Operand {
     if (h.state != 2) return h.sign;
     const uint64_t key = lat_key(p);
     if (const auto it = memo.find(key); it != memo.end()) return it->second;
-    // Crossing parity along x, then y, then z from the leaf's corner 0.
+    // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
-    bool s = n.signs & 1;
-    const auto& idx = fan(h.leaf);
-    I3 a = lattice_to_grid(h.cell.lat);
+    const auto& idx = triangles_in(h.leaf, h.cell);
+    const int c = anchor_corner(h.leaf, h.cell);
+    bool s = (n.signs >> c) & 1;
+    I3 a = lattice_to_grid(h.cell.corner(c));
     const I3 g = lattice_to_grid(p);
     for (int axis = 0; axis < 3; ++axis) {
       const i64 len = g[axis] - a[axis];
       if (len > 0) s ^= count_crossings(tris, idx, a, axis, len) & 1;
+      if (len < 0) {
+        I3 b = a;
+        b[axis] = g[axis];
+        s ^= count_crossings(tris, idx, b, axis, -len) & 1;
+      }
       a[axis] = g[axis];
     }
     memo.emplace(key, s);
@@ -251,7 +287,7 @@ class Combiner {
       s.kind = Side::Gray;
       s.real = true;
       s.signs = n.signs;
-      filter_tris(x.tris, x.fan(node), cell, s.idx);
+      s.idx = x.triangles_in(node, cell);
     } else {
       s.inside = n.kind == CellKind::Black;
     }
@@ -277,7 +313,7 @@ class Combiner {
       v.signs |= uint8_t(sign) << k;
     }
     filter_tris(x.tris, s.idx, cc, v.idx);
-    if (v.idx.empty() && (v.signs == 0 || v.signs == 0xff)) {
+    if ((v.signs == 0 || v.signs == 0xff) && !meets_cell(x.tris, v.idx, cc)) {
       Side u;
       u.inside = v.signs != 0;
       return u;
@@ -417,7 +453,7 @@ class Combiner {
     q += qb;
     auto vertex_of = [&](const Operand& x, const Side& s, const Qef& qs) {
       if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
-      return cell_vertex(qs, cell).position;
+      return cell_vertex(qs, cell, s.signs).position;
     };
     bool meets = false;
     if (!must_split) {
@@ -436,16 +472,14 @@ class Combiner {
         const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
         const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
         Qef::Solution sol = q.solve(seed);
-        if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell);
+        if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell, sr);
         if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr))
           return gray(cell, sr, sol.position, 0);
       }
     }
     if (at_cap) {
       if (r_uniform) return uniform(sr != 0);
-      const Vec3 seed = q.empty() ? Vec3{cell.min_unit()[0] + cell.size() / 2, cell.min_unit()[1] + cell.size() / 2,
-                                          cell.min_unit()[2] + cell.size() / 2}
-                                  : cell_vertex(q, cell).position;
+      const Vec3 seed = cell_vertex(q, cell, sr).position;
       return gray(cell, sr, seed, kFlagCapped);
     }
     return subdivide(cell, a, b);
@@ -484,7 +518,7 @@ void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, uint32_t st
         stamp, count);
 }
 
-/// Triangle fans of the stamped PICs (the partial contour).
+/// The partial contour: dual polygons around stamped cells, indexed for box queries.
 void partial_contour(Operand& x, uint32_t stamp) {
   const Octree& t = x.t;
   std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
@@ -492,10 +526,7 @@ void partial_contour(Operand& x, uint32_t stamp) {
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
     auto add = [&](int i, int j, int k) {
-      const auto id = static_cast<uint32_t>(x.tris.size());
       x.tris.push_back(make_itri(g[i], g[j], g[k]));
-      for (int m = 0; m < poly.count; ++m)
-        if (t.stamps[poly.leaf[m]] == stamp) x.fans[poly.leaf[m]].push_back(id);
     };
     if (poly.count == 3) {
       add(0, 1, 2);
@@ -504,6 +535,7 @@ void partial_contour(Operand& x, uint32_t stamp) {
     for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]})) add(tri[0], tri[1], tri[2]);
   };
   dual_walk(t, &active, emit);
+  x.bvh.build(x.tris);
 }
 
 /// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing

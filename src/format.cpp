@@ -18,8 +18,10 @@ constexpr uint16_t kVersion = 1;
 constexpr size_t kHeaderBytes = 4 + 2 + 2 + 4 + 32 + 8 + 8 + 8;  // 68
 constexpr size_t kCrcBytes = 4;
 
-/// Quantization bits per coordinate for a vertex in a cell of `level`: the error
-/// cell_size / 2^(q+1) stays at or below 2^-25 ~ 3e-8 of the root cube from level 2 on.
+/// Quantization of a vertex in a cell of `level`: each cell-local coordinate is rounded to
+/// i / 2^q, i in [0, 2^q], stored in q+1 bits. The cell's faces and dyadic points (0, 1/2, ...)
+/// stay exact — a box corner on an octree plane must stay on it — and the error
+/// cell_size / 2^(q+1) is at most 2^-25 ~ 3e-8 of the root cube from level 2 on.
 int quant_bits(int level) { return std::min(22, 24 - level); }
 
 class BitWriter {
@@ -80,10 +82,8 @@ void write_node(const Octree& t, uint32_t node, int level, BitWriter& w) {
     if (level == t.max_depth) w.put(n.flags & kFlagCapped, 1);
     const int q = quant_bits(level);
     const double scale = double(1u << q);
-    for (float x : t.vertices[n.index]) {
-      const double v = std::floor(std::clamp(double(x), 0.0, 1.0) * scale);
-      w.put(static_cast<uint32_t>(std::min(v, scale - 1)), q);
-    }
+    for (float x : t.vertices[n.index])
+      w.put(static_cast<uint32_t>(std::nearbyint(std::clamp(double(x), 0.0, 1.0) * scale)), q + 1);
   }
 }
 
@@ -109,7 +109,11 @@ struct Decoder {
       if (level == t.max_depth) n.flags = static_cast<uint8_t>(r.get(1));
       const int q = quant_bits(level);
       std::array<float, 3> v;
-      for (float& x : v) x = static_cast<float>((double(r.get(q)) + 0.5) / double(1u << q));
+      for (float& x : v) {
+        const uint32_t i = r.get(q + 1);
+        if (i > (1u << q)) throw IoError("corrupted .pic file: vertex outside its cell");
+        x = static_cast<float>(double(i) / double(1u << q));
+      }
       n.index = static_cast<uint32_t>(t.vertices.size());
       t.vertices.push_back(v);
     }

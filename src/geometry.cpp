@@ -260,6 +260,39 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
   return true;
 }
 
+double point_triangle_distance2(const Vec3& p, const ITri& t) {
+  // Ericson, Real-Time Collision Detection 5.1.5: closest point by Voronoi regions.
+  const Vec3 a = to_unit(t.v[0]), b = to_unit(t.v[1]), c = to_unit(t.v[2]);
+  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  auto d2 = [&](const Vec3& q) { const Vec3 v = sub(p, q); return dot(v, v); };
+  const double d1 = dot(ab, ap), d2v = dot(ac, ap);
+  if (d1 <= 0 && d2v <= 0) return d2(a);
+  const Vec3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return d2(b);
+  const double vc = d1 * d4 - d3 * d2v;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return d2({a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]});
+  }
+  const Vec3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return d2(c);
+  const double vb = d5 * d2v - d1 * d6;
+  if (vb <= 0 && d2v >= 0 && d6 <= 0) {
+    const double w = d2v / (d2v - d6);
+    return d2({a[0] + w * ac[0], a[1] + w * ac[1], a[2] + w * ac[2]});
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return d2({b[0] + w * (c[0] - b[0]), b[1] + w * (c[1] - b[1]), b[2] + w * (c[2] - b[2])});
+  }
+  const double denom = 1 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return d2({a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
+}
+
 I3 to_grid(const Vec3& u) {
   return {std::llround(u[0] * kGridScale), std::llround(u[1] * kGridScale),
           std::llround(u[2] * kGridScale)};

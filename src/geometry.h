@@ -74,6 +74,9 @@ double crossing_param(const ITri& t, const I3& a, int axis, i64 len);
 /// Whether triangles a and b intersect inside the closed box (double precision).
 bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box);
 
+/// Squared distance from a unit-space point to a grid triangle (double precision).
+double point_triangle_distance2(const Vec3& p, const ITri& t);
+
 /// Unit-space position of a grid point.
 inline Vec3 to_unit(const I3& g) { return {grid_to_unit(g[0]), grid_to_unit(g[1]), grid_to_unit(g[2])}; }
 /// Snap a unit-space position to the grid.

@@ -60,6 +60,13 @@ bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, c
   return any;
 }
 
+bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell) {
+  const IBox box = cell.box();
+  for (uint32_t k : idx)
+    if (!is_degenerate(tris[k]) && clipped_area(tris[k], box) >= 0) return true;
+  return false;
+}
+
 void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
                  std::vector<uint32_t>& out) {
   const IBox b = cell.box();
@@ -77,9 +84,26 @@ bool inside_cell(const Vec3& x, const Cell& cell) {
   return true;
 }
 
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell) {
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
+  if (q.empty()) {
+    // No surface to fit: a sub-cell whose corner signs disagree with the contour by less than
+    // the contour's own error. Put the vertex on the sign-changing edges right next to the
+    // minority corners, so the patch this makes is tiny instead of spanning the cell.
+    const bool minority_inside = __builtin_popcount(signs) <= 4;
+    Vec3 acc{0, 0, 0};
+    int n = 0;
+    for (const auto& [c0, c1] : kEdgeCorners) {
+      if (!(((signs >> c0) ^ (signs >> c1)) & 1)) continue;
+      const bool c0_minority = (((signs >> c0) & 1) != 0) == minority_inside;
+      const double t = c0_minority ? 0.02 : 0.98;
+      for (int k = 0; k < 3; ++k) acc[k] += m[k] + s * ((1 - t) * ((c0 >> k) & 1) + t * ((c1 >> k) & 1));
+      ++n;
+    }
+    if (n == 0) return {{m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, 0, 0};
+    return {{acc[0] / n, acc[1] / n, acc[2] / n}, 0, 0};
+  }
   Qef::Solution sol = q.solve({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2});
   if (inside_cell(sol.position, cell)) return sol;
   // Reseed from the corner closest to the surface (smallest QEF value).
@@ -135,7 +159,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
       return;
     }
   } else {
-    const Qef::Solution sol = cell_vertex(q, cell);
+    const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
                     !has_double_crossing(src.tris(), idx, cell, signs);
     if (ok || at_cap) {

@@ -49,13 +49,18 @@ struct SampleParams {
 bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q);
 
+/// Whether any triangle of `idx` meets the cell under the perturbation convention (a triangle
+/// lying in one of the cell's low faces belongs to the neighbour below).
+bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell);
+
 /// Triangles of `idx` overlapping the closed box of `cell` (conservative).
 void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
                  std::vector<uint32_t>& out);
 
 /// The vertex of a gray cell: QEF minimum seeded at the centre, then at the corner with the
-/// smallest error when the first solution leaves the cell (paper Figure 2).
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell);
+/// smallest error when the first solution leaves the cell (paper Figure 2). With no planes at
+/// all, the mass point of the sign-changing edges' midpoints.
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs);
 bool inside_cell(const Vec3& x, const Cell& cell);
 
 /// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`.

@@ -1,1 +1,230 @@
+// Dual contouring (pic::contour) on hand-built octrees whose output can be counted by hand,
+// and on sampled boxes where the result is geometrically forced.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+
+#include "pic/pic.h"
+#include "pic/primitives.h"
+#include "support/mesh_checks.h"
+#include "support/shapes.h"
+
+namespace pic {
+namespace {
+
+using test::IsClosedManifold;
+
+// Tree-building helpers. Children of an internal node are 8 consecutive nodes.
+uint32_t subdivide(Octree& t, uint32_t node) {
+  const auto first = static_cast<uint32_t>(t.nodes.size());
+  t.nodes.resize(t.nodes.size() + 8);
+  t.nodes[node] = Node{first, CellKind::Internal, 0, 0, 0};
+  return first;
+}
+void make_gray(Octree& t, uint32_t node, uint8_t signs, std::array<float, 3> local) {
+  t.nodes[node] = Node{static_cast<uint32_t>(t.vertices.size()), CellKind::Gray, signs, 0, 0};
+  t.vertices.push_back(local);
+}
+
+// Root split once; the centre point (0.5, 0.5, 0.5) is inside, every other lattice point
+// outside. Child k touches the centre with its corner 7 - k. Vertices at centre +- h.
+Octree centre_blob(double h = 1.0 / 16) {
+  Octree t;
+  t.max_depth = 1;
+  const uint32_t first = subdivide(t, 0);
+  for (int k = 0; k < 8; ++k) {
+    std::array<float, 3> local;
+    for (int a = 0; a < 3; ++a) local[a] = static_cast<float>(((k >> a) & 1) ? 2 * h : 1 - 2 * h);
+    make_gray(t, first + k, uint8_t(1u << (7 - k)), local);
+  }
+  return t;
+}
+
+std::set<Vec3> vertex_set(const TriMesh& m) { return {m.positions.begin(), m.positions.end()}; }
+
+std::set<Vec3> cube_corners(const Vec3& lo, const Vec3& hi) {
+  std::set<Vec3> s;
+  for (int c = 0; c < 8; ++c) s.insert({(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]});
+  return s;
+}
+
+TEST(Contour, EmptyTreesGiveEmptyMeshes) {
+  Octree white;
+  EXPECT_TRUE(contour(white).triangles.empty());
+  EXPECT_TRUE(contour(white).positions.empty());
+
+  Octree black;
+  black.nodes[0].kind = CellKind::Black;
+  EXPECT_TRUE(contour(black).triangles.empty());
+
+  // Subdivided, but every leaf uniform: still nothing to contour (the root's boundary is
+  // not an interior edge).
+  Octree mixed;
+  mixed.max_depth = 2;
+  const uint32_t first = subdivide(mixed, 0);
+  subdivide(mixed, first + 3);
+  EXPECT_TRUE(contour(mixed).triangles.empty());
+  for (auto& n : mixed.nodes)
+    if (n.kind == CellKind::White) n.kind = CellKind::Black;
+  EXPECT_TRUE(contour(mixed).triangles.empty());
+}
+
+TEST(Contour, CentreBlobIsAnAxisAlignedCube) {
+  const Octree t = centre_blob();
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  // 6 sign-changing minimal edges (centre to face centres) -> 6 quads.
+  EXPECT_EQ(m.positions.size(), 8u);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_EQ(vertex_set(m), cube_corners({0.4375, 0.4375, 0.4375}, {0.5625, 0.5625, 0.5625}));
+  EXPECT_NEAR(volume(m), 1.0 / 512, 1e-12 / 512);
+  EXPECT_GT(volume(m), 0) << "outward orientation";
+}
+
+TEST(Contour, ComplementedSignsGiveAnInwardFacingCavity) {
+  Octree t = centre_blob();
+  for (auto& n : t.nodes)
+    if (n.kind == CellKind::Gray) n.signs = uint8_t(~n.signs);
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.triangles.size(), 12u);
+  // A cavity around the centre: the surface faces into it, so the signed volume is negative.
+  EXPECT_NEAR(volume(m), -1.0 / 512, 1e-12 / 512);
+}
+
+TEST(Contour, OutputIsInTheTreeCubeCoordinates) {
+  Octree t = centre_blob();
+  t.cube = Cube{{10, -20, 30}, 4};
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(vertex_set(m), cube_corners({10 + 4 * 0.4375, -20 + 4 * 0.4375, 30 + 4 * 0.4375},
+                                        {10 + 4 * 0.5625, -20 + 4 * 0.5625, 30 + 4 * 0.5625}));
+  EXPECT_NEAR(volume(m), 64.0 / 512, 1e-12);
+}
+
+TEST(Contour, MixedLevelNeighboursAreStitched) {
+  // As the centre blob, but child 0 is subdivided and its grandchild 7 (cell [0.25, 0.5]^3)
+  // holds the vertex; the sign-changing edges towards -x, -y, -z are then shared by one
+  // level-2 cell and three level-1 cells.
+  Octree t = centre_blob();
+  t.max_depth = 2;
+  const uint32_t first = t.nodes[0].index;
+  const uint32_t grand = subdivide(t, first + 0);
+  make_gray(t, grand + 7, 0x80, {0.75f, 0.75f, 0.75f});  // (0.4375, 0.4375, 0.4375)
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.positions.size(), 8u);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_EQ(vertex_set(m), cube_corners({0.4375, 0.4375, 0.4375}, {0.5625, 0.5625, 0.5625}));
+  EXPECT_NEAR(volume(m), 1.0 / 512, 1e-12 / 512);
+  // The level-1 vertex of child 0 is not used: only leaves are contoured.
+  EXPECT_EQ(analyze(t).pics, 8u);
+}
+
+TEST(Contour, TwoSeparateBlobsAtDifferentLevels) {
+  // Blob A around (0.25, 0.25, 0.25) inside child 0 (level-2 cells), blob B around
+  // (0.75, 0.75, 0.75) inside child 7.
+  Octree t;
+  t.max_depth = 2;
+  const uint32_t first = subdivide(t, 0);
+  for (int child : {0, 7}) {
+    const uint32_t g = subdivide(t, first + child);
+    for (int k = 0; k < 8; ++k) {
+      std::array<float, 3> local;
+      for (int a = 0; a < 3; ++a) local[a] = ((k >> a) & 1) ? 0.25f : 0.75f;
+      make_gray(t, g + k, uint8_t(1u << (7 - k)), local);
+    }
+  }
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.positions.size(), 16u);
+  EXPECT_EQ(m.triangles.size(), 24u);
+  EXPECT_EQ(test::component_count(m), 2u);
+  // Each blob: cube of side 2 * 0.25 * 0.25 = 0.125.
+  EXPECT_NEAR(volume(m), 2.0 / 512, 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------
+// Sampled boxes: one gray cell per box corner, 12 triangles, exact volume.
+
+void expect_exact_box(const Vec3& lo, const Vec3& hi, const Cube& cube, int depth) {
+  SampleOptions o;
+  o.depth = depth;
+  o.cube = cube;
+  const Octree t = sample(make_box(lo, hi), o);
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.positions.size(), 8u);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_EQ(vertex_set(m), cube_corners(lo, hi)) << "corners must be exact (lattice points)";
+  const double v = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+  EXPECT_NEAR(volume(m), v, 1e-12 * v);
+}
+
+TEST(Contour, LatticeBoxGivesTwelveTrianglesAndExactVolume) {
+  expect_exact_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}, {{0, 0, 0}, 1}, 8);
+  expect_exact_box({0, 0, 0}, {1, 1, 1}, {{-0.5, -0.5, -0.5}, 2}, 8);
+  expect_exact_box({0.125, 0.375, 0.5}, {0.625, 0.5, 0.9375}, {{0, 0, 0}, 1}, 8);
+  // Input-space cube with a non-trivial origin and size (all lattice coordinates exact).
+  expect_exact_box({-2, 3, 1}, {2, 5, 2}, {{-4, 0, -2}, 8}, 10);
+}
+
+TEST(Contour, BoxAtTheDepthCapIsStillExact) {
+  // Faces on level-4 planes, sampled with depth exactly 4.
+  expect_exact_box({0.25, 0.3125, 0.4375}, {0.6875, 0.75, 0.5625}, {{0, 0, 0}, 1}, 4);
+}
+
+TEST(Contour, OffLatticeBoxHasEightVerticesAndEulerTwo) {
+  SampleOptions o;
+  o.depth = 9;
+  o.cube = Cube{{0, 0, 0}, 1};
+  const TriMesh box = make_box({0.31, 0.22, 0.405}, {0.66, 0.71, 0.59});
+  const TriMesh m = contour(sample(box, o));
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.positions.size(), 8u);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_EQ(test::euler_characteristic(m), 2);
+  EXPECT_NEAR(volume(m), volume(box), 1e-6 * volume(box));
+}
+
+// ---------------------------------------------------------------------------------------
+// Orientation and vertex use on sampled curved shapes.
+
+TEST(Contour, SphereTrianglesFaceOutward) {
+  const Vec3 c{0.5, 0.5, 0.5};
+  SampleOptions o;
+  o.depth = 8;
+  o.cube = Cube{{0, 0, 0}, 1};
+  const Octree t = sample(make_sphere(c, 0.35, 48), o);
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_GT(volume(m), 0);
+  size_t inward = 0;
+  for (const auto& tri : m.triangles) {
+    const Vec3 &a = m.positions[tri[0]], &b = m.positions[tri[1]], &d = m.positions[tri[2]];
+    const Vec3 n = test::cross3(test::sub3(b, a), test::sub3(d, a));
+    const Vec3 centroid = test::mul3(test::add3(a, test::add3(b, d)), 1.0 / 3);
+    inward += test::dot3(n, test::sub3(centroid, c)) < 0;
+  }
+  EXPECT_EQ(inward, 0u) << "of " << m.triangles.size() << " triangles";
+  // Every gray leaf of a sampled solid lies on a sign-changing minimal edge: all are used.
+  EXPECT_EQ(m.positions.size(), analyze(t).pics);
+}
+
+TEST(Contour, VerticesAreTheLeafVertices) {
+  SampleOptions o;
+  o.depth = 8;
+  const Octree t = sample(make_torus({0, 0, 0}, 1, 0.3, 1, 32, 16), o);
+  const TriMesh m = contour(t);
+  std::set<Vec3> leaves;
+  for_each_leaf(t, [&](const LeafView& l) {
+    if (l.kind == CellKind::Gray) leaves.insert(l.vertex);
+  });
+  EXPECT_EQ(vertex_set(m), leaves);
+  EXPECT_EQ(m.positions.size(), leaves.size()) << "each vertex emitted once";
+}
+
+}  // namespace
+}  // namespace pic
