@@ -383,6 +383,29 @@ class Combiner {
     return Node{first, CellKind::Internal, 0, 0, 0};
   }
 
+  /// The new feature (where the two surfaces meet) must also fit one point or line over the
+  /// cell grown by half its size on every side: dual contouring joins this vertex to its
+  /// neighbours' by straight edges, so a curved intersection (a hole's rim) is refined until
+  /// those edges follow it. Not in the paper, whose per-cell test lets big cells sit on a
+  /// curved rim and chords cut across it.
+  bool feature_is_local(const Cell& cell, const Vec3& x) {
+    IBox g = cell.box();
+    const i64 h = lattice_to_grid(cell.span()) / 2;
+    for (int k = 0; k < 3; ++k) {
+      g.lo[k] = std::max<i64>(0, g.lo[k] - h);
+      g.hi[k] = std::min<i64>(i64{1} << kGridBits, g.hi[k] + h);
+    }
+    const double face = 4 * cell.size() * cell.size();
+    Qef q;
+    scratch_.clear();
+    a_.bvh.query(a_.tris, g.lo, g.hi, scratch_);
+    box_qef(a_.tris, scratch_, g, face, q);
+    scratch_.clear();
+    b_.bvh.query(b_.tris, g.lo, g.hi, scratch_);
+    box_qef(b_.tris, scratch_, g, face, q);
+    return q.solve(x).error < error_;
+  }
+
   struct EdgeCrossing {
     bool change;
     double t;
@@ -473,7 +496,8 @@ class Combiner {
         const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
         Qef::Solution sol = q.solve(seed);
         if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell, sr);
-        if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr))
+        if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
+            feature_is_local(cell, sol.position))
           return gray(cell, sr, sol.position, 0);
       }
     }
@@ -495,6 +519,7 @@ class Combiner {
   CsgStats& stats_;
   size_t original_nodes_;
   std::vector<std::pair<uint32_t, Node>> pending_;
+  std::vector<uint32_t> scratch_;
 };
 
 /// Stamps the overlap: pairs of cells where neither operand is uniform (paper 5.2.1).

@@ -30,8 +30,11 @@ void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&
 
 bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q) {
-  const IBox box = cell.box();
-  const double face = cell.size() * cell.size();
+  return box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
+}
+
+bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
+             double face, Qef& q) {
   // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
   constexpr double kFloor = 0.1;

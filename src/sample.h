@@ -48,6 +48,9 @@ struct SampleParams {
 /// planes need them). Returns whether any triangle meets the cell.
 bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q);
+/// The same over an arbitrary box; `face_area` normalizes the weights (unit-space area).
+bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
+             double face_area, Qef& q);
 
 /// Whether any triangle of `idx` meets the cell under the perturbation convention (a triangle
 /// lying in one of the cell's low faces belongs to the neighbour below).

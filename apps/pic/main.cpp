@@ -242,6 +242,8 @@ int main(int argc, char** argv) {
   cmd_prim->add_option("--error", p_error, "QEF residual threshold")->capture_default_str();
   cmd_prim->add_option("--cube", p_cube, "Root cube X,Y,Z,SIZE (share it between CSG operands)");
   cmd_prim->add_flag("--json", p_json, "Print one JSON object on stdout");
+  std::string p_mesh;
+  cmd_prim->add_option("--mesh", p_mesh, "Also write the tessellated input mesh (same input for other tools)");
 
   // render
   auto* cmd_render = app.add_subcommand("render", "Render a PIC object or a mesh to PNG");
@@ -406,6 +408,7 @@ int main(int argc, char** argv) {
         mesh = pic::transformed(pic::transformed(mesh, {1, 0, 0, 0, 1, 0, 0, 0, 1}, {-center[0], -center[1], -center[2]}),
                                 rot, center);
       }
+      if (!p_mesh.empty()) pic::write_mesh(mesh, p_mesh);
       pic::SampleOptions o;
       o.depth = p_depth;
       o.error = p_error;
