@@ -57,7 +57,9 @@ struct Operand {
   std::unordered_map<uint64_t, bool> memo;                        // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
-  explicit Operand(const Octree& tree) : t(tree) {}
+  uint32_t stamp = 0;
+
+  Operand(const Octree& tree, uint32_t op_stamp) : t(tree), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -125,13 +127,16 @@ struct Operand {
     }
     if (n.kind == CellKind::White || n.kind == CellKind::Black) return {1, n.kind == CellKind::Black, node, cell};
     if (n.kind == CellKind::Gray) return {2, false, node, cell};
+    // On a face shared by several gray leaves, prefer one stamped by this operation: only
+    // stamped leaves have their whole partial contour, which the parity walk needs.
     Hit gray;
     for (int c = 0; c < 8; ++c) {
       const Cell cc = cell.child(c);
       if (!contains(cc, p)) continue;
       const Hit h = find(n.index + c, cc, p);
       if (h.state == 1) return h;
-      if (h.state == 2 && gray.state == 0) gray = h;
+      if (h.state == 2 && (gray.state == 0 || (t.stamps[gray.leaf] != stamp && t.stamps[h.leaf] == stamp)))
+        gray = h;
     }
     return gray;
   }
@@ -677,7 +682,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   if (b.stamps.size() != b.nodes.size()) b.stamps.resize(b.nodes.size(), 0);
   tag(a, 0, b, 0, stamp, stats.cells_stamped);
 
-  Operand oa(a), ob(b);
+  Operand oa(a, stamp), ob(b, stamp);
   auto tc = Clock::now();
   partial_contour(oa, stamp);
   stats.contour_a_seconds = since(tc);

@@ -8,6 +8,7 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
+#include "contour.h"
 #include "support/mesh_checks.h"
 #include "support/shapes.h"
 
@@ -149,31 +150,50 @@ TEST(Contour, TwoSeparateBlobsAtDifferentLevels) {
 // ---------------------------------------------------------------------------------------
 // Sampled boxes: one gray cell per box corner, 12 triangles, exact volume.
 
-void expect_exact_box(const Vec3& lo, const Vec3& hi, const Cube& cube, int depth) {
+// Boxes with all faces on octree planes: corners are lattice points, so the result is exact.
+// `minimal`: one gray cell per corner (8 vertices, 12 triangles). When a box edge lies on a
+// cell edge, the cells along it are gray too (their corners are on the surface), so only the
+// exactness is forced there.
+void expect_exact_box(const Vec3& lo, const Vec3& hi, const Cube& cube, int depth, bool minimal) {
+  SCOPED_TRACE(::testing::Message() << "box (" << lo[0] << "," << lo[1] << "," << lo[2] << ")-(" << hi[0]
+                                    << "," << hi[1] << "," << hi[2] << ") depth " << depth);
   SampleOptions o;
   o.depth = depth;
   o.cube = cube;
-  const Octree t = sample(make_box(lo, hi), o);
+  SampleStats st;
+  const Octree t = sample(make_box(lo, hi), o, &st);
+  EXPECT_EQ(st.capped, 0u);
   const TriMesh m = contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
-  EXPECT_EQ(m.positions.size(), 8u);
-  EXPECT_EQ(m.triangles.size(), 12u);
-  EXPECT_EQ(vertex_set(m), cube_corners(lo, hi)) << "corners must be exact (lattice points)";
+  EXPECT_EQ(test::euler_characteristic(m), 2);
+  if (minimal) {
+    EXPECT_EQ(m.positions.size(), 8u);
+    EXPECT_EQ(m.triangles.size(), 12u);
+    EXPECT_EQ(vertex_set(m), cube_corners(lo, hi)) << "corners must be exact (lattice points)";
+  } else {
+    const auto v = vertex_set(m);
+    for (const Vec3& c : cube_corners(lo, hi)) EXPECT_TRUE(v.count(c)) << "corner missing";
+  }
+  for (const Vec3& p : m.positions) EXPECT_EQ(test::box_surface_distance(p, lo, hi), 0.0);
   const double v = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
   EXPECT_NEAR(volume(m), v, 1e-12 * v);
 }
 
 TEST(Contour, LatticeBoxGivesTwelveTrianglesAndExactVolume) {
-  expect_exact_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}, {{0, 0, 0}, 1}, 8);
-  expect_exact_box({0, 0, 0}, {1, 1, 1}, {{-0.5, -0.5, -0.5}, 2}, 8);
-  expect_exact_box({0.125, 0.375, 0.5}, {0.625, 0.5, 0.9375}, {{0, 0, 0}, 1}, 8);
+  expect_exact_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}, {{0, 0, 0}, 1}, 8, true);
+  expect_exact_box({0, 0, 0}, {1, 1, 1}, {{-0.5, -0.5, -0.5}, 2}, 8, true);
+  expect_exact_box({0.3125, 0.375, 0.125}, {0.5625, 0.625, 0.875}, {{0, 0, 0}, 1}, 8, true);
+}
+
+TEST(Contour, LatticeBoxWithEdgesOnCellEdgesIsExact) {
+  expect_exact_box({0.125, 0.375, 0.5}, {0.625, 0.5, 0.9375}, {{0, 0, 0}, 1}, 8, false);
   // Input-space cube with a non-trivial origin and size (all lattice coordinates exact).
-  expect_exact_box({-2, 3, 1}, {2, 5, 2}, {{-4, 0, -2}, 8}, 10);
+  expect_exact_box({-2, 3, 1}, {2, 5, 2}, {{-4, 0, -2}, 8}, 10, false);
 }
 
 TEST(Contour, BoxAtTheDepthCapIsStillExact) {
   // Faces on level-4 planes, sampled with depth exactly 4.
-  expect_exact_box({0.25, 0.3125, 0.4375}, {0.6875, 0.75, 0.5625}, {{0, 0, 0}, 1}, 4);
+  expect_exact_box({0.25, 0.3125, 0.4375}, {0.6875, 0.75, 0.5625}, {{0, 0, 0}, 1}, 4, false);
 }
 
 TEST(Contour, OffLatticeBoxHasEightVerticesAndEulerTwo) {
@@ -192,12 +212,41 @@ TEST(Contour, OffLatticeBoxHasEightVerticesAndEulerTwo) {
 // ---------------------------------------------------------------------------------------
 // Orientation and vertex use on sampled curved shapes.
 
-TEST(Contour, SphereTrianglesFaceOutward) {
+TEST(Contour, SplitQuadNeverFoldsAPlanarDart) {
+  // A planar, counter-clockwise, non-convex quad (vertex 2 is reflex). Only the diagonal
+  // 0-2 lies inside it; the other split makes triangle (1, 2, 3) face backwards.
+  const std::array<Vec3, 4> q{{{0, 0, 0}, {2, 0, 0}, {0.5, 0.5, 0}, {0, 2, 0}}};
+  const auto split = detail::split_quad(q);
+  for (const auto& tri : split) {
+    const Vec3 n = test::cross3(test::sub3(q[tri[1]], q[tri[0]]), test::sub3(q[tri[2]], q[tri[0]]));
+    EXPECT_GT(n[2], 0) << "triangle (" << tri[0] << ", " << tri[1] << ", " << tri[2] << ") is flipped";
+  }
+  // The same dart, slightly non-planar (a smooth surface seen by dual contouring).
+  const std::array<Vec3, 4> r{{{0, 0, 0}, {2, 0, 0.01}, {0.5, 0.5, 0.02}, {0, 2, 0.01}}};
+  for (const auto& tri : detail::split_quad(r)) {
+    const Vec3 n = test::cross3(test::sub3(r[tri[1]], r[tri[0]]), test::sub3(r[tri[2]], r[tri[0]]));
+    EXPECT_GT(n[2], 0) << "triangle (" << tri[0] << ", " << tri[1] << ", " << tri[2] << ") is flipped";
+  }
+}
+
+TEST(Contour, SplitQuadKeepsACreaseDiagonal) {
+  // A quad across a 90-degree box edge: vertices 1 and 3 on the edge (the line x + y = 1,
+  // z = 0), vertex 0 on the face z = 0, vertex 2 on the face x + y = 1. The split must run
+  // along the edge so both triangles lie in the faces: (0, 1, 3) and (1, 2, 3).
+  const std::array<Vec3, 4> c{{{0, 0, 0}, {1, 0, 0}, {0.5, 0.5, -1}, {0, 1, 0}}};
+  std::set<std::set<int>> got;
+  for (const auto& tri : detail::split_quad(c)) got.insert({tri[0], tri[1], tri[2]});
+  EXPECT_EQ(got, (std::set<std::set<int>>{{0, 1, 3}, {1, 2, 3}}));
+}
+
+TEST(Contour, SmoothSphereTrianglesFaceOutward) {
+  // Finely tessellated (facets smaller than the cells): no creases, so every triangle of a
+  // correct contour faces away from the centre.
   const Vec3 c{0.5, 0.5, 0.5};
   SampleOptions o;
   o.depth = 8;
   o.cube = Cube{{0, 0, 0}, 1};
-  const Octree t = sample(make_sphere(c, 0.35, 48), o);
+  const Octree t = sample(make_sphere(c, 0.35, 512), o);
   const TriMesh m = contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_GT(volume(m), 0);

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages PIC needs when they are missing (idempotent; needs root or sudo).
+#   scripts/setup.sh            build + tests
+#   scripts/setup.sh --bench    also the benchmark peers (OpenVDB, Google Benchmark)
+set -euo pipefail
+
+pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
+      libcli11-dev libgtest-dev chromium)
+if [[ "${1:-}" == "--bench" ]]; then
+  pkgs+=(libbenchmark-dev libopenvdb-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev)
+fi
+
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+# The HTML viewer bundles three.js with npm at build time; any node >= 18 with npm will do.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  missing+=(nodejs npm)
+fi
+
+if (( ${#missing[@]} )); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+echo "setup: all packages present"
