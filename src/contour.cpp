@@ -1,5 +1,6 @@
 #include "contour.h"
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -153,9 +154,23 @@ std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
   const Vec3 a0 = tri_normal(p[0], p[1], p[2]), a1 = tri_normal(p[0], p[2], p[3]);
   const Vec3 b0 = tri_normal(p[0], p[1], p[3]), b1 = tri_normal(p[1], p[2], p[3]);
   auto dot = [](const Vec3& x, const Vec3& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
-  auto zero = [](const Vec3& x) { return x[0] == 0 && x[1] == 0 && x[2] == 0; };
-  const bool a_bad = zero(a0) || zero(a1), b_bad = zero(b0) || zero(b1);
-  const bool use_a = a_bad != b_bad ? b_bad : dot(a0, a1) <= dot(b0, b1);
+  // The quad's own orientation: cross product of its diagonals (twice its vector area).
+  const Vec3 d0{p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+  const Vec3 d1{p[3][0] - p[1][0], p[3][1] - p[1][1], p[3][2] - p[1][2]};
+  const Vec3 n{d0[1] * d1[2] - d0[2] * d1[1], d0[2] * d1[0] - d0[0] * d1[2], d0[0] * d1[1] - d0[1] * d1[0]};
+  // A split whose triangle faces against the quad folds it back on itself (a non-convex
+  // quad split along its outer diagonal): never take it when the other split is clean.
+  const bool a_ok = dot(a0, n) > 0 && dot(a1, n) > 0, b_ok = dot(b0, n) > 0 && dot(b1, n) > 0;
+  bool use_a;
+  if (a_ok != b_ok) {
+    use_a = a_ok;
+  } else if (!a_ok) {
+    use_a = std::min(dot(a0, n), dot(a1, n)) >= std::min(dot(b0, n), dot(b1, n));
+  } else {
+    // Both clean: fold along the diagonal that bends most, which keeps a crease whose two
+    // vertices lie on it.
+    use_a = dot(a0, a1) <= dot(b0, b1);
+  }
   if (use_a) return {{{0, 1, 2}, {0, 2, 3}}};
   return {{{0, 1, 3}, {1, 2, 3}}};
 }

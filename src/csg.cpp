@@ -18,6 +18,7 @@
 #include "bvh.h"
 #include "contour.h"
 #include "sample.h"
+#include "topology.h"
 
 namespace pic {
 namespace detail {
@@ -430,6 +431,12 @@ class Combiner {
   Node gray_cell(const Cell& cell, const Side& a, const Side& b) {
     ++stats_.gray_pairs;
     const uint8_t sr = apply_mask(op_, a.signs, b.signs);
+    // The same PIC in both operands (A op A, or untouched common history): nothing to compute.
+    if (a.real && b.real && a.signs == b.signs &&
+        a_.t.vertices[a_.t.nodes[a.node].index] == b_.t.vertices[b_.t.nodes[b.node].index]) {
+      if (op_ == CsgOp::Subtract) return uniform(false);
+      return copy_side(a_, a, cell, false, true);
+    }
     const bool at_cap = cell.level >= max_depth_;
     const bool r_uniform = sr == 0 || sr == 0xff;
     bool must_split = false;
@@ -499,7 +506,8 @@ class Combiner {
         // Q_sum = Q_A + Q_B minimized from the average of the two vertices (paper eq. 3).
         const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
         const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
-        Qef::Solution sol = q.solve(seed);
+        const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
+        Qef::Solution sol = q.solve_in_box(seed, lo, hi);
         if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell, sr);
         if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
             feature_is_local(cell, sol.position))
@@ -566,44 +574,6 @@ void partial_contour(Operand& x, uint32_t stamp) {
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
-}
-
-/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
-/// edge's midpoint), so the contour stays closed whatever the geometry decided.
-size_t repair(Octree& t, uint32_t stamp) {
-  size_t fixed = 0;
-  for (int pass = 0; pass < 4; ++pass) {
-    DualStats ds;
-    std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
-    std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
-    dual_walk(t, &active, emit, &ds);
-    if (ds.cracks == 0) break;
-    std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
-    std::unordered_map<uint32_t, Cell> cells;
-    for (size_t k = 0; k < ds.crack_leaves.size(); ++k) {
-      auto& [sum, n] = mid_sum[ds.crack_leaves[k]];
-      for (int a = 0; a < 3; ++a) sum[a] += ds.crack_points[k][a];
-      ++n;
-      cells[ds.crack_leaves[k]] = ds.crack_cells[k];
-    }
-    for (const auto& [node, ms] : mid_sum) {
-      Node& n = t.nodes[node];
-      if (n.kind == CellKind::Gray) continue;
-      const Cell& cell = cells[node];
-      const auto& [sum, cnt] = ms;
-      constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
-      const Vec3 x{sum[0] * k / (2 * cnt), sum[1] * k / (2 * cnt), sum[2] * k / (2 * cnt)};
-      const uint8_t signs = n.kind == CellKind::Black ? 0xff : 0;
-      const Vec3 m = cell.min_unit();
-      const double inv = double(int64_t{1} << cell.level);
-      std::array<float, 3> local;
-      for (int a = 0; a < 3; ++a) local[a] = static_cast<float>(std::clamp((x[a] - m[a]) * inv, 0.0, 1.0));
-      t.vertices.push_back(local);
-      n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, signs, 0, 0};
-      ++fixed;
-    }
-  }
-  return fixed;
 }
 
 /// Drops unreachable nodes and vertices (left behind by in-place replacement).
@@ -698,7 +668,10 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     comb.run();
   }
   a.max_depth = depth;
-  stats.repaired = repair(a, stamp);
+  std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
+  std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
+  enforce_one_component(a, &stamped, &stamp_it);
+  stats.repaired = repair_cracks(a, &stamped);
   stats.csg_seconds = since(tc);
   // Amortized garbage collection of replaced subtrees.
   if (a.nodes.size() > 2 * std::max<size_t>(before, 4096) || a.nodes.size() > before + 65536) {

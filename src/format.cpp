@@ -168,7 +168,9 @@ Octree deserialize(const std::vector<uint8_t>& in) {
   const auto crc = static_cast<uint32_t>(crc32(0L, in.data(), static_cast<uInt>(in.size() - kCrcBytes)));
   if (crc != stored_crc) throw IoError("corrupted .pic file: checksum mismatch");
   if (depth < 1 || depth > kMaxLevel) throw IoError("corrupted .pic file: bad depth");
-  if (!(t.cube.size > 0) || !std::isfinite(t.cube.size)) throw IoError("corrupted .pic file: bad cube");
+  if (!(t.cube.size > 0) || !std::isfinite(t.cube.size) || !std::isfinite(t.cube.origin[0]) ||
+      !std::isfinite(t.cube.origin[1]) || !std::isfinite(t.cube.origin[2]))
+    throw IoError("corrupted .pic file: bad cube");
   // Every node costs at least 2 bits: bound allocations by the payload size.
   if (node_count == 0 || node_count > payload * 4 + 1 || gray_count > node_count)
     throw IoError("corrupted .pic file: bad node counts");

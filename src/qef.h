@@ -30,6 +30,10 @@ struct Qef {
   /// eigenvalues below kRelativeCutoff * largest are zeroed, so flat and creased patches
   /// keep the vertex close to the seed along their free directions.
   Solution solve(const Vec3& seed) const;
+  /// As solve(), but when the minimum leaves the box [lo, hi] and the QEF has free
+  /// directions (a crease line or a plane), slides along them to a point inside the box:
+  /// the middle of the line's chord through the box, or the centroid of the plane's section.
+  Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi) const;
 };
 
 /// Relative eigenvalue cutoff of the pseudo-inverse. Singular values of A^(1/2) below 0.1 of

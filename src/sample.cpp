@@ -1,5 +1,7 @@
 #include "sample.h"
 
+#include "topology.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -107,7 +109,8 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
     if (n == 0) return {{m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, 0, 0};
     return {{acc[0] / n, acc[1] / n, acc[2] / n}, 0, 0};
   }
-  Qef::Solution sol = q.solve({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2});
+  const Vec3 hi{m[0] + s, m[1] + s, m[2] + s};
+  Qef::Solution sol = q.solve_in_box({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, m, hi);
   if (inside_cell(sol.position, cell)) return sol;
   // Reseed from the corner closest to the surface (smallest QEF value).
   int best = 0;
@@ -121,7 +124,7 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
     }
   }
   const Vec3 p{m[0] + (best & 1) * s, m[1] + ((best >> 1) & 1) * s, m[2] + ((best >> 2) & 1) * s};
-  Qef::Solution again = q.solve(p);
+  Qef::Solution again = q.solve_in_box(p, m, hi);
   return inside_cell(again.position, cell) ? again : sol;
 }
 
@@ -289,6 +292,8 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
+  // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
+  if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) repair_cracks(tree, nullptr);
   if (stats) {
     stats->triangles_in = mesh.triangles.size();
     stats->pics = tree.vertices.size();

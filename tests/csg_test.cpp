@@ -1,1 +1,343 @@
+// CSG on PIC octrees: exact box answers, Boolean algebra, curved cases against analytic
+// signed distances, the paper's Figure 7 wedge, and cost proportional to the overlap.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "pic/pic.h"
+#include "pic/primitives.h"
+#include "support/mesh_checks.h"
+
+namespace pic {
+namespace {
+using namespace pic::test;
+
+constexpr Cube kUnit{{0, 0, 0}, 1.0};
+
+Octree sample_in_unit(const TriMesh& m, int depth, const Cube& cube = kUnit) {
+  SampleOptions o;
+  o.depth = depth;
+  o.cube = cube;
+  return sample(m, o);
+}
+
+// ---- exact solids: signed distance (negative inside) and their planes ---------------------
+
+using Sdf = std::function<double(const Vec3&)>;
+
+struct Plane {
+  Vec3 n;
+  double d;  // n.x = d
+};
+
+/// An oriented box: centre, rotation R (rows = local axes in world), half sizes.
+struct Box {
+  Vec3 c;
+  std::array<double, 9> r;  // row-major, world = R^T local ... we store local axes as rows
+  Vec3 h;
+
+  Vec3 local(const Vec3& p) const {
+    const Vec3 d{p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    return {r[0] * d[0] + r[1] * d[1] + r[2] * d[2], r[3] * d[0] + r[4] * d[1] + r[5] * d[2],
+            r[6] * d[0] + r[7] * d[1] + r[8] * d[2]};
+  }
+  double sdf(const Vec3& p) const {
+    const Vec3 q = local(p);
+    double out = 0, in = -1e300;
+    for (int k = 0; k < 3; ++k) {
+      const double e = std::abs(q[k]) - h[k];
+      out += std::max(e, 0.0) * std::max(e, 0.0);
+      in = std::max(in, e);
+    }
+    return in > 0 ? std::sqrt(out) : in;
+  }
+  std::vector<Plane> planes() const {
+    std::vector<Plane> out;
+    for (int k = 0; k < 3; ++k)
+      for (double s : {-1.0, 1.0}) {
+        const Vec3 n{s * r[3 * k], s * r[3 * k + 1], s * r[3 * k + 2]};
+        out.push_back({n, n[0] * c[0] + n[1] * c[1] + n[2] * c[2] + h[k]});
+      }
+    return out;
+  }
+  TriMesh mesh() const {
+    TriMesh m = make_box({-h[0], -h[1], -h[2]}, {h[0], h[1], h[2]});
+    // local -> world: p = R^T q + c
+    const std::array<double, 9> rt = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+    return transformed(m, rt, c);
+  }
+};
+
+Box axis_box(const Vec3& lo, const Vec3& hi) {
+  return {{(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2},
+          {1, 0, 0, 0, 1, 0, 0, 0, 1},
+          {(hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2, (hi[2] - lo[2]) / 2}};
+}
+Box rotated_box(const Vec3& c, const Vec3& h, const Vec3& axis, double radians) {
+  const auto m = rotation(axis, radians);  // world = m * local  -> rows of m^T are local axes
+  return {c, {m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]}, h};
+}
+
+double sdf_op(CsgOp op, double a, double b) {
+  switch (op) {
+    case CsgOp::Union: return std::min(a, b);
+    case CsgOp::Intersect: return std::max(a, b);
+    case CsgOp::Subtract: return std::max(a, -b);
+  }
+  return 0;
+}
+
+/// Corners of the exact result: points on three independent planes of the operands that lie
+/// on the result's surface and on each of the three solids' faces.
+std::vector<Vec3> exact_corners(const Box& a, const Box& b, CsgOp op) {
+  std::vector<std::pair<Plane, const Box*>> planes;
+  for (const auto& p : a.planes()) planes.push_back({p, &a});
+  for (const auto& p : b.planes()) planes.push_back({p, &b});
+  std::vector<Vec3> out;
+  for (size_t i = 0; i < planes.size(); ++i)
+    for (size_t j = i + 1; j < planes.size(); ++j)
+      for (size_t k = j + 1; k < planes.size(); ++k) {
+        const Vec3 &n1 = planes[i].first.n, &n2 = planes[j].first.n, &n3 = planes[k].first.n;
+        const Vec3 c23 = cross3(n2, n3), c31 = cross3(n3, n1), c12 = cross3(n1, n2);
+        const double det = dot3(n1, c23);
+        if (std::abs(det) < 1e-6) continue;
+        Vec3 p;
+        for (int q = 0; q < 3; ++q)
+          p[q] = (planes[i].first.d * c23[q] + planes[j].first.d * c31[q] + planes[k].first.d * c12[q]) / det;
+        const double r = sdf_op(op, a.sdf(p), b.sdf(p));
+        bool on_faces = std::abs(r) < 1e-9;
+        for (size_t m : {i, j, k}) on_faces = on_faces && std::abs(planes[m].second->sdf(p)) < 1e-9;
+        if (on_faces) out.push_back(p);
+      }
+  return out;
+}
+
+/// Checks a box CSG result: closed and manifold; every representative vertex on the exact
+/// surface within 1e-6 of the root cube, except leaves accepted at the depth cap (a feature
+/// thinner than the finest cell), which must stay within one finest cell; every sharp corner
+/// of the exact answer reproduced by a vertex within 1e-6.
+void expect_exact_box_result(const Box& a, const Box& b, CsgOp op, int depth, double expected_volume = -1,
+                             const Cube& cube = kUnit, bool all_corners = true, size_t min_corners = 8) {
+  const Octree ta = sample_in_unit(a.mesh(), depth, cube), tb = sample_in_unit(b.mesh(), depth, cube);
+  const Octree r = csg(ta, tb, op);
+  const TriMesh m = contour(r);
+  ASSERT_FALSE(m.triangles.empty());
+  EXPECT_TRUE(IsClosedManifold(m));
+  double worst = 0, worst_capped = 0;
+  const double finest = cube.size / double(1 << depth);
+  for_each_leaf(r, [&](const LeafView& v) {
+    if (v.kind != CellKind::Gray) return;
+    const double d = std::abs(sdf_op(op, a.sdf(v.vertex), b.sdf(v.vertex)));
+    if (r.nodes[v.node].flags & kFlagCapped) worst_capped = std::max(worst_capped, d);
+    else worst = std::max(worst, d);
+  });
+  EXPECT_LT(worst, 1e-6) << "an output vertex is off the exact CSG surface";
+  EXPECT_LT(worst_capped, finest) << "a vertex at the depth cap is more than a cell off";
+  const auto corners = exact_corners(a, b, op);
+  EXPECT_GE(corners.size(), min_corners);
+  if (all_corners)
+    for (const Vec3& c : corners)
+      EXPECT_LT(nearest_vertex_distance(m, c), 1e-6)
+          << "sharp corner (" << c[0] << ", " << c[1] << ", " << c[2] << ") is not reproduced";
+  if (expected_volume > 0) EXPECT_NEAR(volume(m), expected_volume, 1e-9 + 1e-9 * expected_volume);
+}
+
+TEST(Csg, BoxMinusRotatedBox) {
+  const Box a = axis_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75});
+  // A prism turned 30 degrees about z notches A's vertical edge, through its full height.
+  const Box b = rotated_box({0.72, 0.7, 0.5}, {0.1, 0.12, 0.35}, {0, 0, 1}, 30.0 * M_PI / 180);
+  expect_exact_box_result(a, b, CsgOp::Subtract, 8);
+}
+
+TEST(Csg, UnionOfBoxesSharingCoplanarFaces) {
+  // Same height: top and bottom faces coplanar, and a shared face at x = 0.5.
+  const Box a = axis_box({0.25, 0.25, 0.25}, {0.5, 0.75, 0.5});
+  const Box b = axis_box({0.5, 0.375, 0.25}, {0.75, 0.625, 0.5});
+  expect_exact_box_result(a, b, CsgOp::Union, 8, 0.25 * 0.5 * 0.25 + 0.25 * 0.25 * 0.25);
+}
+
+TEST(Csg, LShapeFromTwoBoxes) {
+  const Box a = axis_box({0.2, 0.2, 0.3}, {0.7, 0.35, 0.6});
+  const Box b = axis_box({0.2, 0.2, 0.3}, {0.35, 0.8, 0.6});
+  const double v = 0.5 * 0.15 * 0.3 + 0.15 * 0.6 * 0.3 - 0.15 * 0.15 * 0.3;
+  expect_exact_box_result(a, b, CsgOp::Union, 8, v);
+}
+
+TEST(Csg, BoxMinusBoxLeavesThinWall) {
+  // A cup: walls and floor 0.01 thick, thinner than three cells at depth 8.
+  const Box a = axis_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75});
+  const Box b = axis_box({0.26, 0.26, 0.26}, {0.74, 0.74, 0.9});
+  expect_exact_box_result(a, b, CsgOp::Subtract, 8, 0.125 - 0.48 * 0.48 * 0.49);
+}
+
+TEST(Csg, IntersectionOfRotatedBoxes) {
+  // An axis box and a diamond prism (45 degrees about z): an octagonal prism.
+  const Box a = axis_box({0.3, 0.3, 0.3}, {0.7, 0.7, 0.6});
+  const Box b = rotated_box({0.5, 0.5, 0.5}, {0.24, 0.24, 0.2}, {0, 0, 1}, M_PI / 4);
+  expect_exact_box_result(a, b, CsgOp::Intersect, 8);
+}
+
+// The paper's Figure 7: A - B leaves a sharp wedge; at zero QEF residual two crossings can
+// still fall on one cell edge and must be separated by subdivision.
+TEST(Csg, Figure7WedgeKeepsItsSharpEdge) {
+  // B's face passes through the line x = 0.75, z = 0.45 at 10 degrees from A's side face, so
+  // A - B keeps a 10-degree wedge hanging on that side: crossings of both faces crowd onto
+  // the same cell edges near its tip. Sampled in a cube of side 2 so B's far side fits.
+  const double alpha = 10.0 * M_PI / 180;
+  const Box a = axis_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75});
+  const Vec3 u{std::cos(alpha), 0, -std::sin(alpha)};
+  const double h = 0.45;
+  const Box b = rotated_box({0.75 - h * u[0], 0.5, 0.45 - h * u[2]}, {h, 0.4, 0.45}, {0, 1, 0}, alpha);
+  // Near its tip the wedge is thinner than any cell, so the corners there cannot all be
+  // exact; the faces and the sharp edge above the tip must be.
+  const Cube cube{{-0.5, -0.5, -0.5}, 2.0};
+  expect_exact_box_result(a, b, CsgOp::Subtract, 10, -1, cube, /*all_corners=*/false, /*min_corners=*/6);
+  const Octree r = csg(sample_in_unit(a.mesh(), 10, cube), sample_in_unit(b.mesh(), 10, cube), CsgOp::Subtract);
+  const TriMesh m = contour(r);
+  // The wedge's volume: a triangular prism of depth 0.5 and legs 0.2 and 0.2 tan(10 deg).
+  EXPECT_NEAR(volume(m), 0.5 * 0.2 * 0.2 * std::tan(alpha) * 0.5, 2e-4);
+  // The wedge's two edges at its thick end (A's bottom edge and where B's face meets A's
+  // bottom) lie on the mesh.
+  const double x_cut = 0.75 - 0.2 * std::tan(alpha);
+  for (double y : {0.3, 0.5, 0.7}) {
+    EXPECT_LT(point_mesh_distance(m, {0.75, y, 0.25}), 1e-6);
+    EXPECT_LT(point_mesh_distance(m, {x_cut, y, 0.25}), 1e-6);
+  }
+}
+
+// ---- algebra --------------------------------------------------------------------------------
+
+struct AlgebraTest : ::testing::Test {
+  static void SetUpTestSuite() {
+    a = new Octree(sample_in_unit(make_sphere({0.45, 0.5, 0.5}, 0.25, 96), 8));
+    b = new Octree(sample_in_unit(make_cylinder({0.6, 0.5, 0.5}, 0.15, 0.6, 0, 96), 8));
+  }
+  static void TearDownTestSuite() {
+    delete a;
+    delete b;
+  }
+  static Octree* a;
+  static Octree* b;
+};
+Octree* AlgebraTest::a = nullptr;
+Octree* AlgebraTest::b = nullptr;
+
+TEST_F(AlgebraTest, AMinusAIsEmpty) {
+  const Octree r = csg(*a, *a, CsgOp::Subtract);
+  EXPECT_TRUE(contour(r).triangles.empty());
+  EXPECT_EQ(analyze(r).pics, 0u);
+}
+
+TEST_F(AlgebraTest, UnionAndIntersectionWithItselfGiveA) {
+  const TriMesh ma = contour(*a);
+  for (CsgOp op : {CsgOp::Union, CsgOp::Intersect}) {
+    const TriMesh m = contour(csg(*a, *a, op));
+    EXPECT_TRUE(IsClosedManifold(m));
+    EXPECT_LT(two_sided_distance(m, ma), 1e-6) << to_string(op);
+    EXPECT_NEAR(volume(m), volume(ma), 1e-9) << to_string(op);
+  }
+}
+
+TEST_F(AlgebraTest, IntersectionWithDisjointIsEmpty) {
+  const Octree far = sample_in_unit(make_box({0.85, 0.85, 0.85}, {0.95, 0.95, 0.95}), 8);
+  const Octree r = csg(*a, far, CsgOp::Intersect);
+  EXPECT_TRUE(contour(r).triangles.empty());
+  const TriMesh u = contour(csg(*a, far, CsgOp::Union));
+  EXPECT_TRUE(IsClosedManifold(u));
+  EXPECT_EQ(component_count(u), 2u);
+}
+
+TEST_F(AlgebraTest, UnionMinusBEqualsAMinusB) {
+  const TriMesh lhs = contour(csg(csg(*a, *b, CsgOp::Union), *b, CsgOp::Subtract));
+  const TriMesh rhs = contour(csg(*a, *b, CsgOp::Subtract));
+  EXPECT_TRUE(IsClosedManifold(lhs));
+  EXPECT_TRUE(IsClosedManifold(rhs));
+  EXPECT_LT(two_sided_distance(lhs, rhs), 2e-3);
+  EXPECT_NEAR(volume(lhs), volume(rhs), 1e-3 * volume(rhs));
+}
+
+TEST_F(AlgebraTest, ResultsChainSaveAndLoad) {
+  Octree r = csg(*a, *b, CsgOp::Subtract);
+  const auto bytes = serialize(r);
+  const Octree back = deserialize(bytes);
+  EXPECT_EQ(serialize(back), bytes);
+  const Octree s = sample_in_unit(make_sphere({0.3, 0.5, 0.5}, 0.1, 64), 8);
+  const TriMesh m = contour(csg(back, s, CsgOp::Union));
+  EXPECT_TRUE(IsClosedManifold(m));
+}
+
+// ---- curved cases against analytic signed distances ------------------------------------------
+
+double sd_cylinder(const Vec3& p, const Vec3& c, double r, double h, int axis) {
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  const double d1 = std::hypot(p[a] - c[a], p[b] - c[b]) - r, d2 = std::abs(p[axis] - c[axis]) - h / 2;
+  return std::max(d1, d2) > 0 ? std::hypot(std::max(d1, 0.0), std::max(d2, 0.0)) : std::max(d1, d2);
+}
+
+// Paper Table 3's CAD tool: cube, union a cylinder, minus two cylinders.
+TEST(Csg, CadToolMatchesTheExactSolid) {
+  const int depth = 10, seg = 256;
+  const Box cube = axis_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75});
+  const Vec3 c{0.5, 0.5, 0.5};
+  Octree t = sample_in_unit(cube.mesh(), depth);
+  std::vector<CsgStats> stats(3);
+  t = csg(t, sample_in_unit(make_cylinder(c, 0.15, 0.8, 2, seg), depth), CsgOp::Union, {}, &stats[0]);
+  t = csg(t, sample_in_unit(make_cylinder(c, 0.1, 0.8, 0, seg), depth), CsgOp::Subtract, {}, &stats[1]);
+  t = csg(t, sample_in_unit(make_cylinder(c, 0.07, 0.8, 1, seg), depth), CsgOp::Subtract, {}, &stats[2]);
+  const TriMesh m = contour(t);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(euler_characteristic(m), -4);  // genus 3
+  auto sdf = [&](const Vec3& p) {
+    return std::max({std::min(cube.sdf(p), sd_cylinder(p, c, 0.15, 0.8, 2)), -sd_cylinder(p, c, 0.1, 0.8, 0),
+                     -sd_cylinder(p, c, 0.07, 0.8, 1)});
+  };
+  // Tessellation of the 256-gon cylinders is 1.1e-5 of the root cube at most.
+  double worst = 0;
+  for (const Vec3& p : surface_points(m, 20000)) worst = std::max(worst, std::abs(sdf(p)));
+  for (const Vec3& p : m.positions) worst = std::max(worst, std::abs(sdf(p)));
+  EXPECT_LT(worst, 1e-3);
+  // Stamps grow per operation and are never reset.
+  EXPECT_LT(stats[0].stamp, stats[1].stamp);
+  EXPECT_LT(stats[1].stamp, stats[2].stamp);
+  for (const auto& s : stats) EXPECT_GT(s.cells_stamped, 0u);
+}
+
+// ---- cost follows the overlap -----------------------------------------------------------------
+
+size_t cells_for_stroke(const Octree& object, const Vec3& at, double radius, int depth) {
+  const Octree tool = sample_in_unit(make_sphere(at, radius, 64), depth);
+  CsgStats st;
+  Octree r = csg(object, tool, CsgOp::Subtract, {}, &st);
+  EXPECT_TRUE(IsClosedManifold(contour(r)));
+  return st.cells_visited;
+}
+
+TEST(Csg, CostFollowsTheOverlapNotTheObject) {
+  const int depth = 9;
+  const Octree big = sample_in_unit(make_sphere({0.5, 0.5, 0.5}, 0.4, 256), depth);
+  const Octree small = sample_in_unit(make_sphere({0.5, 0.5, 0.5}, 0.25, 256), depth);
+  // Strokes on the surface of each object, averaged over a few directions.
+  auto strokes = [&](const Octree& object, double object_radius, double tool_radius) {
+    size_t total = 0;
+    for (const Vec3& d : {Vec3{0, 0, 1}, Vec3{0.6, 0, 0.8}, Vec3{0, -0.6, -0.8}, Vec3{0.8, 0.6, 0}})
+      total += cells_for_stroke(object, {0.5 + object_radius * d[0], 0.5 + object_radius * d[1], 0.5 + object_radius * d[2]},
+                                tool_radius, depth);
+    return double(total) / 4;
+  };
+  const double on_big = strokes(big, 0.4, 0.03), on_small = strokes(small, 0.25, 0.03);
+  const double larger_tool = strokes(big, 0.4, 0.09);
+  // Independent of the object's size...
+  EXPECT_LT(on_big, 2.0 * on_small);
+  EXPECT_LT(on_small, 2.0 * on_big);
+  // ... a small fraction of the object's cells ...
+  EXPECT_LT(on_big, 0.1 * double(big.nodes.size()));
+  // ... and growing with the tool (9x its area for 3x its radius).
+  EXPECT_GT(larger_tool, 2.0 * on_big);
+}
+
+}  // namespace
+}  // namespace pic

@@ -164,7 +164,9 @@ struct MeshTopology {
   size_t nonmanifold_vertices = 0; ///< vertices whose triangle fan is not a single disk
   size_t degenerate_triangles = 0; ///< repeated vertex index
   bool closed() const { return boundary_edges == 0; }
-  bool manifold() const { return closed() && nonmanifold_vertices == 0 && inconsistent_edges == 0; }
+  bool manifold() const {
+    return closed() && nonmanifold_edges == 0 && nonmanifold_vertices == 0 && inconsistent_edges == 0;
+  }
 };
 MeshTopology analyze_topology(const TriMesh& mesh);
 /// Signed volume (positive for outward orientation).

@@ -316,3 +316,8 @@ inline double box_surface_distance(const Vec3& p, const Vec3& lo, const Vec3& hi
 }
 
 }  // namespace pic::test
+
+namespace pic {
+// The helpers are also visible unqualified inside namespace pic (tests live there).
+using namespace pic::test;
+}  // namespace pic

@@ -1,0 +1,142 @@
+// Micro-benchmarks (Google Benchmark). Run: build/bench/pic_bench [--benchmark_filter=REGEX]
+//   BM_QefAccumulateSolve/N      N planes added to a QEF, then solved (one gray cell's vertex)
+//   BM_SampleSphere/D            corner classification + vertex placement: a 64-segment sphere
+//                                sampled at depth D (counters: PICs, cells = octree nodes)
+//   BM_SampleFandisk/serial|tbb  data/fandisk.obj, depth 12, error 1e-8 (paper Table 2)
+//   BM_Contour/fandisk           dual contouring of the fandisk PIC object (triangles/s)
+//   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
+//                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
+#include <benchmark/benchmark.h>
+
+#include <array>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pic/pic.h"
+#include "pic/primitives.h"
+#include "qef.h"
+
+namespace {
+
+const std::string kData = PIC_BENCH_DATA_DIR;
+
+void BM_QefAccumulateSolve(benchmark::State& state) {
+  const int planes = static_cast<int>(state.range(0));
+  std::mt19937 rng(42);
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  // Planes through points of a small cell around a corner (a realistic feature cell).
+  std::vector<std::pair<pic::Vec3, double>> pl;
+  for (int i = 0; i < planes; ++i) {
+    pic::Vec3 n{g(rng), g(rng), g(rng)};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (auto& x : n) x /= len;
+    const pic::Vec3 p{0.5 + 0.01 * u(rng), 0.5 + 0.01 * u(rng), 0.5 + 0.01 * u(rng)};
+    pl.push_back({n, n[0] * p[0] + n[1] * p[1] + n[2] * p[2]});
+  }
+  const pic::Vec3 seed{0.5, 0.5, 0.5};
+  for (auto _ : state) {
+    pic::detail::Qef q;
+    for (const auto& [n, d] : pl) q.add_plane(n, d, 1.0);
+    auto s = q.solve(seed);
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["solves/s"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_QefAccumulateSolve)->Arg(1)->Arg(3)->Arg(8)->Arg(32);
+
+const pic::TriMesh& fandisk() {
+  static const pic::TriMesh m = pic::read_mesh(kData + "/fandisk.obj");
+  return m;
+}
+
+void BM_SampleSphere(benchmark::State& state) {
+  const pic::TriMesh sphere = pic::make_sphere({0.5, 0.5, 0.5}, 0.3, 64);
+  pic::SampleOptions o;
+  o.depth = static_cast<int>(state.range(0));
+  o.cube = pic::Cube{{0, 0, 0}, 1};
+  o.parallel = false;
+  pic::SampleStats st;
+  size_t nodes = 0;
+  for (auto _ : state) {
+    auto t = pic::sample(sphere, o, &st);
+    nodes = t.nodes.size();
+    benchmark::DoNotOptimize(t);
+  }
+  state.counters["PICs"] = static_cast<double>(st.pics);
+  state.counters["cells"] = static_cast<double>(nodes);
+  state.counters["cells/s"] = benchmark::Counter(static_cast<double>(nodes), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_SampleSphere)->DenseRange(6, 12, 2)->Unit(benchmark::kMillisecond);
+
+void BM_SampleFandisk(benchmark::State& state) {
+  const pic::TriMesh& m = fandisk();
+  pic::SampleOptions o;
+  o.depth = 12;
+  o.error = 1e-8;
+  o.parallel = state.range(0) != 0;
+  pic::SampleStats st;
+  for (auto _ : state) {
+    auto t = pic::sample(m, o, &st);
+    benchmark::DoNotOptimize(t);
+  }
+  state.SetLabel(o.parallel ? "tbb" : "serial");
+  state.counters["PICs"] = static_cast<double>(st.pics);
+  state.counters["triangles_in"] = static_cast<double>(st.triangles_in);
+}
+BENCHMARK(BM_SampleFandisk)->ArgName("parallel")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Contour(benchmark::State& state) {
+  pic::SampleOptions o;
+  const pic::Octree t = pic::sample(fandisk(), o);
+  size_t tris = 0;
+  for (auto _ : state) {
+    auto m = pic::contour(t);
+    tris = m.triangles.size();
+    benchmark::DoNotOptimize(m);
+  }
+  state.SetLabel("fandisk");
+  state.counters["triangles"] = static_cast<double>(tris);
+  state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(tris), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_Contour)->Unit(benchmark::kMillisecond);
+
+struct CadScene {
+  std::array<pic::Octree, 4> operands;  // cube, cylinder z, cylinder x, cylinder y
+  std::array<pic::Octree, 3> before;    // the accumulated object before step k
+  CadScene() {
+    pic::SampleOptions o;
+    o.cube = pic::Cube{{0, 0, 0}, 1};
+    const pic::Vec3 c{0.5, 0.5, 0.5};
+    operands[0] = pic::sample(pic::make_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}), o);
+    operands[1] = pic::sample(pic::make_cylinder(c, 0.15, 0.8, 2, 128), o);
+    operands[2] = pic::sample(pic::make_cylinder(c, 0.1, 0.8, 0, 128), o);
+    operands[3] = pic::sample(pic::make_cylinder(c, 0.07, 0.8, 1, 128), o);
+    before[0] = operands[0];
+    before[1] = pic::csg(before[0], operands[1], pic::CsgOp::Union);
+    before[2] = pic::csg(before[1], operands[2], pic::CsgOp::Subtract);
+  }
+};
+
+void BM_CsgCadStep(benchmark::State& state) {
+  static const CadScene scene;
+  const int k = static_cast<int>(state.range(0));
+  const pic::CsgOp op = k == 0 ? pic::CsgOp::Union : pic::CsgOp::Subtract;
+  pic::CsgStats st;
+  for (auto _ : state) {
+    auto r = pic::csg(scene.before[k], scene.operands[k + 1], op, {}, &st);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetLabel(k == 0 ? "cube+cyl_z" : k == 1 ? "-cyl_x" : "-cyl_y");
+  state.counters["cells_visited"] = static_cast<double>(st.cells_visited);
+  state.counters["contour_a_ms"] = st.contour_a_seconds * 1e3;
+  state.counters["contour_b_ms"] = st.contour_b_seconds * 1e3;
+  state.counters["csg_ms"] = st.csg_seconds * 1e3;
+}
+BENCHMARK(BM_CsgCadStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

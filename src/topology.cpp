@@ -1,0 +1,186 @@
+#include "topology.h"
+
+#include "contour.h"
+#include "sample.h"
+
+#include <algorithm>
+#include <array>
+#include <unordered_map>
+#include <vector>
+
+namespace pic::detail {
+namespace {
+
+using Lat = std::array<int64_t, 3>;
+
+struct LeafRef {
+  uint32_t node;
+  Cell cell;
+};
+
+/// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the
+/// nodes from the root down to it.
+LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nullptr) {
+  uint32_t node = 0;
+  Cell cell;
+  while (t.nodes[node].kind == CellKind::Internal) {
+    if (path) path->push_back(node);
+    const int64_t h = cell.span() / 2;
+    int c = 0;
+    for (int k = 0; k < 3; ++k)
+      if (q[k] >= cell.lat[k] + h) c |= 1 << k;
+    node = t.nodes[node].index + c;
+    cell = cell.child(c);
+  }
+  if (path) path->push_back(node);
+  return {node, cell};
+}
+
+int corner_index(const Cell& cell, const Lat& p) {
+  const int64_t s = cell.span();
+  int k = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (p[a] == cell.lat[a] + s) k |= 1 << a;
+    else if (p[a] != cell.lat[a]) return -1;
+  }
+  return k;
+}
+
+/// Leaves having lattice point p as a corner, with the corner index in each; `path` gets
+/// every node on the way down to them.
+struct Around {
+  uint32_t node;
+  int corner;
+  Cell cell;
+};
+std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr) {
+  std::vector<Around> out;
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  for (int o = 0; o < 8; ++o) {
+    Lat q;
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
+      inside = inside && q[k] >= 0 && q[k] < kLimit;
+    }
+    if (!inside) continue;
+    const LeafRef l = leaf_at(t, q, path);
+    const int c = corner_index(l.cell, p);
+    if (c < 0) continue;
+    bool seen = false;
+    for (const auto& a : out) seen = seen || a.node == l.node;
+    if (!seen) out.push_back({l.node, c, l.cell});
+  }
+  return out;
+}
+
+bool multi(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
+
+/// The leaf's corner signs as a mask (uniform leaves: all corners alike).
+uint8_t signs_of(const Node& n) {
+  if (n.kind == CellKind::Gray) return n.signs;
+  return n.kind == CellKind::Black ? 0xff : 0;
+}
+
+/// Flips corner c of a leaf. A uniform leaf becomes gray with its vertex right next to that
+/// corner (the only place its surface can be).
+void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
+  Node& n = t.nodes[node];
+  if (n.kind == CellKind::Gray) {
+    n.signs ^= uint8_t(1 << c);
+    return;
+  }
+  const uint8_t s = uint8_t(signs_of(n) ^ (1 << c));
+  const Vec3 x = cell_vertex(Qef{}, cell, s).position;
+  const Vec3 m = cell.min_unit();
+  const double inv = double(int64_t{1} << cell.level);
+  std::array<float, 3> local;
+  for (int k = 0; k < 3; ++k) local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
+  t.vertices.push_back(local);
+  n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, s, 0, 0};
+}
+
+}  // namespace
+
+TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
+                                  const std::function<void(uint32_t)>* touched) {
+  TopologyFix fix;
+  for (int pass = 0; pass < 6; ++pass) {
+    std::vector<LeafRef> bad;
+    visit_leaves(t, 0, Cell{}, [&](uint32_t node, const Cell& cell) {
+      const Node& n = t.nodes[node];
+      if (n.kind == CellKind::Gray && multi(n.signs) && (!active || (*active)(node))) bad.push_back({node, cell});
+    });
+    fix.remaining = bad.size();
+    if (bad.empty()) break;
+    for (const LeafRef& l : bad) {
+      const uint8_t s = t.nodes[l.node].signs;
+      if (!multi(s)) continue;  // fixed by an earlier flip
+      // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
+      // preferring to flip the minority sign (removing the thinner feature).
+      int best = -1, best_cost = 1 << 30;
+      std::vector<Around> best_around;
+      const bool minority_inside = __builtin_popcount(s) <= 4;
+      for (int k = 0; k < 8; ++k) {
+        if (multi(uint8_t(s ^ (1 << k)))) continue;
+        const auto around = leaves_around(t, l.cell.corner(k));
+        int cost = 0;
+        for (const auto& a : around) cost += 2 * multi(uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner)));
+        cost += (((s >> k) & 1) != 0) != minority_inside;
+        if (cost < best_cost) {
+          best_cost = cost;
+          best = k;
+          best_around = around;
+        }
+      }
+      if (best < 0) continue;
+      for (const auto& a : best_around) flip_corner(t, a.node, a.corner, a.cell);
+      if (touched) {
+        std::vector<uint32_t> path;
+        leaves_around(t, l.cell.corner(best), &path);
+        for (uint32_t n : path) (*touched)(n);
+      }
+      ++fix.flipped;
+    }
+  }
+  return fix;
+}
+
+/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
+/// edge's midpoint), so the contour stays closed whatever the geometry decided.
+size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active) {
+  size_t fixed = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    DualStats ds;
+    std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
+    dual_walk(t, active, emit, &ds);
+    if (ds.cracks == 0) break;
+    std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
+    std::unordered_map<uint32_t, Cell> cells;
+    for (size_t k = 0; k < ds.crack_leaves.size(); ++k) {
+      auto& [sum, n] = mid_sum[ds.crack_leaves[k]];
+      for (int a = 0; a < 3; ++a) sum[a] += ds.crack_points[k][a];
+      ++n;
+      cells[ds.crack_leaves[k]] = ds.crack_cells[k];
+    }
+    for (const auto& [node, ms] : mid_sum) {
+      Node& n = t.nodes[node];
+      if (n.kind == CellKind::Gray) continue;
+      const Cell& cell = cells[node];
+      const auto& [sum, cnt] = ms;
+      constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
+      const Vec3 x{sum[0] * k / (2 * cnt), sum[1] * k / (2 * cnt), sum[2] * k / (2 * cnt)};
+      const uint8_t signs = n.kind == CellKind::Black ? 0xff : 0;
+      const Vec3 m = cell.min_unit();
+      const double inv = double(int64_t{1} << cell.level);
+      std::array<float, 3> local;
+      for (int a = 0; a < 3; ++a) local[a] = static_cast<float>(std::clamp((x[a] - m[a]) * inv, 0.0, 1.0));
+      t.vertices.push_back(local);
+      n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, signs, 0, 0};
+      ++fixed;
+    }
+  }
+  return fixed;
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,29 @@
+// Topology clean-up after sampling and CSG: leaves at the depth cap may hold two surface
+// components (the paper's rule 3 could not be met). Dual contouring then makes non-manifold
+// edges. A corner sign is flipped — consistently in every leaf that has that lattice point as
+// a corner — until every leaf holds one component. This removes or joins features thinner
+// than the finest cell, which the octree cannot represent anyway.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "octree_util.h"
+
+namespace pic::detail {
+
+struct TopologyFix {
+  size_t flipped = 0;    // lattice points whose sign changed
+  size_t remaining = 0;  // leaves still holding more than one component
+};
+
+/// Works on the leaves for which `active` is true (all leaves when null); `touched` is called
+/// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
+TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
+                                  const std::function<void(uint32_t)>* touched = nullptr);
+
+/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
+/// edges' midpoint), so the contour stays closed. Returns how many leaves changed.
+size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active);
+
+}  // namespace pic::detail
