@@ -261,8 +261,11 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
 }
 
 double point_triangle_distance2(const Vec3& p, const ITri& t) {
+  return point_triangle_distance2(p, to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2]));
+}
+
+double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Ericson, Real-Time Collision Detection 5.1.5: closest point by Voronoi regions.
-  const Vec3 a = to_unit(t.v[0]), b = to_unit(t.v[1]), c = to_unit(t.v[2]);
   const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
   auto d2 = [&](const Vec3& q) { const Vec3 v = sub(p, q); return dot(v, v); };
   const double d1 = dot(ab, ap), d2v = dot(ac, ap);

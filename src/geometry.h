@@ -76,6 +76,7 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box);
 
 /// Squared distance from a unit-space point to a grid triangle (double precision).
 double point_triangle_distance2(const Vec3& p, const ITri& t);
+double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// Unit-space position of a grid point.
 inline Vec3 to_unit(const I3& g) { return {grid_to_unit(g[0]), grid_to_unit(g[1]), grid_to_unit(g[2])}; }

@@ -1,6 +1,8 @@
 // The .pic file: round trips, size, robustness against damaged or foreign files, atomic save.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -273,16 +275,16 @@ TEST(Format, FlippedBytesInALargeFileAreRejected) {
 // cleanly or load into a tree that contours without crashing.
 TEST(Format, ForgedFilesWithValidChecksumNeverCrash) {
   const auto bytes = serialize(small_tree());
-  test::Rng rng(99);
+  std::mt19937_64 rng(99);
   size_t rejected = 0, accepted = 0;
   for (int trial = 0; trial < 3000; ++trial) {
     auto bad = bytes;
-    const int flips = 1 + int(rng.next() % 4);
+    const int flips = 1 + int(rng() % 4);
     for (int f = 0; f < flips; ++f) {
       // Half the flips in the header fields after the magic, half in the payload.
-      const size_t lo = (rng.next() & 1) ? 6 : kHeaderBytes;
-      const size_t i = lo + rng.next() % (bad.size() - 4 - lo);
-      bad[i] ^= uint8_t(1u << (rng.next() % 8));
+      const size_t lo = (rng() & 1) ? 6 : kHeaderBytes;
+      const size_t i = lo + rng() % (bad.size() - 4 - lo);
+      bad[i] ^= uint8_t(1u << (rng() % 8));
     }
     fix_crc(bad);
     try {
@@ -360,8 +362,8 @@ TEST(Format, ForeignEmptyAndMissingFilesGiveClearErrors) {
   expect_message(dir / "folder.pic", "directory");
   // Random bytes.
   std::vector<uint8_t> noise(5000);
-  test::Rng rng(3);
-  for (auto& b : noise) b = uint8_t(rng.next());
+  std::mt19937_64 rng(3);
+  for (auto& b : noise) b = uint8_t(rng());
   write_raw(dir / "noise.pic", noise);
   expect_message(dir / "noise.pic", "not a .pic file");
 }

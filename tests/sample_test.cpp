@@ -53,9 +53,8 @@ void expect_box_features(const Sampled& s, const TriMesh& box_in, double tol = 1
   for (const Vec3& corner : box_in.positions)
     worst_corner = std::max(worst_corner, test::nearest_vertex_distance(s.out, corner) / unit);
   EXPECT_LE(worst_corner, tol) << "a box corner has no output vertex near it";
-  const test::MeshDistance to_box(box_in);
   double worst_vertex = 0;
-  for (const Vec3& p : s.out.positions) worst_vertex = std::max(worst_vertex, to_box.distance(p) / unit);
+  for (double d : distance_to_mesh(box_in, s.out.positions)) worst_vertex = std::max(worst_vertex, d / unit);
   EXPECT_LE(worst_vertex, tol) << "an output vertex is off the box surface";
   std::printf("  [measure] worst corner %.3g, worst vertex off surface %.3g\n", worst_corner, worst_vertex);
 }
@@ -136,13 +135,12 @@ TEST_P(SampleRotatedBox, CornersEdgesAndVolumeReproduced) {
   // at the depth cap may hold a vertex clamped into their cell: a box edge that passes just
   // outside a cell both of whose faces enter it puts the QEF minimum outside the cell at
   // every level (dual contouring's one-vertex-per-cell limit). Bound those by the cap cell.
-  const test::MeshDistance to_box(box);
   const double cap_cell = 1.0 / (1 << depth);
   double worst_ok = 0, worst_capped = 0;
   size_t capped = 0;
   for_each_leaf(s.tree, [&](const LeafView& l) {
     if (l.kind != CellKind::Gray) return;
-    const double d = to_box.distance(l.vertex);
+    const double d = distance_to_mesh(box, {l.vertex})[0];
     if (s.tree.nodes[l.node].flags & kFlagCapped) {
       ++capped;
       worst_capped = std::max(worst_capped, d);

@@ -185,6 +185,21 @@ struct LeafView {
 /// Calls `visit` for every leaf, depth-first in child order.
 void for_each_leaf(const Octree& tree, const std::function<void(const LeafView&)>& visit);
 
+/// @name Distances between surfaces (exact point-to-triangle, sampled).
+///@{
+/// Every vertex plus `samples` area-weighted points (deterministic for a given seed).
+std::vector<Vec3> sample_surface(const TriMesh& mesh, size_t samples, uint64_t seed = 12345);
+/// Unsigned distance from each point to the mesh.
+std::vector<double> distance_to_mesh(const TriMesh& mesh, const std::vector<Vec3>& points);
+struct SurfaceDistance {
+  double hausdorff = 0;            ///< max of the two one-sided distances
+  double a_to_b = 0, b_to_a = 0;   ///< one-sided maxima
+  double mean_a_to_b = 0, mean_b_to_a = 0;
+};
+/// Two-sided (Hausdorff) distance sampled at all vertices plus `samples` points per side.
+SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples = 100000);
+///@}
+
 /// Cell counts of an octree (`pic info`).
 struct OctreeStats {
   struct Level {
