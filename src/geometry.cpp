@@ -99,6 +99,14 @@ ITri make_itri(const I3& a, const I3& b, const I3& c) {
     t.lo[k] = std::min({a[k], b[k], c[k]});
     t.hi[k] = std::max({a[k], b[k], c[k]});
   }
+  const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
+  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (len > 0) {
+    t.unit_normal = {nx / len, ny / len, nz / len};
+    const Vec3 v0 = to_unit(a);
+    t.plane = t.unit_normal[0] * v0[0] + t.unit_normal[1] * v0[1] + t.unit_normal[2] * v0[2];
+    t.area = 0.5 * len / (kGridScale * kGridScale);
+  }
   return t;
 }
 
@@ -141,6 +149,10 @@ bool overlaps_box(const ITri& t, const I3& lo, const I3& hi) {
 double clipped_area(const ITri& t, const IBox& box) {
   for (int k = 0; k < 3; ++k)
     if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return -1;
+  // Wholly inside the box, away from its low faces: no clipping needed.
+  if (t.lo[0] > box.lo[0] && t.lo[1] > box.lo[1] && t.lo[2] > box.lo[2] && t.hi[0] <= box.hi[0] &&
+      t.hi[1] <= box.hi[1] && t.hi[2] <= box.hi[2])
+    return t.area;
   Poly poly;
   poly.n = 3;
   for (int k = 0; k < 3; ++k) poly.p[k] = to_unit(t.v[k]);

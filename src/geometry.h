@@ -38,6 +38,9 @@ struct ITri {
   std::array<i128, 3> n;  // (v1-v0) x (v2-v0), < 2^70 per component
   i128 d;                 // n . v0
   I3 lo, hi;              // bounding box
+  Vec3 unit_normal{0, 0, 0};  // double precision, for QEFs
+  double plane = 0;           // unit_normal . v0 (unit-cube coordinates)
+  double area = 0;            // unit-cube units
 };
 ITri make_itri(const I3& a, const I3& b, const I3& c);
 inline bool is_degenerate(const ITri& t) { return t.n[0] == 0 && t.n[1] == 0 && t.n[2] == 0; }

@@ -71,8 +71,9 @@ void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent
 void check_text_for_nan(const std::vector<uint8_t>& bytes) {
   const size_t n = std::min<size_t>(bytes.size(), size_t{1} << 30);
   for (size_t i = 0; i + 3 <= n; ++i) {
-    const char a = char(std::tolower(bytes[i])), b = char(std::tolower(bytes[i + 1])),
-               c = char(std::tolower(bytes[i + 2]));
+    const uint8_t first = bytes[i] | 0x20;  // ASCII lower case
+    if (first != 'n' && first != 'i') continue;
+    const char a = char(first), b = char(bytes[i + 1] | 0x20), c = char(bytes[i + 2] | 0x20);
     const bool word_start = i == 0 || std::isspace(bytes[i - 1]) || bytes[i - 1] == '-' || bytes[i - 1] == '+';
     if (word_start && ((a == 'n' && b == 'a' && c == 'n') || (a == 'i' && b == 'n' && c == 'f')))
       throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");

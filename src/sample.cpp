@@ -41,13 +41,7 @@ bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
   constexpr double kFloor = 0.1;
   bool any = false;
-  auto add = [&](const ITri& t, double w) {
-    const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    const Vec3 n{nx / len, ny / len, nz / len};
-    const Vec3 v = to_unit(t.v[0]);
-    q.add_plane(n, n[0] * v[0] + n[1] * v[1] + n[2] * v[2], w);
-  };
+  auto add = [&](const ITri& t, double w) { q.add_plane(t.unit_normal, t.plane, w); };
   for (uint32_t k : idx) {
     const ITri& t = tris[k];
     if (is_degenerate(t)) continue;
