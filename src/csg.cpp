@@ -535,8 +535,16 @@ class Combiner {
   std::vector<uint32_t> scratch_;
 };
 
-/// Stamps the overlap: pairs of cells where neither operand is uniform (paper 5.2.1).
-void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, uint32_t stamp, size_t& count) {
+struct Deferred {
+  uint32_t b_node;
+  Cell cell;
+};
+
+/// Stamps the overlap: pairs of cells where neither operand is uniform (paper 5.2.1). Where a
+/// gray leaf of A covers a subtree of B, B's subtree is not stamped yet: `deferred` keeps it
+/// for stamp_under_surface(), which stamps only the parts A's surface comes near.
+void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
+         size_t& count, std::vector<Deferred>& deferred) {
   const Node& x = a.nodes[na];
   const Node& y = b.nodes[nb];
   const bool ux = x.kind == CellKind::White || x.kind == CellKind::Black;
@@ -551,9 +559,32 @@ void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, uint32_t st
     ++count;
   }
   if (x.kind != CellKind::Internal && y.kind != CellKind::Internal) return;
+  if (x.kind == CellKind::Gray) {
+    deferred.push_back({nb, cell});
+    return;
+  }
   for (int c = 0; c < 8; ++c)
-    tag(a, x.kind == CellKind::Internal ? x.index + c : na, b, y.kind == CellKind::Internal ? y.index + c : nb,
-        stamp, count);
+    tag(a, x.index + c, b, y.kind == CellKind::Internal ? y.index + c : nb, cell.child(c), stamp, count, deferred);
+}
+
+/// Stamps the cells of B's subtree that A's partial contour comes near: elsewhere A is
+/// uniform inside its gray leaf, so the result there is B's subtree or uniform, with no need
+/// for B's partial contour. This makes the cost of a coarse clay against a fine tool follow
+/// the clay's surface, not the tool's whole volume.
+void stamp_under_surface(const Operand& a, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
+                         size_t& count, std::vector<uint32_t>& scratch) {
+  const Node& y = b.nodes[nb];
+  if (y.kind == CellKind::White || y.kind == CellKind::Black) return;
+  const IBox box = cell.box();
+  scratch.clear();
+  a.bvh.query(a.tris, box.lo, box.hi, scratch);
+  if (scratch.empty()) return;
+  if (b.stamps[nb] != stamp) {
+    b.stamps[nb] = stamp;
+    ++count;
+  }
+  if (y.kind == CellKind::Internal)
+    for (int c = 0; c < 8; ++c) stamp_under_surface(a, b, y.index + c, cell.child(c), stamp, count, scratch);
 }
 
 /// The partial contour: dual polygons around stamped cells, indexed for box queries.
@@ -650,13 +681,22 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   stats.stamp = stamp;
   if (a.stamps.size() != a.nodes.size()) a.stamps.resize(a.nodes.size(), 0);
   if (b.stamps.size() != b.nodes.size()) b.stamps.resize(b.nodes.size(), 0);
-  tag(a, 0, b, 0, stamp, stats.cells_stamped);
+  std::vector<Deferred> deferred;
+  tag(a, 0, b, 0, Cell{}, stamp, stats.cells_stamped, deferred);
 
   Operand oa(a, stamp), ob(b, stamp);
   auto tc = Clock::now();
   partial_contour(oa, stamp);
   stats.contour_a_seconds = since(tc);
   tc = Clock::now();
+  {
+    std::vector<uint32_t> scratch;
+    for (const Deferred& d : deferred) {
+      const Node& y = b.nodes[d.b_node];
+      for (int c = 0; c < 8; ++c)
+        stamp_under_surface(oa, b, y.index + c, d.cell.child(c), stamp, stats.cells_stamped, scratch);
+    }
+  }
   partial_contour(ob, stamp);
   stats.contour_b_seconds = since(tc);
 
