@@ -146,6 +146,20 @@ struct Operand {
   bool sign(const Lat& p) {
     const Hit h = find(0, Cell{}, p);
     if (h.state != 2) return h.sign;
+    return classify(p, h.leaf, h.cell);
+  }
+
+  /// sign_X(p) for p known to lie in the closed cell of gray leaf `leaf`: a point strictly
+  /// inside it needs no search from the root.
+  bool sign_in(const Lat& p, uint32_t leaf, const Cell& cell) {
+    const int64_t s = cell.span();
+    for (int k = 0; k < 3; ++k)
+      if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return sign(p);
+    return classify(p, leaf, cell);
+  }
+
+  bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
+    const Hit h{2, false, leaf, cell};
     const uint64_t key = lat_key(p);
     if (const auto it = memo.find(key); it != memo.end()) return it->second;
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
@@ -195,6 +209,7 @@ struct Side {
   bool real = false;    // Gray: the cell is the leaf's own cell
   uint8_t signs = 0;    // Gray: signs at this cell's corners
   std::vector<uint32_t> idx;  // Gray: fan triangles overlapping this cell
+  Cell leaf_cell;             // Gray: the cell of the leaf `node`
 };
 
 class Combiner {
@@ -293,12 +308,16 @@ class Combiner {
       s.kind = Side::Gray;
       s.real = true;
       s.signs = n.signs;
+      s.leaf_cell = cell;
       s.idx = x.triangles_in(node, cell);
     } else {
       s.inside = n.kind == CellKind::Black;
     }
     return s;
   }
+
+  /// The cell of the gray leaf behind a Gray side (its own cell when real).
+  static Cell leaf_cell(const Operand&, const Side& s) { return s.leaf_cell; }
 
   Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
     const Cell cc = cell.child(c);
@@ -308,13 +327,14 @@ class Combiner {
     v.kind = Side::Gray;
     v.node = s.node;
     v.real = false;
+    v.leaf_cell = s.leaf_cell;
     for (int k = 0; k < 8; ++k) {
       const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
       bool sign;
       if (gx != 1 && gy != 1 && gz != 1) {
         sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
       } else {
-        sign = x.sign(cc.corner(k));
+        sign = x.sign_in(cc.corner(k), s.node, leaf_cell(x, s));
       }
       v.signs |= uint8_t(sign) << k;
     }
