@@ -432,6 +432,21 @@ class Combiner {
     return q.solve(x).error < error_;
   }
 
+  /// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a
+  /// leaf here would meet finer neighbours showing a second sheet on its faces.
+  bool refinement_is_simple(const Cell& cell, const Side& a, const Side& b, uint8_t sr) {
+    std::array<bool, 27> g{};
+    for (int k = 0; k < 8; ++k) g[grid_index_of_corner(k)] = (sr >> k) & 1;
+    const int64_t h = cell.span() / 2;
+    for (int i = 0; i < 27; ++i) {
+      const int x = i % 3, y = (i / 3) % 3, z = i / 9;
+      if (x != 1 && y != 1 && z != 1) continue;
+      const Lat p{cell.lat[0] + x * h, cell.lat[1] + y * h, cell.lat[2] + z * h};
+      g[i] = apply(op_, a_.sign_in(p, a.node, a.leaf_cell), b_.sign_in(p, b.node, b.leaf_cell));
+    }
+    return grid_is_simple(g);
+  }
+
   struct EdgeCrossing {
     bool change;
     double t;
@@ -516,13 +531,14 @@ class Combiner {
         for (size_t j = 0; j < b.idx.size() && !meets; ++j)
           meets = triangles_meet_in_box(a_.tris[a.idx[i]], b_.tris[b.idx[j]], cell.box());
       const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
-      if (!meets) {
+      const bool simple = at_cap || refinement_is_simple(cell, a, b, sr);
+      if (!meets && simple) {
         // Triangle-fan culling: the surfaces do not meet here, so the result is one operand's
         // cell, or uniform, when the signs agree.
         if (!vis_a && !vis_b && r_uniform) return uniform(sr != 0);
         if (vis_a && !vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
         if (vis_b && !vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
-      } else {
+      } else if (meets && simple) {
         // Q_sum = Q_A + Q_B minimized from the average of the two vertices (paper eq. 3).
         const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
         const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};

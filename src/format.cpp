@@ -72,12 +72,16 @@ T get(const std::vector<uint8_t>& in, size_t& at) {
   return v;
 }
 
-void write_node(const Octree& t, uint32_t node, int level, BitWriter& w) {
+// Counts are of the nodes reached from the root: an octree edited in place (csg_inplace)
+// keeps replaced subtrees in its arrays until it is compacted.
+void write_node(const Octree& t, uint32_t node, int level, BitWriter& w, uint64_t& nodes, uint64_t& grays) {
   const Node& n = t.nodes[node];
+  ++nodes;
   w.put(static_cast<uint32_t>(n.kind), 2);
   if (n.kind == CellKind::Internal) {
-    for (int c = 0; c < 8; ++c) write_node(t, n.index + c, level + 1, w);
+    for (int c = 0; c < 8; ++c) write_node(t, n.index + c, level + 1, w, nodes, grays);
   } else if (n.kind == CellKind::Gray) {
+    ++grays;
     w.put(n.signs, 8);
     if (level == t.max_depth) w.put(n.flags & kFlagCapped, 1);
     const int q = quant_bits(level);
@@ -125,7 +129,8 @@ struct Decoder {
 
 std::vector<uint8_t> serialize(const Octree& tree) {
   BitWriter w;
-  write_node(tree, 0, 0, w);
+  uint64_t nodes = 0, grays = 0;
+  write_node(tree, 0, 0, w, nodes, grays);
   std::vector<uint8_t> out;
   out.reserve(kHeaderBytes + w.bytes().size() + kCrcBytes);
   put_bytes(out, kMagic, 4);
@@ -136,8 +141,8 @@ std::vector<uint8_t> serialize(const Octree& tree) {
   put<uint16_t>(out, 0);
   for (double x : tree.cube.origin) put<double>(out, x);
   put<double>(out, tree.cube.size);
-  put<uint64_t>(out, tree.nodes.size());
-  put<uint64_t>(out, tree.vertices.size());
+  put<uint64_t>(out, nodes);
+  put<uint64_t>(out, grays);
   put<uint64_t>(out, w.bytes().size());
   put_bytes(out, w.bytes().data(), w.bytes().size());
   put<uint32_t>(out, static_cast<uint32_t>(crc32(0L, out.data(), static_cast<uInt>(out.size()))));

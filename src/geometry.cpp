@@ -313,6 +313,68 @@ I3 to_grid(const Vec3& u) {
           std::llround(u[2] * kGridScale)};
 }
 
+bool grid_is_simple(const std::array<bool, 27>& g) {
+  auto at = [&](int a, int b, int c) { return g[a + 3 * b + 9 * c]; };
+  // Edges: a midpoint between two equal corners must agree with them.
+  for (int axis = 0; axis < 3; ++axis)
+    for (int u = 0; u < 3; u += 2)
+      for (int v = 0; v < 3; v += 2) {
+        int p0[3], p1[3], m[3];
+        const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+        p0[axis] = 0, p1[axis] = 2, m[axis] = 1;
+        p0[i] = p1[i] = m[i] = u;
+        p0[j] = p1[j] = m[j] = v;
+        const bool s0 = at(p0[0], p0[1], p0[2]), s1 = at(p1[0], p1[1], p1[2]);
+        if (s0 == s1 && at(m[0], m[1], m[2]) != s0) return false;
+      }
+  // Faces: with four equal corners the centre agrees.
+  for (int axis = 0; axis < 3; ++axis)
+    for (int w = 0; w < 3; w += 2) {
+      const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+      int q[3];
+      q[axis] = w;
+      bool first = true, same = true, s0 = false;
+      for (int u = 0; u < 3; u += 2)
+        for (int v = 0; v < 3; v += 2) {
+          q[i] = u, q[j] = v;
+          const bool sv = at(q[0], q[1], q[2]);
+          if (first) s0 = sv, first = false;
+          same = same && sv == s0;
+        }
+      q[i] = q[j] = 1;
+      if (same && at(q[0], q[1], q[2]) != s0) return false;
+    }
+  // Each sign class 6-connected over the grid.
+  for (bool inside : {false, true}) {
+    int seen = 0, stack = 0, total = 0, start = -1;
+    for (int k = 0; k < 27; ++k)
+      if (g[k] == inside) {
+        ++total;
+        if (start < 0) start = k;
+      }
+    if (total == 0) continue;
+    seen = stack = 1 << start;
+    int count = 0;
+    while (stack) {
+      const int k = __builtin_ctz(stack);
+      stack &= stack - 1;
+      ++count;
+      const int a = k % 3, b = (k / 3) % 3, c = k / 9;
+      const int nb[6][3] = {{a - 1, b, c}, {a + 1, b, c}, {a, b - 1, c}, {a, b + 1, c}, {a, b, c - 1}, {a, b, c + 1}};
+      for (const auto& n : nb) {
+        if (n[0] < 0 || n[0] > 2 || n[1] < 0 || n[1] > 2 || n[2] < 0 || n[2] > 2) continue;
+        const int kk = n[0] + 3 * n[1] + 9 * n[2];
+        if (g[kk] == inside && !((seen >> kk) & 1)) {
+          seen |= 1 << kk;
+          stack |= 1 << kk;
+        }
+      }
+    }
+    if (count != total) return false;
+  }
+  return true;
+}
+
 bool one_component(uint8_t signs) {
   static const std::array<uint8_t, 256> table = make_component_table();
   return table[signs] != 0;

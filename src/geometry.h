@@ -94,6 +94,13 @@ inline constexpr std::array<std::array<int, 2>, 12> kEdgeCorners = {{
 }};
 inline constexpr int edge_axis(int e) { return e / 4; }
 
+/// Whether the signs of a cell's 3x3x3 child grid (index a + 3b + 9c) add nothing to what its
+/// 8 corners say: no sign appears at an edge midpoint, face centre or the cell centre unless
+/// the corners around it already change sign there, and inside and outside points are each
+/// 6-connected. A leaf accepted with a non-simple grid would meet finer neighbours whose
+/// signs show a second sheet on its faces (Ju et al. 2002, topology-safe simplification).
+bool grid_is_simple(const std::array<bool, 27>& g);
+
 /// One surface component by corner signs: inside corners connected along cube edges and
 /// outside corners connected too (the 7 one-component Marching Cubes classes and their
 /// complements). Uniform sign masks return false.

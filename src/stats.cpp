@@ -91,13 +91,13 @@ double volume(const TriMesh& mesh) {
 
 OctreeStats analyze(const Octree& tree) {
   OctreeStats s;
-  s.nodes = tree.nodes.size();
   s.memory_bytes = tree.nodes.size() * sizeof(Node) + tree.vertices.size() * sizeof(tree.vertices[0]);
   s.levels.resize(tree.max_depth + 1);
   s.bbox_min = {1e300, 1e300, 1e300};
   s.bbox_max = {-1e300, -1e300, -1e300};
   std::function<void(uint32_t, const detail::Cell&)> walk = [&](uint32_t node, const detail::Cell& cell) {
     const Node& n = tree.nodes[node];
+    ++s.nodes;  // reachable nodes: an octree edited in place may hold replaced ones
     if (cell.level >= static_cast<int>(s.levels.size())) s.levels.resize(cell.level + 1);
     auto& l = s.levels[cell.level];
     switch (n.kind) {

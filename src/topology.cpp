@@ -106,11 +106,18 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
                                   const std::function<void(uint32_t)>* touched) {
   TopologyFix fix;
   for (int pass = 0; pass < 6; ++pass) {
+    // Only subtrees with active nodes are visited: a sculpting stroke stays local.
     std::vector<LeafRef> bad;
-    visit_leaves(t, 0, Cell{}, [&](uint32_t node, const Cell& cell) {
+    std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
+      if (active && !(*active)(node)) return;
       const Node& n = t.nodes[node];
-      if (n.kind == CellKind::Gray && multi(n.signs) && (!active || (*active)(node))) bad.push_back({node, cell});
-    });
+      if (n.kind == CellKind::Internal) {
+        for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
+      } else if (n.kind == CellKind::Gray && multi(n.signs)) {
+        bad.push_back({node, cell});
+      }
+    };
+    walk(0, Cell{});
     fix.remaining = bad.size();
     if (bad.empty()) break;
     for (const LeafRef& l : bad) {

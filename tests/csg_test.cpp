@@ -285,6 +285,19 @@ TEST_F(AlgebraTest, ResultsChainSaveAndLoad) {
   EXPECT_TRUE(IsClosedManifold(m));
 }
 
+TEST_F(AlgebraTest, InPlaceEditsSaveAndLoad) {
+  // csg_inplace leaves replaced subtrees in the arrays until it compacts: the file must hold
+  // only the live tree.
+  Octree r = *a;
+  for (double x : {0.3, 0.4, 0.5, 0.6})
+    csg_inplace(r, sample_in_unit(make_sphere({x, 0.5, 0.72}, 0.05, 48), 8), CsgOp::Subtract);
+  const Octree back = deserialize(serialize(r));
+  EXPECT_EQ(analyze(back).pics, analyze(r).pics);
+  const TriMesh m = contour(back);
+  EXPECT_TRUE(IsClosedManifold(m));
+  EXPECT_LT(two_sided_distance(m, contour(r)), 1e-6);
+}
+
 // ---- curved cases against analytic signed distances ------------------------------------------
 
 double sd_cylinder(const Vec3& p, const Vec3& c, double r, double h, int axis) {
