@@ -19,6 +19,13 @@ class DualWalker {
       : t_(t), active_(active), emit_(emit), stats_(stats) {}
 
   bool leaf(const Ref& r) const { return t_.nodes[r.node].kind != CellKind::Internal; }
+  // Every lattice point in a white or black leaf's closure has its colour, so no edge on a
+  // face or edge it touches changes sign: the walk can skip it. Not when looking for cracks
+  // (a violated invariant), which is exactly such an edge.
+  bool skip(const Ref& r) const {
+    const CellKind k = t_.nodes[r.node].kind;
+    return !stats_ && (k == CellKind::White || k == CellKind::Black);
+  }
   bool on(const Ref& r) const { return !active_ || (*active_)(r.node); }
   Ref sub(const Ref& r, int c) const {
     if (leaf(r)) return r;
@@ -43,7 +50,7 @@ class DualWalker {
   }
 
   void face_proc(const Ref& lo, const Ref& hi, int d) {
-    if (leaf(lo) && leaf(hi)) return;
+    if ((leaf(lo) && leaf(hi)) || skip(lo) || skip(hi)) return;
     if (!on(lo) && !on(hi)) return;
     const int i = d == 0 ? 1 : 0, j = d == 2 ? 1 : 2;
     for (int a = 0; a < 2; ++a)
@@ -67,6 +74,7 @@ class DualWalker {
 
   void edge_proc(const std::array<Ref, 4>& n, int e) {
     if (active_ && !on(n[0]) && !on(n[1]) && !on(n[2]) && !on(n[3])) return;
+    if (skip(n[0]) || skip(n[1]) || skip(n[2]) || skip(n[3])) return;
     if (leaf(n[0]) && leaf(n[1]) && leaf(n[2]) && leaf(n[3])) {
       process_edge(n, e);
       return;
