@@ -108,19 +108,9 @@ struct Operand {
       if (p[k] < c.lat[k] || p[k] > c.lat[k] + s) return false;
     return true;
   }
-  static int corner_of(const Cell& c, const Lat& p) {
-    const int64_t s = c.span();
-    int k = 0;
-    for (int a = 0; a < 3; ++a) {
-      if (p[a] == c.lat[a] + s) k |= 1 << a;
-      else if (p[a] != c.lat[a]) return -1;
-    }
-    return k;
-  }
-
   Hit find(uint32_t node, const Cell& cell, const Lat& p) const {
     const Node& n = t.nodes[node];
-    const int k = corner_of(cell, p);
+    const int k = cell.corner_index(p);
     if (k >= 0) {
       if (n.kind == CellKind::Internal) return find(n.index + k, cell.child(k), p);
       const bool s = n.kind == CellKind::Gray ? ((n.signs >> k) & 1) : n.kind == CellKind::Black;

@@ -1,5 +1,7 @@
 // Distances between surfaces, for `pic compare`, tests and benchmarks: exact point-to-triangle
 // distances over a median-split BVH, sampled at every vertex plus area-weighted points.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -185,7 +187,10 @@ std::vector<Vec3> sample_surface(const TriMesh& mesh, size_t samples, uint64_t s
 std::vector<double> distance_to_mesh(const TriMesh& mesh, const std::vector<Vec3>& points) {
   const MeshDistance d(mesh);
   std::vector<double> out(points.size());
-  for (size_t i = 0; i < points.size(); ++i) out[i] = d.distance(points[i]);
+  tbb::parallel_for(size_t{0}, points.size(), size_t{4096}, [&](size_t begin) {
+    const size_t end = std::min(points.size(), begin + 4096);
+    for (size_t i = begin; i < end; ++i) out[i] = d.distance(points[i]);
+  });
   return out;
 }
 

@@ -25,6 +25,16 @@ struct Cell {
     return {lat[0] + (c & 1) * s, lat[1] + ((c >> 1) & 1) * s, lat[2] + ((c >> 2) & 1) * s};
   }
   IBox box() const { return cell_box(level, lat); }
+  /// Which corner of this cell the lattice point p is, or -1.
+  int corner_index(const std::array<int64_t, 3>& p) const {
+    const int64_t s = span();
+    int k = 0;
+    for (int a = 0; a < 3; ++a) {
+      if (p[a] == lat[a] + s) k |= 1 << a;
+      else if (p[a] != lat[a]) return -1;
+    }
+    return k;
+  }
   double size() const { return 1.0 / double(int64_t{1} << level); }
   Vec3 min_unit() const {
     constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);

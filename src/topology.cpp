@@ -36,16 +36,6 @@ LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nul
   return {node, cell};
 }
 
-int corner_index(const Cell& cell, const Lat& p) {
-  const int64_t s = cell.span();
-  int k = 0;
-  for (int a = 0; a < 3; ++a) {
-    if (p[a] == cell.lat[a] + s) k |= 1 << a;
-    else if (p[a] != cell.lat[a]) return -1;
-  }
-  return k;
-}
-
 /// Leaves having lattice point p as a corner, with the corner index in each; `path` gets
 /// every node on the way down to them.
 struct Around {
@@ -65,7 +55,7 @@ std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uin
     }
     if (!inside) continue;
     const LeafRef l = leaf_at(t, q, path);
-    const int c = corner_index(l.cell, p);
+    const int c = l.cell.corner_index(p);
     if (c < 0) continue;
     bool seen = false;
     for (const auto& a : out) seen = seen || a.node == l.node;
