@@ -7,7 +7,7 @@ set -euo pipefail
 pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
       libcli11-dev libgtest-dev chromium)
 if [[ "${1:-}" == "--bench" ]]; then
-  pkgs+=(libbenchmark-dev libopenvdb-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev)
+  pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3)
 fi
 
 missing=()
