@@ -134,8 +134,15 @@ struct Operand {
 
   /// sign_X(p): single-valued by construction (a pure function of the tree and p).
   bool sign(const Lat& p) {
+    // Every lattice point is asked for by up to 8 cells: remember all answers, not only the
+    // ones that needed a parity walk.
+    const uint64_t key = lat_key(p);
+    if (const auto it = memo.find(key); it != memo.end()) return it->second;
     const Hit h = find(0, Cell{}, p);
-    if (h.state != 2) return h.sign;
+    if (h.state != 2) {
+      memo.emplace(key, h.sign);
+      return h.sign;
+    }
     return classify(p, h.leaf, h.cell);
   }
 

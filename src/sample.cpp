@@ -61,8 +61,15 @@ bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
 
 bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell) {
   const IBox box = cell.box();
-  for (uint32_t k : idx)
-    if (!is_degenerate(tris[k]) && clipped_area(tris[k], box) >= 0) return true;
+  for (uint32_t k : idx) {
+    const ITri& t = tris[k];
+    if (is_degenerate(t)) continue;
+    // `idx` already overlaps the closed box; the perturbation only rejects a triangle that
+    // stays at or below one of the low faces. (Clipping would also reject one that crosses a
+    // low face plane outside the box and touches the box only along that face: rare, and
+    // then the cell is just refined once more.)
+    if (t.hi[0] > box.lo[0] && t.hi[1] > box.lo[1] && t.hi[2] > box.lo[2]) return true;
+  }
   return false;
 }
 
