@@ -513,11 +513,17 @@ class Combiner {
       if (n_r >= 2) must_split = true;
     }
 
-    Qef qa, qb;
-    cell_qef(a_.tris, a.idx, cell, qa);
-    cell_qef(b_.tris, b.idx, cell, qb);
-    Qef q = qa;
-    q += qb;
+    // The QEFs are needed only when a vertex is made here (not when the cell splits).
+    Qef qa, qb, q;
+    bool have_q = false;
+    auto qefs = [&] {
+      if (have_q) return;
+      cell_qef(a_.tris, a.idx, cell, qa);
+      cell_qef(b_.tris, b.idx, cell, qb);
+      q = qa;
+      q += qb;
+      have_q = true;
+    };
     auto vertex_of = [&](const Operand& x, const Side& s, const Qef& qs) {
       if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
       return cell_vertex(qs, cell, s.signs).position;
@@ -537,6 +543,7 @@ class Combiner {
         if (vis_b && !vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
       } else if (meets && simple) {
         // Q_sum = Q_A + Q_B minimized from the average of the two vertices (paper eq. 3).
+        qefs();
         const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
         const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
         const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
@@ -549,6 +556,7 @@ class Combiner {
     }
     if (at_cap) {
       if (r_uniform) return uniform(sr != 0);
+      qefs();
       const Vec3 seed = cell_vertex(q, cell, sr).position;
       return gray(cell, sr, seed, kFlagCapped);
     }
