@@ -92,6 +92,65 @@ void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
 
 }  // namespace
 
+size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
+                      const std::function<void(uint32_t)>* touched) {
+  size_t flipped = 0;
+  std::vector<std::pair<uint32_t, Cell>> leaves;
+  std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray) {
+      leaves.push_back({node, cell});
+    }
+  };
+  walk(0, Cell{});
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  for (const auto& [node, cell] : leaves) {
+    for (int k = 0; k < 8; ++k) {
+      const Lat p = cell.corner(k);
+      const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
+      // Is p on an edge or face of a bigger gray leaf whose corners there all disagree with p?
+      for (int o = 0; o < 8; ++o) {
+        Lat q;
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) {
+          q[a] = p[a] - (((o >> a) & 1) ? 0 : 1);
+          inside = inside && q[a] >= 0 && q[a] < kLimit;
+        }
+        if (!inside) continue;
+        const LeafRef big = leaf_at(t, q);
+        if (big.cell.corner_index(p) >= 0 || t.nodes[big.node].kind != CellKind::Gray) continue;
+        // The corners of `big` on the smallest face or edge through p.
+        const int64_t sz = big.cell.span();
+        const uint8_t bs = t.nodes[big.node].signs;
+        bool all_differ = true;
+        int seen = 0;
+        for (int c = 0; c < 8; ++c) {
+          bool on = true;
+          for (int a = 0; a < 3; ++a) {
+            const bool at_lo = p[a] == big.cell.lat[a], at_hi = p[a] == big.cell.lat[a] + sz;
+            if (at_lo && ((c >> a) & 1)) on = false;
+            if (at_hi && !((c >> a) & 1)) on = false;
+          }
+          if (!on) continue;
+          ++seen;
+          all_differ = all_differ && (((bs >> c) & 1) != 0) != sp;
+        }
+        if (seen == 0 || seen == 8 || !all_differ) continue;
+        std::vector<uint32_t> path;
+        for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
+        if (touched)
+          for (uint32_t n : path) (*touched)(n);
+        ++flipped;
+        break;
+      }
+    }
+  }
+  return flipped;
+}
+
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
                                   const std::function<void(uint32_t)>* touched) {
   TopologyFix fix;

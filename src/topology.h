@@ -22,6 +22,13 @@ struct TopologyFix {
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
                                   const std::function<void(uint32_t)>* touched = nullptr);
 
+/// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
+/// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
+/// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
+/// to match, in every leaf that has it as a corner. Returns how many points changed.
+size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
+                      const std::function<void(uint32_t)>* touched = nullptr);
+
 /// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
 /// edges' midpoint), so the contour stays closed. Returns how many leaves changed.
 size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active);
