@@ -101,7 +101,10 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray) {
+    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 3) {
+      // Islands are features near the finest cell size: their points are corners of leaves
+      // within a few levels of the depth cap. (Checking every leaf would cost a root descent
+      // per corner and octant.)
       leaves.push_back({node, cell});
     }
   };
