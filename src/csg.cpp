@@ -699,17 +699,31 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   using namespace detail;
   const auto t0 = Clock::now();
   CsgStats stats;
-  // One frame: re-express B in A's cube when they differ (resample its contour).
+  // One frame: re-express B in A's cube when they differ (resample its contour). When B's
+  // surface does not fit in A's cube, both are resampled into the cube around both cubes
+  // (A then changes cube: its root grows).
   std::optional<Octree> resampled;
   if (!(a.cube == b_in.cube)) {
     SampleOptions so;
     so.cube = a.cube;
     so.depth = std::max(a.max_depth, b_in.max_depth);
     so.error = options.error;
+    const TriMesh mb = contour(b_in);
     try {
-      resampled = sample(contour(b_in), so);
-    } catch (const InvalidInput& e) {
-      throw InvalidInput(std::string("operand B cannot be expressed in A's cube: ") + e.what());
+      resampled = sample(mb, so);
+    } catch (const InvalidInput&) {
+      Cube both;
+      double hi = -1e300;
+      for (int k = 0; k < 3; ++k) {
+        both.origin[k] = std::min(a.cube.origin[k], b_in.cube.origin[k]);
+        hi = std::max({hi, a.cube.origin[k] + a.cube.size - both.origin[k],
+                       b_in.cube.origin[k] + b_in.cube.size - both.origin[k]});
+      }
+      both.size = hi;
+      so.cube = both;
+      if (!contour(a).triangles.empty()) a = sample(contour(a), so);
+      else a = Octree{both, so.depth, {Node{}}, {}, {}};
+      resampled = sample(mb, so);
     }
     stats.resampled_b = true;
   } else if (&a == &b_in) {

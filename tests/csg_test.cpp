@@ -298,6 +298,32 @@ TEST_F(AlgebraTest, InPlaceEditsSaveAndLoad) {
   EXPECT_LT(two_sided_distance(m, contour(r)), 1e-6);
 }
 
+TEST(Csg, OperandsInDifferentCubesShareOneFrame) {
+  SampleOptions o;
+  o.depth = 8;
+  const Octree a = sample(make_box({0.2, 0.2, 0.2}, {0.8, 0.8, 0.8}), o);              // cube from its bbox
+  const Octree b = sample(make_sphere({0.8, 0.8, 0.8}, 0.25, 96), o);                   // another cube
+  ASSERT_FALSE(a.cube == b.cube);
+  CsgStats st;
+  const Octree r = csg(a, b, CsgOp::Subtract, {}, &st);
+  EXPECT_TRUE(st.resampled_b);
+  // B sticks out of A's cube: both are resampled into a cube around both.
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(r.cube.origin[k], std::min(a.cube.origin[k], b.cube.origin[k]));
+    EXPECT_GE(r.cube.origin[k] + r.cube.size, b.cube.origin[k] + b.cube.size);
+  }
+  const TriMesh m = contour(r);
+  EXPECT_TRUE(IsClosedManifold(m));
+  // The box minus an eighth of the ball: 0.216 - (1/8)(4/3)pi 0.25^3.
+  // A sphere that fits in A's cube is resampled into it, and A keeps its frame.
+  const Octree inner = sample(make_sphere({0.5, 0.5, 0.5}, 0.2, 96), o);
+  const Octree r2 = csg(a, inner, CsgOp::Subtract, {}, &st);
+  EXPECT_TRUE(st.resampled_b);
+  EXPECT_TRUE(r2.cube == a.cube);
+  EXPECT_TRUE(IsClosedManifold(contour(r2)));
+  EXPECT_NEAR(volume(m), 0.216 - M_PI * 0.015625 / 6, 2e-3 * 0.216);
+}
+
 // ---- curved cases against analytic signed distances ------------------------------------------
 
 double sd_cylinder(const Vec3& p, const Vec3& c, double r, double h, int axis) {
