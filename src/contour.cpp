@@ -1,5 +1,7 @@
 #include "contour.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
@@ -34,9 +36,14 @@ class DualWalker {
 
   void cell_proc(const Ref& r) {
     if (leaf(r) || !on(r)) return;
+    for (int c = 0; c < 8; ++c) cell_proc(sub(r, c));
+    root_faces_and_edges(r);
+  }
+
+  /// The faces and edges inside an internal cell, between its children.
+  void root_faces_and_edges(const Ref& r) {
     std::array<Ref, 8> ch;
     for (int c = 0; c < 8; ++c) ch[c] = sub(r, c);
-    for (int c = 0; c < 8; ++c) cell_proc(ch[c]);
     for (int d = 0; d < 3; ++d) {
       for (int c = 0; c < 8; ++c)
         if (!((c >> d) & 1)) face_proc(ch[c], ch[c | (1 << d)], d);
@@ -189,26 +196,56 @@ namespace pic {
 
 TriMesh contour(const Octree& tree) {
   using namespace detail;
-  TriMesh out;
-  std::vector<uint32_t> remap(tree.vertices.size(), UINT32_MAX);
-  std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
-    std::array<uint32_t, 4> id{};
-    for (int k = 0; k < poly.count; ++k) {
-      const uint32_t v = tree.nodes[poly.leaf[k]].index;
-      if (remap[v] == UINT32_MAX) {
-        remap[v] = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(unit_to_world(tree.cube, poly.pos[k]));
-      }
-      id[k] = remap[v];
-    }
+  // Triangles as triples of the tree's vertex indices, made by 9 tasks — the 8 root children
+  // and the faces and edges between them — each into its own list; concatenated in that fixed
+  // order they are exactly what a serial walk makes.
+  using Tri = std::array<uint32_t, 3>;
+  struct Part {
+    std::vector<Tri> tris;
+    std::vector<uint32_t> order;  // polygon vertices in walk order: output numbering
+  };
+  auto triangulate = [&](const DualPolygon& poly, Part& part) {
+    std::array<uint32_t, 4> v{};
+    for (int k = 0; k < poly.count; ++k) part.order.push_back(v[k] = tree.nodes[poly.leaf[k]].index);
+    std::vector<Tri>& out = part.tris;
     if (poly.count == 3) {
-      out.triangles.push_back({id[0], id[1], id[2]});
+      out.push_back({v[0], v[1], v[2]});
       return;
     }
-    const auto split = split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]});
-    for (const auto& tri : split) out.triangles.push_back({id[tri[0]], id[tri[1]], id[tri[2]]});
+    for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]}))
+      out.push_back({v[tri[0]], v[tri[1]], v[tri[2]]});
   };
-  dual_walk(tree, nullptr, emit);
+  std::array<Part, 9> parts;
+  const bool split = tree.nodes[0].kind == CellKind::Internal;
+  tbb::parallel_for(0, split ? 9 : 1, [&](int task) {
+    std::function<void(const DualPolygon&)> keep = [&](const DualPolygon& p) { triangulate(p, parts[task]); };
+    DualWalker w(tree, nullptr, keep, nullptr);
+    if (!split) w.cell_proc({0, Cell{}});
+    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), Cell{}.child(task)});
+    else w.root_faces_and_edges({0, Cell{}});
+  });
+  // Positions of the vertices in use, numbered in order of first use.
+  std::vector<Vec3> unit(tree.vertices.size());
+  visit_leaves(tree, 0, Cell{}, [&](uint32_t node, const Cell& cell) {
+    const Node& n = tree.nodes[node];
+    if (n.kind == CellKind::Gray) unit[n.index] = vertex_unit(cell, tree.vertices[n.index]);
+  });
+  // Numbered by first appearance in the polygons, so the numbering does not depend on how
+  // quads were split.
+  TriMesh out;
+  std::vector<uint32_t> remap(tree.vertices.size(), UINT32_MAX);
+  size_t total = 0;
+  for (const auto& part : parts) {
+    total += part.tris.size();
+    for (uint32_t v : part.order)
+      if (remap[v] == UINT32_MAX) {
+        remap[v] = static_cast<uint32_t>(out.positions.size());
+        out.positions.push_back(unit_to_world(tree.cube, unit[v]));
+      }
+  }
+  out.triangles.reserve(total);
+  for (const auto& part : parts)
+    for (const Tri& t : part.tris) out.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
   return out;
 }
 
