@@ -765,7 +765,11 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   a.max_depth = depth;
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
-  remove_islands(a, &stamped, &stamp_it);
+  // Islands come with new geometry: look at the leaves this operation created.
+  std::function<bool(uint32_t)> fresh = [&](uint32_t n) {
+    return a.stamps[n] == stamp && (n >= before || a.nodes[n].kind == CellKind::Internal);
+  };
+  remove_islands(a, &fresh, &stamp_it);
   enforce_one_component(a, &stamped, &stamp_it);
   stats.repaired = repair_cracks(a, &stamped);
   stats.csg_seconds = since(tc);
