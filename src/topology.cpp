@@ -36,6 +36,17 @@ LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nul
   return {node, cell};
 }
 
+/// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
+/// false when it falls outside the root.
+bool octant_cell(const Lat& p, int o, Lat& q) {
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
+    if (q[k] < 0 || q[k] >= kLimit) return false;
+  }
+  return true;
+}
+
 /// Leaves having lattice point p as a corner, with the corner index in each; `path` gets
 /// every node on the way down to them.
 struct Around {
@@ -45,15 +56,9 @@ struct Around {
 };
 std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr) {
   std::vector<Around> out;
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   for (int o = 0; o < 8; ++o) {
     Lat q;
-    bool inside = true;
-    for (int k = 0; k < 3; ++k) {
-      q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
-      inside = inside && q[k] >= 0 && q[k] < kLimit;
-    }
-    if (!inside) continue;
+    if (!octant_cell(p, o, q)) continue;
     const LeafRef l = leaf_at(t, q, path);
     const int c = l.cell.corner_index(p);
     if (c < 0) continue;
@@ -109,7 +114,6 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     }
   };
   walk(0, Cell{});
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   for (const auto& [node, cell] : leaves) {
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
@@ -117,12 +121,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
       // Is p on an edge or face of a bigger gray leaf whose corners there all disagree with p?
       for (int o = 0; o < 8; ++o) {
         Lat q;
-        bool inside = true;
-        for (int a = 0; a < 3; ++a) {
-          q[a] = p[a] - (((o >> a) & 1) ? 0 : 1);
-          inside = inside && q[a] >= 0 && q[a] < kLimit;
-        }
-        if (!inside) continue;
+        if (!octant_cell(p, o, q)) continue;
         const LeafRef big = leaf_at(t, q);
         if (big.cell.corner_index(p) >= 0 || t.nodes[big.node].kind != CellKind::Gray) continue;
         // The corners of `big` on the smallest face or edge through p.

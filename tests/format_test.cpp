@@ -14,6 +14,7 @@
 #include "pic/pic.h"
 #include "pic/primitives.h"
 #include "support/mesh_checks.h"
+#include "support/temp_dir.h"
 #include "support/shapes.h"
 
 namespace pic {
@@ -25,31 +26,8 @@ using test::IsClosedManifold;
 constexpr size_t kHeaderBytes = 68;  // magic 4, version 2, flags 2, depth 4, cube 32, counts 24
 
 // A fresh directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "pic_format_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" + std::to_string(::getpid());
-    std::replace(name.begin(), name.end(), '/', '_');  // parameterized names contain '/'
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("pic_format") {}
 };
 
 std::vector<uint8_t> read_bytes(const fs::path& p) {

@@ -13,6 +13,7 @@
 #include "pic/pic.h"
 #include "pic/primitives.h"
 #include "support/mesh_checks.h"
+#include "support/temp_dir.h"
 #include "support/shapes.h"
 
 namespace pic {
@@ -21,25 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 using test::IsClosedManifold;
 
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "pic_meshio_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" + std::to_string(::getpid());
-    std::replace(name.begin(), name.end(), '/', '_');  // parameterized names contain '/'
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  size_t count() const { return static_cast<size_t>(std::distance(fs::directory_iterator(path_), fs::directory_iterator())); }
-
- private:
-  fs::path path_;
+// A fresh directory per test, removed afterwards.
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("pic_meshio") {}
 };
 
 void write_file(const fs::path& p, const std::string& text) {
@@ -71,7 +56,7 @@ TEST_P(MeshIoRoundTrip, WriteThenReadGivesTheSameMesh) {
   const fs::path p = dir / ("m" + GetParam());
   write_mesh(m, p);
   ASSERT_TRUE(fs::exists(p));
-  EXPECT_EQ(dir.count(), 1u) << "no temporary or side files";
+  EXPECT_EQ(dir.entries().size(), 1u) << "no temporary or side files";
   const TriMesh back = read_mesh(p);
   // Readers go through single precision: ~1e-7 relative to the coordinates (~3).
   expect_same_mesh(m, back, 2e-6);
@@ -196,7 +181,7 @@ TEST(MeshIo, UnknownExtensionIsAnIoError) {
   EXPECT_THROW(write_mesh(test_mesh(), dir / "out.xyz"), IoError);
   EXPECT_THROW(write_mesh(test_mesh(), dir / "noext"), IoError);
   EXPECT_FALSE(fs::exists(dir / "out.xyz"));
-  EXPECT_EQ(dir.count(), 2u);
+  EXPECT_EQ(dir.entries().size(), 2u);
 }
 
 TEST(MeshIo, EmptyFileIsRejected) {
@@ -248,7 +233,7 @@ TEST(MeshIo, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
     SCOPED_TRACE(ext);
     EXPECT_THROW(write_mesh(test_mesh(), dir / (std::string("missing/m") + ext)), IoError);
   }
-  EXPECT_EQ(dir.count(), 0u);
+  EXPECT_EQ(dir.entries().size(), 0u);
 }
 
 TEST(MeshIo, WriteReplacesAnExistingFile) {
@@ -258,7 +243,7 @@ TEST(MeshIo, WriteReplacesAnExistingFile) {
   const TriMesh back = read_mesh(dir / "m.obj");
   EXPECT_EQ(back.positions.size(), 8u);
   EXPECT_NEAR(volume(back), 2.0, 1e-9);
-  EXPECT_EQ(dir.count(), 1u);
+  EXPECT_EQ(dir.entries().size(), 1u);
 }
 
 // ---------------------------------------------------------------------------------------
