@@ -1,15 +1,16 @@
 // CSG on two PIC octrees (paper section 5), computed in place on A.
 //
-// Stages, each a function below:
-//   tag            stamp the overlap cells of both operands with this operation's timestamp
-//   partial_contour  dual-contour only around stamped cells; keep each PIC's triangle fan
-//   combine        the paired recursion: trivial cases, GraycellCSG, forced subdivision
-//   repair         make sure no uniform leaf borders a sign change (keeps the surface closed)
+// Stages, each a function or class below:
+//   tag / stamp_under_surface   stamp the overlap cells with this operation's timestamp
+//   partial_contour             dual-contour only around stamped cells, triangles in a BVH
+//   Combiner                    the paired recursion: trivial cases, GraycellCSG, forced
+//                               subdivision (resampling a leaf's partial contour)
+//   topology.h                  islands, one component per leaf, crack repair
 //
 // Topology comes from signs alone: each operand's sign is a single-valued function of the
 // lattice point (stored corner signs first; inside a gray leaf, crossing parity along a fixed
-// path from the leaf's corner 0 through its triangle fan), and the result's sign is
-// op(sign_A, sign_B). Vertex positions only decide accuracy.
+// path from the leaf's most reliable corner through its partial contour), and the result's
+// sign is op(sign_A, sign_B). Vertex positions only decide accuracy.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -205,7 +206,7 @@ struct Side {
   uint32_t node = 0;    // Internal: the node; Gray: the leaf
   bool real = false;    // Gray: the cell is the leaf's own cell
   uint8_t signs = 0;    // Gray: signs at this cell's corners
-  std::vector<uint32_t> idx;  // Gray: fan triangles overlapping this cell
+  std::vector<uint32_t> idx;  // Gray: partial-contour triangles overlapping this cell
   Cell leaf_cell;             // Gray: the cell of the leaf `node`
 };
 
@@ -219,7 +220,7 @@ class Combiner {
   void run() {
     Side sa = side_of(a_, 0, Cell{});
     Side sb = side_of(b_, 0, Cell{});
-    set(0, combine(Cell{}, sa, sb, 0));
+    set(0, combine(Cell{}, sa, sb));
     for (const auto& [slot, node] : pending_) out_.nodes[slot] = node;
   }
 
@@ -361,10 +362,8 @@ class Combiner {
     return uniform(false);
   }
 
-  Node combine(const Cell& cell, const Side& a, const Side& b, uint32_t slot_hint) {
-    (void)slot_hint;
+  Node combine(const Cell& cell, const Side& a, const Side& b) {
     ++stats_.cells_visited;
-    const bool sub = op_ == CsgOp::Subtract;
     if (a.kind == Side::Uniform) {
       if (b.kind == Side::Uniform) return uniform(apply(op_, a.inside, b.inside));
       // white | X = X, black & X = X, black - X = not X; the rest are uniform.
@@ -377,7 +376,6 @@ class Combiner {
       if (op_ == CsgOp::Intersect) return b.inside ? copy_side(a_, a, cell, false, true) : uniform(false);
       return b.inside ? uniform(false) : copy_side(a_, a, cell, false, true);
     }
-    (void)sub;
     if (a.kind == Side::Internal || b.kind == Side::Internal) return subdivide(cell, a, b);
     return gray_cell(cell, a, b);
   }
@@ -397,7 +395,7 @@ class Combiner {
     for (int c = 0; c < 8; ++c) {
       const Side ca = child_side(a_, a, cell, c);
       const Side cb = child_side(b_, b, cell, c);
-      kids[c] = combine(cell.child(c), ca, cb, first + c);
+      kids[c] = combine(cell.child(c), ca, cb);
       set(first + c, kids[c]);
       all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
                     kids[c].kind == kids[0].kind;

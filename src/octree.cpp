@@ -28,13 +28,6 @@ void Builder::splice(uint32_t slot, const Builder& sub) {
       nodes.push_back(n);
     }
   }
-  if (track_stamps) {
-    stamps.resize(nodes.size(), 0);
-    if (!sub.stamps.empty()) {
-      stamps[slot] = sub.stamps[0];
-      std::copy(sub.stamps.begin() + 1, sub.stamps.end(), stamps.end() - (sub.nodes.size() - 1));
-    }
-  }
   vertices.insert(vertices.end(), sub.vertices.begin(), sub.vertices.end());
 }
 

@@ -46,12 +46,10 @@ struct Cell {
 struct Builder {
   std::vector<Node> nodes;
   std::vector<std::array<float, 3>> vertices;
-  std::vector<uint32_t> stamps;  // optional, parallel to nodes when used
 
   uint32_t alloc_children() {
     const auto first = static_cast<uint32_t>(nodes.size());
     nodes.resize(nodes.size() + 8);
-    if (!stamps.empty() || track_stamps) stamps.resize(nodes.size(), 0);
     return first;
   }
   void set_gray(uint32_t slot, const Cell& cell, uint8_t signs, const Vec3& x_unit, uint8_t flags);
@@ -60,7 +58,6 @@ struct Builder {
   }
   /// Appends `sub` (root at sub.nodes[0]) with its root written into `slot`.
   void splice(uint32_t slot, const Builder& sub);
-  bool track_stamps = false;
 };
 
 /// World position of a cell-local vertex.
