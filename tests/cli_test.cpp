@@ -229,7 +229,16 @@ TEST_F(Cli, PrimThenCsgThenMesh) {
   const CliRun r = pic("csg a.pic subtract b.pic -o c.pic --mesh c.obj --json");
   ASSERT_EQ(r.code, 0) << r.err;
   expect_json_object(r.out);
-  EXPECT_TRUE(json_has(r.out, "pics")) << r.out;
+  // The JSON contract other tools read: pics, seconds, and per operation its time and cells.
+  for (const char* key : {"pics", "seconds", "ops", "op", "cells_visited", "cells_stamped"})
+    EXPECT_TRUE(json_has(r.out, key)) << key << " missing in " << r.out;
+  // Chained operations, left to right, and the result reloads.
+  ASSERT_EQ(pic("prim cylinder --radius 0.2 --height 1.8 --axis x --depth 7 --cube -1,-1,-1,2 -o d.pic").code, 0);
+  const CliRun chain = pic("csg a.pic subtract b.pic union d.pic -o e.pic --json");
+  ASSERT_EQ(chain.code, 0) << chain.err;
+  EXPECT_NE(chain.out.find("\"subtract\""), std::string::npos) << chain.out;
+  EXPECT_NE(chain.out.find("\"union\""), std::string::npos) << chain.out;
+  EXPECT_EQ(pic("info e.pic --json").code, 0);
   const TriMesh c = read_mesh(path("c.obj"));
   EXPECT_TRUE(test::IsClosedManifold(c));
   const double sphere_in_box = 4.0 / 3 * 3.14159265358979 * 0.216;  // the sphere pokes out a bit
