@@ -763,12 +763,12 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   a.max_depth = depth;
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
-  // Islands come with new geometry: look at the leaves this operation created.
-  std::function<bool(uint32_t)> fresh = [&](uint32_t n) {
-    return a.stamps[n] == stamp && (n >= before || a.nodes[n].kind == CellKind::Internal);
-  };
-  remove_islands(a, &fresh, &stamp_it);
-  enforce_one_component(a, &stamped, &stamp_it);
+  // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
+  // component can leave a new island, so the two alternate until both are quiet.
+  for (int round = 0; round < 4; ++round) {
+    const size_t islands = remove_islands(a, &stamped, &stamp_it);
+    if (enforce_one_component(a, &stamped, &stamp_it).flipped == 0 && (islands == 0 || round > 0)) break;
+  }
   stats.repaired = repair_cracks(a, &stamped);
   stats.csg_seconds = since(tc);
   // Amortized garbage collection of replaced subtrees.

@@ -97,58 +97,117 @@ void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
 
 }  // namespace
 
+namespace {
+
+/// Whether lattice point p, of sign sp, on the boundary of gray leaf `big` (not one of its
+/// corners) disagrees with all of big's corners on the smallest face or edge through it.
+bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
+  const int64_t sz = cell.span();
+  bool all_differ = true;
+  int seen = 0;
+  for (int c = 0; c < 8; ++c) {
+    bool on = true;
+    for (int a = 0; a < 3; ++a) {
+      const bool at_lo = p[a] == cell.lat[a], at_hi = p[a] == cell.lat[a] + sz;
+      if (at_lo && ((c >> a) & 1)) on = false;
+      if (at_hi && !((c >> a) & 1)) on = false;
+    }
+    if (!on) continue;
+    ++seen;
+    all_differ = all_differ && (((big.signs >> c) & 1) != 0) != sp;
+  }
+  return seen > 0 && seen < 8 && all_differ;
+}
+
+/// The node covering `target` (a cell) or the leaf above it.
+LeafRef node_at(const Octree& t, const Cell& target) {
+  uint32_t node = 0;
+  Cell cell;
+  while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
+    const int64_t h = cell.span() / 2;
+    int c = 0;
+    for (int k = 0; k < 3; ++k)
+      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
+    node = t.nodes[node].index + c;
+    cell = cell.child(c);
+  }
+  return {node, cell};
+}
+
+}  // namespace
+
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
                       const std::function<void(uint32_t)>* touched) {
-  size_t flipped = 0;
   std::vector<std::pair<uint32_t, Cell>> leaves;
   std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
     if (active && !(*active)(node)) return;
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 3) {
-      // Islands are features near the finest cell size: their points are corners of leaves
-      // within a few levels of the depth cap. (Checking every leaf would cost a root descent
-      // per corner and octant.)
+    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 4) {
+      // Islands are features near the finest cell size, next to leaves a few levels up.
       leaves.push_back({node, cell});
     }
   };
   walk(0, Cell{});
+  size_t flipped = 0;
+  auto flip = [&](const Lat& p) {
+    std::vector<uint32_t> path;
+    for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
+    if (touched)
+      for (uint32_t x : path) (*touched)(x);
+    ++flipped;
+  };
+  // A fine active leaf's corners against the coarser leaves around them (an old coarse
+  // leaf next to new fine ones)...
   for (const auto& [node, cell] : leaves) {
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
       const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
-      // Is p on an edge or face of a bigger gray leaf whose corners there all disagree with p?
       for (int o = 0; o < 8; ++o) {
         Lat q;
         if (!octant_cell(p, o, q)) continue;
         const LeafRef big = leaf_at(t, q);
         if (big.cell.corner_index(p) >= 0 || t.nodes[big.node].kind != CellKind::Gray) continue;
-        // The corners of `big` on the smallest face or edge through p.
-        const int64_t sz = big.cell.span();
-        const uint8_t bs = t.nodes[big.node].signs;
-        bool all_differ = true;
-        int seen = 0;
-        for (int c = 0; c < 8; ++c) {
-          bool on = true;
-          for (int a = 0; a < 3; ++a) {
-            const bool at_lo = p[a] == big.cell.lat[a], at_hi = p[a] == big.cell.lat[a] + sz;
-            if (at_lo && ((c >> a) & 1)) on = false;
-            if (at_hi && !((c >> a) & 1)) on = false;
-          }
-          if (!on) continue;
-          ++seen;
-          all_differ = all_differ && (((bs >> c) & 1) != 0) != sp;
-        }
-        if (seen == 0 || seen == 8 || !all_differ) continue;
-        std::vector<uint32_t> path;
-        for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
-        if (touched)
-          for (uint32_t n : path) (*touched)(n);
-        ++flipped;
+        if (!is_island(t.nodes[big.node], big.cell, p, sp)) continue;
+        flip(p);
         break;
       }
     }
+  }
+  // ... and an active coarse leaf against the finer leaves across its faces (a new coarse
+  // leaf next to old fine ones).
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  for (const auto& [big, cell] : leaves) {
+    if (cell.level >= t.max_depth) continue;
+    const int64_t sz = cell.span();
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        Cell across = cell;
+        across.lat[d] += side ? sz : -sz;
+        if (across.lat[d] < 0 || across.lat[d] >= kLimit) continue;
+        const LeafRef n = node_at(t, across);
+        if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
+        const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
+        // Leaves of the finer side touching the shared face, and their corners on it.
+        std::function<void(uint32_t, const Cell&)> visit = [&](uint32_t node, const Cell& c) {
+          const Node& m = t.nodes[node];
+          if (m.kind == CellKind::Internal) {
+            for (int k = 0; k < 8; ++k) {
+              const Cell ch = c.child(k);
+              if (ch.lat[d] <= plane && ch.lat[d] + ch.span() >= plane) visit(m.index + k, ch);
+            }
+            return;
+          }
+          for (int k = 0; k < 8; ++k) {
+            const Lat p = c.corner(k);
+            if (p[d] != plane || cell.corner_index(p) >= 0) continue;
+            const bool sp = (signs_of(m) >> k) & 1;
+            if (is_island(t.nodes[big], cell, p, sp)) flip(p);
+          }
+        };
+        visit(n.node, n.cell);
+      }
   }
   return flipped;
 }
