@@ -161,6 +161,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   // A fine active leaf's corners against the coarser leaves around them (an old coarse
   // leaf next to new fine ones)...
   for (const auto& [node, cell] : leaves) {
+    if (cell.level < t.max_depth - 1) continue;  // the finest leaves carry the islands
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
       const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
