@@ -124,8 +124,11 @@ struct CsgStats {
   bool resampled_b = false;      ///< B was re-expressed in A's cube
 };
 
-/// Boolean of two PIC objects computed on the octrees (paper section 5). If the cubes or
-/// depths differ, B is first resampled from its contour into A's cube.
+/// Boolean of two PIC objects computed on the octrees (paper section 5). Operands should
+/// share a root cube; if they do not, B is resampled from its contour into A's cube, or,
+/// when B does not fit there, both are resampled into the cube around both cubes. Depths may
+/// differ (the result takes the larger). The result is closed; see docs/algorithms.md.
+/// \throws InvalidInput when an operand cannot be resampled.
 Octree csg(const Octree& a, const Octree& b, CsgOp op, const CsgOptions& options = {},
            CsgStats* stats = nullptr);
 
