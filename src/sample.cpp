@@ -60,16 +60,10 @@ bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
 }
 
 bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell) {
+  // An exact clip: the conservative list also holds triangles that pass beside the cell.
   const IBox box = cell.box();
-  for (uint32_t k : idx) {
-    const ITri& t = tris[k];
-    if (is_degenerate(t)) continue;
-    // `idx` already overlaps the closed box; the perturbation only rejects a triangle that
-    // stays at or below one of the low faces. (Clipping would also reject one that crosses a
-    // low face plane outside the box and touches the box only along that face: rare, and
-    // then the cell is just refined once more.)
-    if (t.hi[0] > box.lo[0] && t.hi[1] > box.lo[1] && t.hi[2] > box.lo[2]) return true;
-  }
+  for (uint32_t k : idx)
+    if (!is_degenerate(tris[k]) && clipped_area(tris[k], box) >= 0) return true;
   return false;
 }
 
@@ -156,16 +150,19 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     out.set_uniform(slot, (written & 1) != 0);
     return;
   }
-  Qef q;
-  const bool meets = cell_qef(src.tris(), idx, cell, q);
   const bool at_cap = cell.level >= p.max_depth;
   if (uniform) {
+    // No vertex here: only whether surface enters the cell matters, not its QEF.
+    const bool meets = meets_cell(src.tris(), idx, cell);
     if (!meets || at_cap) {
       if (meets) ++capped;  // a feature thinner than the deepest cell is dropped
       out.set_uniform(slot, (written & 1) != 0);
       return;
     }
-  } else {
+  } else if (at_cap || one_component(signs)) {
+    // (Two components by the signs always split, below the cap: no QEF needed to know.)
+    Qef q;
+    cell_qef(src.tris(), idx, cell, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
                     !has_double_crossing(src.tris(), idx, cell, signs);
