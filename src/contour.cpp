@@ -114,7 +114,6 @@ class DualWalker {
     for (int k = 0; k < 4; ++k) {
       if (t_.nodes[n[k].node].kind != CellKind::Gray) {
         if (stats_) {
-          ++stats_->cracks;
           stats_->crack_leaves.push_back(n[k].node);
           stats_->crack_cells.push_back(n[k].cell);
           const auto a = n[deepest].cell.corner(c0), b = n[deepest].cell.corner(c1);
@@ -203,10 +202,14 @@ TriMesh contour(const Octree& tree) {
   struct Part {
     std::vector<Tri> tris;
     std::vector<uint32_t> order;  // polygon vertices in walk order: output numbering
+    std::vector<Vec3> pos;        // and their positions (unit cube)
   };
   auto triangulate = [&](const DualPolygon& poly, Part& part) {
     std::array<uint32_t, 4> v{};
-    for (int k = 0; k < poly.count; ++k) part.order.push_back(v[k] = tree.nodes[poly.leaf[k]].index);
+    for (int k = 0; k < poly.count; ++k) {
+      part.order.push_back(v[k] = tree.nodes[poly.leaf[k]].index);
+      part.pos.push_back(poly.pos[k]);
+    }
     std::vector<Tri>& out = part.tris;
     if (poly.count == 3) {
       out.push_back({v[0], v[1], v[2]});
@@ -224,12 +227,6 @@ TriMesh contour(const Octree& tree) {
     else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), Cell{}.child(task)});
     else w.root_faces_and_edges({0, Cell{}});
   });
-  // Positions of the vertices in use, numbered in order of first use.
-  std::vector<Vec3> unit(tree.vertices.size());
-  visit_leaves(tree, 0, Cell{}, [&](uint32_t node, const Cell& cell) {
-    const Node& n = tree.nodes[node];
-    if (n.kind == CellKind::Gray) unit[n.index] = vertex_unit(cell, tree.vertices[n.index]);
-  });
   // Numbered by first appearance in the polygons, so the numbering does not depend on how
   // quads were split.
   TriMesh out;
@@ -237,10 +234,10 @@ TriMesh contour(const Octree& tree) {
   size_t total = 0;
   for (const auto& part : parts) {
     total += part.tris.size();
-    for (uint32_t v : part.order)
-      if (remap[v] == UINT32_MAX) {
-        remap[v] = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(unit_to_world(tree.cube, unit[v]));
+    for (size_t i = 0; i < part.order.size(); ++i)
+      if (remap[part.order[i]] == UINT32_MAX) {
+        remap[part.order[i]] = static_cast<uint32_t>(out.positions.size());
+        out.positions.push_back(unit_to_world(tree.cube, part.pos[i]));
       }
   }
   out.triangles.reserve(total);

@@ -20,8 +20,9 @@ struct DualPolygon {
 };
 
 struct DualStats {
-  size_t cracks = 0;  // sign-changing minimal edges next to a non-gray leaf
-  std::vector<uint32_t> crack_leaves;  // those non-gray leaves (for repair)
+  // Sign-changing minimal edges next to a non-gray leaf: the leaf, its cell, and the edge's
+  // midpoint (lattice coordinates doubled).
+  std::vector<uint32_t> crack_leaves;
   std::vector<Cell> crack_cells;       // and their cells
   std::vector<std::array<int64_t, 3>> crack_points;  // midpoint lattice (x2) of each crack edge
 };

@@ -153,13 +153,14 @@ struct Operand {
     const int64_t s = cell.span();
     for (int k = 0; k < 3; ++k)
       if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return sign(p);
+    if (const auto it = memo.find(lat_key(p)); it != memo.end()) return it->second;
     return classify(p, leaf, cell);
   }
 
+  /// Parity walk for p in gray leaf `leaf` (callers have checked the memo).
   bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
     const Hit h{2, false, leaf, cell};
     const uint64_t key = lat_key(p);
-    if (const auto it = memo.find(key); it != memo.end()) return it->second;
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
     const auto& idx = triangles_in(h.leaf, h.cell);
@@ -237,12 +238,7 @@ class Combiner {
     return first;
   }
   Node gray(const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
-    const Vec3 m = cell.min_unit();
-    const double inv = double(int64_t{1} << cell.level);
-    std::array<float, 3> local;
-    for (int k = 0; k < 3; ++k) local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
-    out_.vertices.push_back(local);
-    return Node{static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray, signs, flags, 0};
+    return add_gray(out_.vertices, cell, signs, x, flags);
   }
   static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
 
@@ -314,9 +310,6 @@ class Combiner {
     return s;
   }
 
-  /// The cell of the gray leaf behind a Gray side (its own cell when real).
-  static Cell leaf_cell(const Operand&, const Side& s) { return s.leaf_cell; }
-
   Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
     const Cell cc = cell.child(c);
     if (s.kind == Side::Uniform) return s;
@@ -332,7 +325,7 @@ class Combiner {
       if (gx != 1 && gy != 1 && gz != 1) {
         sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
       } else {
-        sign = x.sign_in(cc.corner(k), s.node, leaf_cell(x, s));
+        sign = x.sign_in(cc.corner(k), s.node, s.leaf_cell);
       }
       v.signs |= uint8_t(sign) << k;
     }
@@ -719,7 +712,8 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
       }
       both.size = hi;
       so.cube = both;
-      if (!contour(a).triangles.empty()) a = sample(contour(a), so);
+      const TriMesh ma = contour(a);
+      if (!ma.triangles.empty()) a = sample(ma, so);
       else a = Octree{both, so.depth, {Node{}}, {}, {}};
       resampled = sample(mb, so);
     }

@@ -5,13 +5,7 @@
 namespace pic::detail {
 
 void Builder::set_gray(uint32_t slot, const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
-  const Vec3 m = cell.min_unit();
-  const double inv = double(int64_t{1} << cell.level);
-  std::array<float, 3> local;
-  for (int k = 0; k < 3; ++k)
-    local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
-  nodes[slot] = Node{static_cast<uint32_t>(vertices.size()), CellKind::Gray, signs, flags, 0};
-  vertices.push_back(local);
+  nodes[slot] = add_gray(vertices, cell, signs, x, flags);
 }
 
 void Builder::splice(uint32_t slot, const Builder& sub) {

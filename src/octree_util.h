@@ -1,6 +1,7 @@
 // Internal octree helpers: cell addressing on the global lattice and a tree builder.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -65,6 +66,23 @@ inline Vec3 vertex_unit(const Cell& cell, const std::array<float, 3>& local) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
   return {m[0] + local[0] * s, m[1] + local[1] * s, m[2] + local[2] * s};
+}
+
+/// Cell-local float coordinates of a unit-space position, clamped into the cell (the .pic
+/// quantization relies on the [0, 1] range).
+inline std::array<float, 3> to_local(const Cell& cell, const Vec3& x) {
+  const Vec3 m = cell.min_unit();
+  const double inv = double(int64_t{1} << cell.level);
+  std::array<float, 3> local;
+  for (int k = 0; k < 3; ++k) local[k] = static_cast<float>(std::min(1.0, std::max(0.0, (x[k] - m[k]) * inv)));
+  return local;
+}
+
+/// Appends a gray leaf's vertex to `vertices` and returns the leaf's node.
+inline Node add_gray(std::vector<std::array<float, 3>>& vertices, const Cell& cell, uint8_t signs, const Vec3& x,
+                     uint8_t flags = 0) {
+  vertices.push_back(to_local(cell, x));
+  return Node{static_cast<uint32_t>(vertices.size() - 1), CellKind::Gray, signs, flags, 0};
 }
 
 /// Unit-cube to input coordinates and back.

@@ -143,7 +143,7 @@ constexpr uint8_t kAll = 0xff;
 }  // namespace
 
 void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
-                 std::vector<uint32_t> idx, Builder& out, uint32_t slot, size_t& capped) {
+                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped) {
   const uint8_t written = p.invert ? uint8_t(~signs) : signs;
   const bool uniform = signs == 0 || signs == kAll;
   if (idx.empty() && uniform) {

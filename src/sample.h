@@ -68,7 +68,7 @@ bool inside_cell(const Vec3& x, const Cell& cell);
 
 /// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`.
 void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
-                 std::vector<uint32_t> idx, Builder& out, uint32_t slot, size_t& capped);
+                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped);
 
 /// Corner signs of the 8 children of a cell from its child grid.
 inline uint8_t child_signs(const std::array<bool, 27>& g, int c) {

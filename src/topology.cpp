@@ -86,18 +86,21 @@ void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
     return;
   }
   const uint8_t s = uint8_t(signs_of(n) ^ (1 << c));
-  const Vec3 x = cell_vertex(Qef{}, cell, s).position;
-  const Vec3 m = cell.min_unit();
-  const double inv = double(int64_t{1} << cell.level);
-  std::array<float, 3> local;
-  for (int k = 0; k < 3; ++k) local[k] = static_cast<float>(std::clamp((x[k] - m[k]) * inv, 0.0, 1.0));
-  t.vertices.push_back(local);
-  n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, s, 0, 0};
+  n = add_gray(t.vertices, cell, s, cell_vertex(Qef{}, cell, s).position);
 }
 
 }  // namespace
 
 namespace {
+
+/// Flips lattice point p's sign in every leaf that has it as a corner (consistently), and
+/// reports the nodes on the way to them.
+void flip_point(Octree& t, const Lat& p, const std::function<void(uint32_t)>* touched) {
+  std::vector<uint32_t> path;
+  for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
+  if (touched)
+    for (uint32_t x : path) (*touched)(x);
+}
 
 /// Whether lattice point p, of sign sp, on the boundary of gray leaf `big` (not one of its
 /// corners) disagrees with all of big's corners on the smallest face or edge through it.
@@ -152,10 +155,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   walk(0, Cell{});
   size_t flipped = 0;
   auto flip = [&](const Lat& p) {
-    std::vector<uint32_t> path;
-    for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
-    if (touched)
-      for (uint32_t x : path) (*touched)(x);
+    flip_point(t, p, touched);
     ++flipped;
   };
   // A fine active leaf's corners against the coarser leaves around them (an old coarse
@@ -237,7 +237,6 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
       // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
       // preferring to flip the minority sign (removing the thinner feature).
       int best = -1, best_cost = 1 << 30;
-      std::vector<Around> best_around;
       const bool minority_inside = __builtin_popcount(s) <= 4;
       for (int k = 0; k < 8; ++k) {
         if (multi(uint8_t(s ^ (1 << k)))) continue;
@@ -248,16 +247,10 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         if (cost < best_cost) {
           best_cost = cost;
           best = k;
-          best_around = around;
         }
       }
       if (best < 0) continue;
-      for (const auto& a : best_around) flip_corner(t, a.node, a.corner, a.cell);
-      if (touched) {
-        std::vector<uint32_t> path;
-        leaves_around(t, l.cell.corner(best), &path);
-        for (uint32_t n : path) (*touched)(n);
-      }
+      flip_point(t, l.cell.corner(best), touched);
       ++fix.flipped;
     }
   }
@@ -272,7 +265,7 @@ size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active) {
     DualStats ds;
     std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
     dual_walk(t, active, emit, &ds);
-    if (ds.cracks == 0) break;
+    if (ds.crack_leaves.empty()) break;
     std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
     std::unordered_map<uint32_t, Cell> cells;
     for (size_t k = 0; k < ds.crack_leaves.size(); ++k) {
@@ -288,13 +281,7 @@ size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active) {
       const auto& [sum, cnt] = ms;
       constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
       const Vec3 x{sum[0] * k / (2 * cnt), sum[1] * k / (2 * cnt), sum[2] * k / (2 * cnt)};
-      const uint8_t signs = n.kind == CellKind::Black ? 0xff : 0;
-      const Vec3 m = cell.min_unit();
-      const double inv = double(int64_t{1} << cell.level);
-      std::array<float, 3> local;
-      for (int a = 0; a < 3; ++a) local[a] = static_cast<float>(std::clamp((x[a] - m[a]) * inv, 0.0, 1.0));
-      t.vertices.push_back(local);
-      n = Node{static_cast<uint32_t>(t.vertices.size() - 1), CellKind::Gray, signs, 0, 0};
+      n = add_gray(t.vertices, cell, n.kind == CellKind::Black ? 0xff : 0, x);
       ++fixed;
     }
   }

@@ -155,21 +155,21 @@ int axis_of(const std::string& a) {
   throw pic::InvalidInput("--axis must be x, y or z");
 }
 
-// Loads a .pic, or samples a mesh file with default options (so `render`/`view` take both).
-pic::Octree load_any(const std::string& path, int depth, pic::TriMesh* mesh_out) {
+// Loads a .pic, or samples a mesh file with default options (so `render`/`view` take both);
+// `contour_out` gets the PIC object's surface either way.
+pic::Octree load_any(const std::string& path, int depth, pic::TriMesh* contour_out) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".pic") {
     auto t = pic::load(path);
-    if (mesh_out) *mesh_out = pic::contour(t);
+    if (contour_out) *contour_out = pic::contour(t);
     return t;
   }
-  pic::TriMesh m = pic::read_mesh(path);
   pic::SampleOptions o;
   o.depth = depth;
-  auto t = pic::sample(m, o);
-  if (mesh_out) *mesh_out = std::move(m);
+  auto t = pic::sample(pic::read_mesh(path), o);
+  if (contour_out) *contour_out = pic::contour(t);
   return t;
 }
 
@@ -386,14 +386,15 @@ int main(int argc, char** argv) {
       const double secs = since(t0);
       pic::save(acc, c_out);
       Json j;
-      j.add("pics", pic::analyze(acc).pics).add("seconds", secs).raw("ops", ops);
+      const size_t pics = pic::analyze(acc).pics;
+      j.add("pics", pics).add("seconds", secs).raw("ops", ops);
       if (!c_mesh.empty()) {
         const pic::TriMesh mesh = pic::contour(acc);
         pic::write_mesh(mesh, c_mesh);
         j.add("triangles", mesh.triangles.size()).raw("topology", topology_json(pic::analyze_topology(mesh)));
       }
       if (c_json) std::cout << j.str() << "\n";
-      else std::printf("%zu PICs -> %s\n", pic::analyze(acc).pics, c_out.c_str());
+      else std::printf("%zu PICs -> %s\n", pics, c_out.c_str());
     } else if (*cmd_prim) {
       const auto c = parse_numbers(p_center, 3, "--center");
       const pic::Vec3 center{c[0], c[1], c[2]};
@@ -482,7 +483,6 @@ int main(int argc, char** argv) {
       const bool is_pic = r_in.size() > 4 && r_in.substr(r_in.size() - 4) == ".pic";
       if (is_pic || r_octree || r_points) {
         const pic::Octree tree = load_any(r_in, r_depth, &mesh);
-        if (!is_pic) mesh = pic::contour(tree);
         pic::write_png(pic::render(mesh, &tree, ro), r_out);
       } else {
         mesh = pic::read_mesh(r_in);
@@ -496,7 +496,6 @@ int main(int argc, char** argv) {
       pic::TriMesh mesh;
       const pic::Octree tree = load_any(v_in, v_depth, &mesh);
       const bool is_pic = v_in.size() > 4 && v_in.substr(v_in.size() - 4) == ".pic";
-      if (!is_pic) mesh = pic::contour(tree);
       const std::string html = pic::view_html(mesh, &tree, info_json(tree, is_pic ? std::filesystem::file_size(v_in) : 0));
       pic::write_text(v_out, html);
 #else
