@@ -6,6 +6,8 @@
 // 1024x1024 well within a second on one core.
 #include "pic/render.h"
 
+#include "file_util.h"
+
 #include <png.h>
 #include <unistd.h>
 
@@ -469,34 +471,22 @@ bool encode_png(std::FILE* f, const Image& img, png_bytep* rows, PngError& err) 
 void write_png(const Image& img, const std::filesystem::path& path) {
   if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * img.height * 3)
     throw InvalidInput("write_png: image size does not match its pixel buffer");
-  // A unique temp name beside the target: rename() is atomic only within one file system.
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f)
-    throw IoError("cannot write PNG '" + path.string() + "': " + std::strerror(errno));
-
-  std::vector<png_bytep> rows(size_t(img.height));
-  for (int y = 0; y < img.height; ++y)
-    rows[size_t(y)] = const_cast<png_bytep>(&img.rgb[size_t(y) * img.width * 3]);
-  PngError err;
-  bool ok = encode_png(f, img, rows.data(), err);
-  ok = std::fflush(f) == 0 && ok && !std::ferror(f);
-  int saved_errno = errno;
-  ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    std::string why = err.message[0] ? err.message : std::strerror(saved_errno);
-    throw IoError("cannot write PNG '" + path.string() + "': " + why);
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw IoError("cannot write PNG '" + path.string() + "': " + ec.message());
-  }
+  // Written beside the target and renamed over it (file_util.h): a failed write keeps an
+  // existing file.
+  detail::write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw IoError("cannot write PNG '" + path.string() + "': " + std::strerror(errno));
+    std::vector<png_bytep> rows(size_t(img.height));
+    for (int y = 0; y < img.height; ++y)
+      rows[size_t(y)] = const_cast<png_bytep>(&img.rgb[size_t(y) * img.width * 3]);
+    PngError err;
+    bool ok = encode_png(f, img, rows.data(), err);
+    ok = std::fflush(f) == 0 && ok && !std::ferror(f);
+    const int saved_errno = errno;
+    ok = std::fclose(f) == 0 && ok;
+    if (!ok)
+      throw IoError("cannot write PNG '" + path.string() + "': " + (err.message[0] ? err.message : std::strerror(saved_errno)));
+  });
 }
 
 }  // namespace pic
