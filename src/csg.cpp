@@ -276,18 +276,8 @@ class Combiner {
     return append(sub);
   }
   Node append(const Builder& sub) {
-    const auto offset = static_cast<uint32_t>(out_.nodes.size()) - 1;
-    const auto vbase = static_cast<uint32_t>(out_.vertices.size());
-    Node root{};
-    for (size_t k = 0; k < sub.nodes.size(); ++k) {
-      Node n = sub.nodes[k];
-      if (n.kind == CellKind::Internal) n.index += offset;
-      if (n.kind == CellKind::Gray) n.index += vbase;
-      if (k == 0) root = n;
-      else out_.nodes.push_back(n);
-    }
+    const Node root = append_subtree(out_.nodes, out_.vertices, sub);
     out_.stamps.resize(out_.nodes.size(), stamp_);
-    out_.vertices.insert(out_.vertices.end(), sub.vertices.begin(), sub.vertices.end());
     return root;
   }
 

@@ -8,21 +8,25 @@ void Builder::set_gray(uint32_t slot, const Cell& cell, uint8_t signs, const Vec
   nodes[slot] = add_gray(vertices, cell, signs, x, flags);
 }
 
-void Builder::splice(uint32_t slot, const Builder& sub) {
-  const auto offset = static_cast<uint32_t>(nodes.size()) - 1;
+Node append_subtree(std::vector<Node>& nodes, std::vector<std::array<float, 3>>& vertices, const Builder& sub) {
+  const auto offset = static_cast<uint32_t>(nodes.size()) - 1;  // sub's node k >= 1 lands at offset + k
   const auto vbase = static_cast<uint32_t>(vertices.size());
   nodes.reserve(nodes.size() + sub.nodes.size());
+  Node root{};
   for (size_t k = 0; k < sub.nodes.size(); ++k) {
     Node n = sub.nodes[k];
     if (n.kind == CellKind::Internal) n.index += offset;
     if (n.kind == CellKind::Gray) n.index += vbase;
-    if (k == 0) {
-      nodes[slot] = n;
-    } else {
-      nodes.push_back(n);
-    }
+    if (k == 0) root = n;
+    else nodes.push_back(n);
   }
   vertices.insert(vertices.end(), sub.vertices.begin(), sub.vertices.end());
+  return root;
+}
+
+void Builder::splice(uint32_t slot, const Builder& sub) {
+  const Node root = append_subtree(nodes, vertices, sub);
+  nodes[slot] = root;
 }
 
 }  // namespace pic::detail

@@ -59,7 +59,12 @@ struct Builder {
   }
   /// Appends `sub` (root at sub.nodes[0]) with its root written into `slot`.
   void splice(uint32_t slot, const Builder& sub);
+
 };
+
+/// Appends the nodes and vertices of `sub` below its root, re-indexed, and returns its root
+/// (for the caller to place).
+Node append_subtree(std::vector<Node>& nodes, std::vector<std::array<float, 3>>& vertices, const Builder& sub);
 
 /// World position of a cell-local vertex.
 inline Vec3 vertex_unit(const Cell& cell, const std::array<float, 3>& local) {

@@ -18,22 +18,27 @@ struct LeafRef {
   Cell cell;
 };
 
-/// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the
-/// nodes from the root down to it.
-LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nullptr) {
+/// The node covering cell `target`, or the leaf above it; `path` gets the nodes from the
+/// root down to it.
+LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path = nullptr) {
   uint32_t node = 0;
   Cell cell;
-  while (t.nodes[node].kind == CellKind::Internal) {
+  while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
     if (path) path->push_back(node);
     const int64_t h = cell.span() / 2;
     int c = 0;
     for (int k = 0; k < 3; ++k)
-      if (q[k] >= cell.lat[k] + h) c |= 1 << k;
+      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
     node = t.nodes[node].index + c;
     cell = cell.child(c);
   }
   if (path) path->push_back(node);
   return {node, cell};
+}
+
+/// The leaf containing the finest lattice cell whose min corner is `q`.
+LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nullptr) {
+  return node_at(t, Cell{kMaxLevel, q}, path);
 }
 
 /// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
@@ -122,20 +127,6 @@ bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
   return seen > 0 && seen < 8 && all_differ;
 }
 
-/// The node covering `target` (a cell) or the leaf above it.
-LeafRef node_at(const Octree& t, const Cell& target) {
-  uint32_t node = 0;
-  Cell cell;
-  while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
-    const int64_t h = cell.span() / 2;
-    int c = 0;
-    for (int k = 0; k < 3; ++k)
-      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
-    node = t.nodes[node].index + c;
-    cell = cell.child(c);
-  }
-  return {node, cell};
-}
 
 }  // namespace
 
