@@ -3,10 +3,11 @@
 //   BM_SampleSphere/D            corner classification + vertex placement: a 64-segment sphere
 //                                sampled at depth D (counters: PICs, cells = octree nodes)
 //   BM_SampleFandisk/serial|tbb  data/fandisk.obj, depth 12, error 1e-8 (paper Table 2)
-//   BM_Contour/fandisk           dual contouring of the fandisk PIC object (triangles/s)
+//   BM_Contour/threads:T         dual contouring of the fandisk PIC object on T threads (triangles/s)
 //   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
 //                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <array>
 #include <cmath>
@@ -89,8 +90,9 @@ void BM_SampleFandisk(benchmark::State& state) {
 BENCHMARK(BM_SampleFandisk)->ArgName("parallel")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_Contour(benchmark::State& state) {
-  pic::SampleOptions o;
-  const pic::Octree t = pic::sample(fandisk(), o);
+  static const pic::Octree t = pic::sample(fandisk(), pic::SampleOptions{});
+  // Threads the contouring may use: 1 = the one-core figure.
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(state.range(0)));
   size_t tris = 0;
   for (auto _ : state) {
     auto m = pic::contour(t);
@@ -101,7 +103,7 @@ void BM_Contour(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(tris);
   state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(tris), benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_Contour)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Contour)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 struct CadScene {
   std::array<pic::Octree, 4> operands;  // cube, cylinder z, cylinder x, cylinder y

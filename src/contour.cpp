@@ -9,29 +9,44 @@
 namespace pic::detail {
 namespace {
 
-struct Ref {
+// What the walk carries for a node: the lean walk of a whole contour needs only the level
+// (vertex positions are computed once per leaf beforehand); partial contours and the crack
+// search need the cell itself.
+struct LevelRef {
+  uint32_t node;
+  int level;
+};
+struct CellRef {
   uint32_t node;
   Cell cell;
 };
+inline int level_of(const LevelRef& r) { return r.level; }
+inline int level_of(const CellRef& r) { return r.cell.level; }
+inline LevelRef child_ref(const LevelRef& r, uint32_t first, int c) { return {first + uint32_t(c), r.level + 1}; }
+inline CellRef child_ref(const CellRef& r, uint32_t first, int c) { return {first + uint32_t(c), r.cell.child(c)}; }
 
+/// The recursion of Ju et al. over node references. `V` supplies `active(node)` (is the node
+/// part of the walked region), `kCracks` (report sign changes next to non-gray leaves instead
+/// of skipping uniform leaves), `crack(...)` and `polygon(refs, count)`.
+template <class Ref, class V>
 class DualWalker {
  public:
-  DualWalker(const Octree& t, const std::function<bool(uint32_t)>* active,
-             const std::function<void(const DualPolygon&)>& emit, DualStats* stats)
-      : t_(t), active_(active), emit_(emit), stats_(stats) {}
+  DualWalker(const Octree& t, V& v) : nodes_(t.nodes.data()), v_(v) {}
 
-  bool leaf(const Ref& r) const { return t_.nodes[r.node].kind != CellKind::Internal; }
+  bool leaf(const Ref& r) const { return nodes_[r.node].kind != CellKind::Internal; }
   // Every lattice point in a white or black leaf's closure has its colour, so no edge on a
   // face or edge it touches changes sign: the walk can skip it. Not when looking for cracks
   // (a violated invariant), which is exactly such an edge.
   bool skip(const Ref& r) const {
-    const CellKind k = t_.nodes[r.node].kind;
-    return !stats_ && (k == CellKind::White || k == CellKind::Black);
+    if constexpr (V::kCracks) return false;
+    const CellKind k = nodes_[r.node].kind;
+    return k == CellKind::White || k == CellKind::Black;
   }
-  bool on(const Ref& r) const { return !active_ || (*active_)(r.node); }
+  bool on(const Ref& r) const { return v_.active(r.node); }
   Ref sub(const Ref& r, int c) const {
-    if (leaf(r)) return r;
-    return {t_.nodes[r.node].index + c, r.cell.child(c)};
+    const Node& n = nodes_[r.node];
+    if (n.kind != CellKind::Internal) return r;
+    return child_ref(r, n.index, c);
   }
 
   void cell_proc(const Ref& r) {
@@ -80,7 +95,7 @@ class DualWalker {
   }
 
   void edge_proc(const std::array<Ref, 4>& n, int e) {
-    if (active_ && !on(n[0]) && !on(n[1]) && !on(n[2]) && !on(n[3])) return;
+    if (!on(n[0]) && !on(n[1]) && !on(n[2]) && !on(n[3])) return;
     if (skip(n[0]) || skip(n[1]) || skip(n[2]) || skip(n[3])) return;
     if (leaf(n[0]) && leaf(n[1]) && leaf(n[2]) && leaf(n[3])) {
       process_edge(n, e);
@@ -98,11 +113,11 @@ class DualWalker {
   void process_edge(const std::array<Ref, 4>& n, int e) {
     int deepest = 0;
     for (int k = 1; k < 4; ++k)
-      if (n[k].cell.level > n[deepest].cell.level) deepest = k;
+      if (level_of(n[k]) > level_of(n[deepest])) deepest = k;
     const int p = e == 0 ? 1 : 0, q = e == 2 ? 1 : 2;
     const int c0 = ((1 - (deepest & 1)) << p) | ((1 - (deepest >> 1)) << q);
     const int c1 = c0 | (1 << e);
-    const Node& dn = t_.nodes[n[deepest].node];
+    const Node& dn = nodes_[n[deepest].node];
     bool s0, s1;
     if (dn.kind == CellKind::Gray) {
       s0 = (dn.signs >> c0) & 1;
@@ -111,16 +126,12 @@ class DualWalker {
       s0 = s1 = dn.kind == CellKind::Black;
     }
     if (s0 == s1) return;
-    for (int k = 0; k < 4; ++k) {
-      if (t_.nodes[n[k].node].kind != CellKind::Gray) {
-        if (stats_) {
-          stats_->crack_leaves.push_back(n[k].node);
-          stats_->crack_cells.push_back(n[k].cell);
-          const auto a = n[deepest].cell.corner(c0), b = n[deepest].cell.corner(c1);
-          stats_->crack_points.push_back({a[0] + b[0], a[1] + b[1], a[2] + b[2]});
+    if constexpr (V::kCracks) {
+      for (int k = 0; k < 4; ++k)
+        if (nodes_[n[k].node].kind != CellKind::Gray) {
+          v_.crack(n[k], n[deepest], c0, c1);
+          return;
         }
-        return;
-      }
     }
     // Cyclic order around the edge: (0,0) (1,0) (1,1) (0,1); counter-clockwise seen from +e
     // when (p, q, e) is right-handed, which fails only for e = y.
@@ -128,62 +139,115 @@ class DualWalker {
     const bool ccw_from_plus = e != 1;
     const bool outward_plus = s0;  // the low end is inside: the surface faces +e
     const bool reverse = ccw_from_plus != outward_plus;
-    DualPolygon poly{};
-    poly.count = 0;
+    std::array<Ref, 4> poly;
+    int count = 0;
     for (int m = 0; m < 4; ++m) {
       const Ref& r = n[kCycle[reverse ? 3 - m : m]];
-      if (poly.count > 0 && poly.leaf[poly.count - 1] == r.node) continue;
-      poly.leaf[poly.count] = r.node;
-      poly.pos[poly.count] = vertex_unit(r.cell, t_.vertices[t_.nodes[r.node].index]);
-      ++poly.count;
+      if (count > 0 && poly[count - 1].node == r.node) continue;
+      poly[count++] = r;
     }
-    if (poly.count > 1 && poly.leaf[poly.count - 1] == poly.leaf[0]) --poly.count;
-    if (poly.count >= 3) emit_(poly);
+    if (count > 1 && poly[count - 1].node == poly[0].node) --count;
+    if (count >= 3) v_.polygon(poly, count);
   }
 
  private:
-  const Octree& t_;
-  const std::function<bool(uint32_t)>* active_;
-  const std::function<void(const DualPolygon&)>& emit_;
-  DualStats* stats_;
+  const Node* nodes_;
+  V& v_;
 };
 
-Vec3 tri_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-  const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (l > 0) n = {n[0] / l, n[1] / l, n[2] / l};
-  return n;
+/// dual_walk's visitor: the optional `active` filter, polygons with positions, cracks.
+template <bool Cracks>
+struct CallbackVisitor {
+  static constexpr bool kCracks = Cracks;
+  const Octree& t;
+  const std::function<bool(uint32_t)>* filter;
+  const std::function<void(const DualPolygon&)>& emit;
+  DualStats* stats;
+
+  bool active(uint32_t node) const { return !filter || (*filter)(node); }
+  void crack(const CellRef& leaf, const CellRef& deepest, int c0, int c1) {
+    stats->crack_leaves.push_back(leaf.node);
+    stats->crack_cells.push_back(leaf.cell);
+    const auto a = deepest.cell.corner(c0), b = deepest.cell.corner(c1);
+    stats->crack_points.push_back({a[0] + b[0], a[1] + b[1], a[2] + b[2]});
+  }
+  void polygon(const std::array<CellRef, 4>& refs, int count) {
+    DualPolygon poly{};
+    poly.count = count;
+    for (int k = 0; k < count; ++k) {
+      poly.leaf[k] = refs[k].node;
+      poly.pos[k] = vertex_unit(refs[k].cell, t.vertices[t.nodes[refs[k].node].index]);
+    }
+    emit(poly);
+  }
+};
+
+inline Vec3 sub3(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline Vec3 cross3(const Vec3& u, const Vec3& v) {
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
 }
+inline double dot3(const Vec3& x, const Vec3& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; }
+
+/// Whole-contour visitor: triangles as triples of the tree's vertex indices, positions
+/// looked up from a per-vertex table.
+struct MeshVisitor {
+  using Tri = std::array<uint32_t, 3>;
+  static constexpr bool kCracks = false;
+  const Node* nodes;
+  const Vec3* pos;
+  std::vector<Tri>& tris;
+
+  static bool active(uint32_t) { return true; }
+  void crack(const LevelRef&, const LevelRef&, int, int) {}
+  void polygon(const std::array<LevelRef, 4>& r, int count) {
+    std::array<uint32_t, 4> v;
+    for (int k = 0; k < count; ++k) v[k] = nodes[r[k].node].index;
+    if (count == 3) {
+      tris.push_back({v[0], v[1], v[2]});
+      return;
+    }
+    for (const auto& tri : split_quad({pos[v[0]], pos[v[1]], pos[v[2]], pos[v[3]]}))
+      tris.push_back({v[tri[0]], v[tri[1]], v[tri[2]]});
+  }
+};
 
 }  // namespace
 
 void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
                const std::function<void(const DualPolygon&)>& emit, DualStats* stats) {
-  DualWalker w(t, active, emit, stats);
-  w.cell_proc({0, Cell{}});
+  if (stats) {
+    CallbackVisitor<true> v{t, active, emit, stats};
+    DualWalker<CellRef, CallbackVisitor<true>>(t, v).cell_proc({0, Cell{}});
+  } else {
+    CallbackVisitor<false> v{t, active, emit, nullptr};
+    DualWalker<CellRef, CallbackVisitor<false>>(t, v).cell_proc({0, Cell{}});
+  }
 }
 
 std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
-  const Vec3 a0 = tri_normal(p[0], p[1], p[2]), a1 = tri_normal(p[0], p[2], p[3]);
-  const Vec3 b0 = tri_normal(p[0], p[1], p[3]), b1 = tri_normal(p[1], p[2], p[3]);
-  auto dot = [](const Vec3& x, const Vec3& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  // Unnormalized triangle normals: their signs against the quad's normal need no square root.
+  const Vec3 a0 = cross3(sub3(p[1], p[0]), sub3(p[2], p[0])), a1 = cross3(sub3(p[2], p[0]), sub3(p[3], p[0]));
+  const Vec3 b0 = cross3(sub3(p[1], p[0]), sub3(p[3], p[0])), b1 = cross3(sub3(p[2], p[1]), sub3(p[3], p[1]));
   // The quad's own orientation: cross product of its diagonals (twice its vector area).
-  const Vec3 d0{p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
-  const Vec3 d1{p[3][0] - p[1][0], p[3][1] - p[1][1], p[3][2] - p[1][2]};
-  const Vec3 n{d0[1] * d1[2] - d0[2] * d1[1], d0[2] * d1[0] - d0[0] * d1[2], d0[0] * d1[1] - d0[1] * d1[0]};
+  const Vec3 n = cross3(sub3(p[2], p[0]), sub3(p[3], p[1]));
+  const double da0 = dot3(a0, n), da1 = dot3(a1, n), db0 = dot3(b0, n), db1 = dot3(b1, n);
   // A split whose triangle faces against the quad folds it back on itself (a non-convex
   // quad split along its outer diagonal): never take it when the other split is clean.
-  const bool a_ok = dot(a0, n) > 0 && dot(a1, n) > 0, b_ok = dot(b0, n) > 0 && dot(b1, n) > 0;
+  const bool a_ok = da0 > 0 && da1 > 0, b_ok = db0 > 0 && db1 > 0;
+  auto len = [](const Vec3& x) {
+    const double l = std::sqrt(dot3(x, x));
+    return l > 0 ? l : 1.0;
+  };
   bool use_a;
   if (a_ok != b_ok) {
     use_a = a_ok;
   } else if (!a_ok) {
-    use_a = std::min(dot(a0, n), dot(a1, n)) >= std::min(dot(b0, n), dot(b1, n));
+    use_a = std::min(da0 / len(a0), da1 / len(a1)) >= std::min(db0 / len(b0), db1 / len(b1));
   } else {
-    // Both clean: fold along the diagonal that bends most, which keeps a crease whose two
-    // vertices lie on it.
-    use_a = dot(a0, a1) <= dot(b0, b1);
+    // Both clean: fold along the diagonal that bends most (smaller cosine between its two
+    // triangles), which keeps a crease whose two vertices lie on it.
+    use_a = dot3(a0, a1) / std::sqrt(dot3(a0, a0) * dot3(a1, a1)) <=
+            dot3(b0, b1) / std::sqrt(dot3(b0, b0) * dot3(b1, b1));
   }
   if (use_a) return {{{0, 1, 2}, {0, 2, 3}}};
   return {{{0, 1, 3}, {1, 2, 3}}};
@@ -195,54 +259,50 @@ namespace pic {
 
 TriMesh contour(const Octree& tree) {
   using namespace detail;
-  // Triangles as triples of the tree's vertex indices, made by 9 tasks — the 8 root children
-  // and the faces and edges between them — each into its own list; concatenated in that fixed
-  // order they are exactly what a serial walk makes.
-  using Tri = std::array<uint32_t, 3>;
-  struct Part {
-    std::vector<Tri> tris;
-    std::vector<uint32_t> order;  // polygon vertices in walk order: output numbering
-    std::vector<Vec3> pos;        // and their positions (unit cube)
-  };
-  auto triangulate = [&](const DualPolygon& poly, Part& part) {
-    std::array<uint32_t, 4> v{};
-    for (int k = 0; k < poly.count; ++k) {
-      part.order.push_back(v[k] = tree.nodes[poly.leaf[k]].index);
-      part.pos.push_back(poly.pos[k]);
-    }
-    std::vector<Tri>& out = part.tris;
-    if (poly.count == 3) {
-      out.push_back({v[0], v[1], v[2]});
-      return;
-    }
-    for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]}))
-      out.push_back({v[tri[0]], v[tri[1]], v[tri[2]]});
-  };
-  std::array<Part, 9> parts;
+  using Tri = MeshVisitor::Tri;
   const bool split = tree.nodes[0].kind == CellKind::Internal;
+  // Each gray leaf's vertex in input coordinates, once (the walk meets it up to 12 times).
+  std::vector<Vec3> pos(tree.vertices.size());
+  auto place = [&](uint32_t node, const Cell& cell) {
+    const Node& n = tree.nodes[node];
+    if (n.kind == CellKind::Gray) pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, tree.vertices[n.index]));
+  };
+  if (split) {
+    tbb::parallel_for(0, 8, [&](int c) { visit_leaves(tree, tree.nodes[0].index + c, Cell{}.child(c), place); });
+  } else {
+    visit_leaves(tree, 0, Cell{}, place);
+  }
+  // Triangles made by 9 tasks — the 8 root children and the faces and edges between them —
+  // each into its own list; concatenated in that fixed order they are exactly what a serial
+  // walk makes.
+  std::array<std::vector<Tri>, 9> parts;
   tbb::parallel_for(0, split ? 9 : 1, [&](int task) {
-    std::function<void(const DualPolygon&)> keep = [&](const DualPolygon& p) { triangulate(p, parts[task]); };
-    DualWalker w(tree, nullptr, keep, nullptr);
-    if (!split) w.cell_proc({0, Cell{}});
-    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), Cell{}.child(task)});
-    else w.root_faces_and_edges({0, Cell{}});
+    MeshVisitor v{tree.nodes.data(), pos.data(), parts[task]};
+    DualWalker<LevelRef, MeshVisitor> w(tree, v);
+    if (!split) w.cell_proc({0, 0});
+    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), 1});
+    else w.root_faces_and_edges({0, 0});
   });
-  // Numbered by first appearance in the polygons, so the numbering does not depend on how
-  // quads were split.
-  TriMesh out;
-  std::vector<uint32_t> remap(tree.vertices.size(), UINT32_MAX);
+  // Vertices numbered in the tree's vertex order, keeping those the triangles use.
+  std::vector<uint32_t> remap(tree.vertices.size(), 0);
   size_t total = 0;
   for (const auto& part : parts) {
-    total += part.tris.size();
-    for (size_t i = 0; i < part.order.size(); ++i)
-      if (remap[part.order[i]] == UINT32_MAX) {
-        remap[part.order[i]] = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(unit_to_world(tree.cube, part.pos[i]));
-      }
+    total += part.size();
+    for (const Tri& t : part) remap[t[0]] = remap[t[1]] = remap[t[2]] = 1;
   }
-  out.triangles.reserve(total);
+  TriMesh out;
+  uint32_t used = 0;
+  for (uint32_t& r : remap) used += r;
+  out.positions.reserve(used);
+  for (size_t i = 0; i < remap.size(); ++i)
+    if (remap[i]) {
+      remap[i] = static_cast<uint32_t>(out.positions.size());
+      out.positions.push_back(pos[i]);
+    }
+  out.triangles.resize(total);
+  size_t k = 0;
   for (const auto& part : parts)
-    for (const Tri& t : part.tris) out.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+    for (const Tri& t : part) out.triangles[k++] = {remap[t[0]], remap[t[1]], remap[t[2]]};
   return out;
 }
 
