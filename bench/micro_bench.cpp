@@ -136,6 +136,7 @@ void BM_CsgCadStep(benchmark::State& state) {
   state.counters["contour_a_ms"] = st.contour_a_seconds * 1e3;
   state.counters["contour_b_ms"] = st.contour_b_seconds * 1e3;
   state.counters["csg_ms"] = st.csg_seconds * 1e3;
+  state.counters["cleanup_ms"] = st.cleanup_seconds * 1e3;
 }
 BENCHMARK(BM_CsgCadStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 

@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     so.depth = tree.max_depth;
     so.parallel = false;  // a stroke-sized tool: threads only add overhead
 
-    std::vector<double> stroke_s, tool_s, visited, stamped, tool_pics;
+    std::vector<double> stroke_s, tool_s, visited, stamped, tool_pics, contour_s, combine_s, cleanup_s;
     stroke_s.reserve(strokes);
     std::vector<pic::Vec3> candidates;
     double pick_s = 0;
@@ -140,6 +140,9 @@ int main(int argc, char** argv) {
       visited.push_back(static_cast<double>(st.cells_visited));
       stamped.push_back(static_cast<double>(st.cells_stamped));
       tool_pics.push_back(static_cast<double>(sst.pics));
+      contour_s.push_back(st.contour_a_seconds + st.contour_b_seconds);
+      combine_s.push_back(st.csg_seconds - st.cleanup_seconds);
+      cleanup_s.push_back(st.cleanup_seconds);
     }
     const double total_s = since(t_all);
     const auto stats = pic::analyze(tree);
@@ -156,6 +159,8 @@ int main(int argc, char** argv) {
     std::cout << "{\"strokes\": " << strokes << ", \"radius\": " << num(radius) << ", \"depth\": " << tree.max_depth
               << ", \"segments\": " << segments << ", \"seed\": " << seed << ", \"repick\": " << repick
               << ", \"stroke_ms\": " << summary(stroke_s, 1e3) << ", \"tool_sample_ms\": " << summary(tool_s, 1e3)
+              << ", \"partial_contours_ms\": " << summary(contour_s, 1e3)
+              << ", \"combine_ms\": " << summary(combine_s, 1e3) << ", \"cleanup_ms\": " << summary(cleanup_s, 1e3)
               << ", \"cells_visited\": " << summary(visited, 1) << ", \"cells_stamped\": " << summary(stamped, 1)
               << ", \"tool_pics\": " << summary(tool_pics, 1) << ", \"pick_seconds\": " << num(pick_s)
               << ", \"total_seconds\": " << num(total_s) << ", \"pics_before\": " << pics_before

@@ -745,6 +745,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     comb.run();
   }
   a.max_depth = depth;
+  const auto tclean = Clock::now();
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
@@ -754,6 +755,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     if (enforce_one_component(a, &stamped, &stamp_it).flipped == 0 && (islands == 0 || round > 0)) break;
   }
   stats.repaired = repair_cracks(a, &stamped);
+  stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);
   // Amortized garbage collection of replaced subtrees.
   if (a.nodes.size() > 2 * std::max<size_t>(before, 4096) || a.nodes.size() > before + 65536) {

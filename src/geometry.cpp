@@ -30,12 +30,13 @@ struct Poly {
   int n = 0;
 };
 
-// Clip against the half-space sign*(x[axis] - value) <= 0, snapping new points onto the plane.
-void clip(Poly& poly, int axis, double value, bool keep_below) {
-  Poly out;
-  for (int k = 0; k < poly.n; ++k) {
-    const Vec3& a = poly.p[k];
-    const Vec3& b = poly.p[(k + 1) % poly.n];
+// Clip `in` against the half-space sign*(x[axis] - value) <= 0 into `out`, snapping new
+// points onto the plane.
+void clip(const Poly& in, Poly& out, int axis, double value, bool keep_below) {
+  out.n = 0;
+  for (int k = 0; k < in.n; ++k) {
+    const Vec3& a = in.p[k];
+    const Vec3& b = in.p[k + 1 == in.n ? 0 : k + 1];
     const double da = keep_below ? a[axis] - value : value - a[axis];
     const double db = keep_below ? b[axis] - value : value - b[axis];
     if (da <= 0) out.p[out.n++] = a;
@@ -46,7 +47,6 @@ void clip(Poly& poly, int axis, double value, bool keep_below) {
       out.p[out.n++] = x;
     }
   }
-  poly = out;
 }
 
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
@@ -153,15 +153,25 @@ double clipped_area(const ITri& t, const IBox& box) {
   if (t.lo[0] > box.lo[0] && t.lo[1] > box.lo[1] && t.lo[2] > box.lo[2] && t.hi[0] <= box.hi[0] &&
       t.hi[1] <= box.hi[1] && t.hi[2] <= box.hi[2])
     return t.area;
-  Poly poly;
-  poly.n = 3;
-  for (int k = 0; k < 3; ++k) poly.p[k] = to_unit(t.v[k]);
-  const Vec3 lo = to_unit(box.lo), hi = to_unit(box.hi);
-  for (int k = 0; k < 3 && poly.n > 0; ++k) {
-    clip(poly, k, hi[k], true);
-    if (poly.n > 0) clip(poly, k, lo[k], false);
+  // Only the planes the triangle's box crosses can cut it (exact: same integer bounds).
+  Poly bufs[2];
+  int cur = 0;
+  bufs[0].n = 3;
+  for (int k = 0; k < 3; ++k) bufs[0].p[k] = to_unit(t.v[k]);
+  for (int k = 0; k < 3; ++k) {
+    if (t.hi[k] > box.hi[k]) {
+      clip(bufs[cur], bufs[1 - cur], k, grid_to_unit(box.hi[k]), true);
+      cur = 1 - cur;
+      if (bufs[cur].n == 0) return -1;
+    }
+    if (t.lo[k] < box.lo[k]) {
+      clip(bufs[cur], bufs[1 - cur], k, grid_to_unit(box.lo[k]), false);
+      cur = 1 - cur;
+      if (bufs[cur].n == 0) return -1;
+    }
   }
-  if (poly.n == 0) return -1;
+  const Poly& poly = bufs[cur];
+  const Vec3 lo = to_unit(box.lo);
   for (int k = 0; k < 3; ++k) {
     bool all_low = true;
     for (int q = 0; q < poly.n && all_low; ++q) all_low = poly.p[q][k] == lo[k];

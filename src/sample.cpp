@@ -12,22 +12,59 @@
 
 namespace pic::detail {
 
-void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
-                                  std::array<bool, 27>& g) const {
-  const int64_t h = lattice_to_grid(cell.span() / 2);
-  const I3 base = lattice_to_grid(cell.lat);
-  // Visit points by how many of their coordinates are mid (1): edge midpoints, face centres,
-  // then the centre; each is reached from an already known point along one axis.
-  for (int ones = 1; ones <= 3; ++ones) {
-    for (int i = 0; i < 27; ++i) {
-      const int a[3] = {i % 3, (i / 3) % 3, i / 9};
+namespace {
+
+/// The 19 segments that carry signs from a cell's corners to the rest of its child grid: grid
+/// point `to` is reached from `from` along `axis`; the segment's other two coordinates are
+/// grid steps `ci` (axis i) and `cj` (axis j), i < j. Ordered so that `from` is always known.
+struct GridSegment {
+  int to, from, axis, i, j, ci, cj;
+};
+constexpr std::array<GridSegment, 19> make_grid_segments() {
+  std::array<GridSegment, 19> out{};
+  int n = 0;
+  for (int ones = 1; ones <= 3; ++ones)
+    for (int g = 0; g < 27; ++g) {
+      const int a[3] = {g % 3, (g / 3) % 3, g / 9};
       if ((a[0] == 1) + (a[1] == 1) + (a[2] == 1) != ones) continue;
       const int axis = a[0] == 1 ? 0 : (a[1] == 1 ? 1 : 2);
-      const int from = i - (axis == 0 ? 1 : axis == 1 ? 3 : 9);  // same point, coordinate 0
-      const I3 start{base[0] + (from % 3) * h, base[1] + ((from / 3) % 3) * h, base[2] + (from / 9) * h};
-      g[i] = g[from] ^ (count_crossings(*tris_, idx, start, axis, h) & 1);
+      const int i = axis == 0 ? 1 : 0, j = axis == 2 ? 1 : 2;
+      out[n++] = {g, g - (axis == 0 ? 1 : axis == 1 ? 3 : 9), axis, i, j, a[i], a[j]};
+    }
+  return out;
+}
+constexpr std::array<GridSegment, 19> kGridSegments = make_grid_segments();
+
+}  // namespace
+
+void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
+                                  std::array<bool, 27>& g) const {
+  const i64 h = lattice_to_grid(cell.span() / 2);
+  const I3 base = lattice_to_grid(cell.lat);
+  // One pass over the triangles (not one per segment): each triangle's box says which grid
+  // lines it can cross, and only those get the exact test. Bit `to` = crossing parity of
+  // segment `to`.
+  uint32_t parity = 0;
+  for (uint32_t k : idx) {
+    const ITri& t = (*tris_)[k];
+    std::array<unsigned, 3> on{};  // bit b: grid line coordinate base + b h within [lo, hi)
+    std::array<bool, 3> spans{};   // the segments along this axis overlap the triangle's box
+    for (int d = 0; d < 3; ++d) {
+      for (int b = 0; b < 3; ++b) {
+        const i64 x = base[d] + b * h;
+        on[d] |= unsigned(x >= t.lo[d] && x < t.hi[d]) << b;
+      }
+      spans[d] = base[d] + h >= t.lo[d] && base[d] <= t.hi[d];
+    }
+    for (const GridSegment& s : kGridSegments) {
+      if (!spans[s.axis] || !((on[s.i] >> s.ci) & 1) || !((on[s.j] >> s.cj) & 1)) continue;
+      I3 start = base;
+      start[s.i] += s.ci * h;
+      start[s.j] += s.cj * h;
+      if (crosses(t, start, s.axis, h)) parity ^= 1u << s.to;
     }
   }
+  for (const GridSegment& s : kGridSegments) g[s.to] = g[s.from] ^ ((parity >> s.to) & 1);
 }
 
 bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,

@@ -370,6 +370,7 @@ int main(int argc, char** argv) {
                                          .add("contour_a_seconds", st.contour_a_seconds)
                                          .add("contour_b_seconds", st.contour_b_seconds)
                                          .add("csg_seconds", st.csg_seconds)
+                                         .add("cleanup_seconds", st.cleanup_seconds)
                                          .add("cells_visited", st.cells_visited)
                                          .add("cells_stamped", st.cells_stamped)
                                          .add("gray_pairs", st.gray_pairs)

@@ -114,7 +114,8 @@ struct CsgStats {
   double seconds = 0;
   double contour_a_seconds = 0;  ///< partial contour of A
   double contour_b_seconds = 0;  ///< partial contour of B
-  double csg_seconds = 0;        ///< the octree recursion itself
+  double csg_seconds = 0;        ///< the octree recursion itself, clean-up included
+  double cleanup_seconds = 0;    ///< of which: islands, one component per leaf, cracks
   size_t cells_visited = 0;      ///< cell pairs visited by the recursion
   size_t cells_stamped = 0;      ///< operand cells stamped as overlap
   size_t gray_pairs = 0;         ///< gray/gray evaluations (GraycellCSG)
