@@ -41,6 +41,20 @@ LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nul
   return node_at(t, Cell{kMaxLevel, q}, path);
 }
 
+/// Every leaf whose closed cell meets the closed lattice box [lo, hi], in depth-first order.
+void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                     std::vector<LeafRef>& out) {
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  const Node& n = t.nodes[node];
+  if (n.kind != CellKind::Internal) {
+    out.push_back({node, cell});
+    return;
+  }
+  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, out);
+}
+
 /// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
 /// false when it falls outside the root.
 bool octant_cell(const Lat& p, int o, Lat& q) {
@@ -151,17 +165,22 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   };
   // A fine active leaf's corners against the coarser leaves around them (an old coarse
   // leaf next to new fine ones)...
+  std::vector<LeafRef> near;
   for (const auto& [node, cell] : leaves) {
     if (cell.level < t.max_depth - 1) continue;  // the finest leaves carry the islands
+    // The leaves around its corners: one descent for the cell's closed box instead of one
+    // per corner and octant.
+    near.clear();
+    leaves_touching(t, 0, Cell{}, cell.lat, cell.corner(7), near);
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
       const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
-      for (int o = 0; o < 8; ++o) {
-        Lat q;
-        if (!octant_cell(p, o, q)) continue;
-        const LeafRef big = leaf_at(t, q);
-        if (big.cell.corner_index(p) >= 0 || t.nodes[big.node].kind != CellKind::Gray) continue;
-        if (!is_island(t.nodes[big.node], big.cell, p, sp)) continue;
+      for (const LeafRef& big : near) {
+        if (t.nodes[big.node].kind != CellKind::Gray || big.cell.corner_index(p) >= 0) continue;
+        bool touches = true;
+        for (int a = 0; a < 3 && touches; ++a)
+          touches = p[a] >= big.cell.lat[a] && p[a] <= big.cell.lat[a] + big.cell.span();
+        if (!touches || !is_island(t.nodes[big.node], big.cell, p, sp)) continue;
         flip(p);
         break;
       }
