@@ -17,6 +17,8 @@
 #include <chrono>
 #include <unordered_map>
 
+#include <tbb/parallel_for.h>
+
 #include "bvh.h"
 #include "contour.h"
 #include "sample.h"
@@ -95,18 +97,28 @@ class SignMemo {
   int shift_ = 64;
 };
 
-/// One operand during an operation: its tree, partial contour and sign memo.
+/// An operand's partial contour (grid units), indexed for box queries. Read-only once built,
+/// shared by all the tasks of an operation.
+struct PartialContour {
+  std::vector<ITri> tris;
+  TriangleBvh bvh;
+};
+
+/// One operand as seen by one task of an operation: its tree, its partial contour, and the
+/// task's caches (sign memo, triangles and anchor corner per leaf).
 struct Operand {
   const Octree& t;
-  std::vector<ITri> tris;  // partial contour, grid units
-  TriangleBvh bvh;
+  const PartialContour& pc;
+  const std::vector<ITri>& tris;
+  const TriangleBvh& bvh;
   std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
   SignMemo memo;                                                  // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
   uint32_t stamp = 0;
 
-  Operand(const Octree& tree, uint32_t op_stamp) : t(tree), stamp(op_stamp) {}
+  Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
+      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -256,34 +268,65 @@ struct Side {
   Cell leaf_cell;             // Gray: the cell of the leaf `node`
 };
 
+/// Levels whose cells split into parallel tasks when both operands are subdivided there.
+constexpr int kParallelLevels = 2;
+
+/// What one task of the combine step builds, kept apart from A (which every task reads) until
+/// the tasks are done: new nodes and vertices, and writes into A's existing slots. Indices with
+/// kLocal set point into the fragment's own arrays; the others into A's.
+struct Fragment {
+  static constexpr uint32_t kLocal = 1u << 31;
+  std::vector<Node> nodes;
+  std::vector<std::array<float, 3>> vertices;
+  std::vector<std::pair<uint32_t, Node>> pending;  // A's slot -> node
+
+  static bool is_local(uint32_t index) { return (index & kLocal) != 0; }
+  /// `n` with its fragment-local index moved to where the fragment's arrays land (bases
+  /// possibly local themselves, when merging into a parent fragment).
+  static Node relocate(Node n, uint32_t node_base, uint32_t vertex_base) {
+    if (n.kind == CellKind::Internal && is_local(n.index)) n.index = node_base + (n.index & ~kLocal);
+    if (n.kind == CellKind::Gray && is_local(n.index)) n.index = vertex_base + (n.index & ~kLocal);
+    return n;
+  }
+  /// Appends `f` to this fragment; returns `root` (a node of f) relocated.
+  Node absorb(const Fragment& f, Node root) {
+    const uint32_t nb = kLocal | uint32_t(nodes.size()), vb = kLocal | uint32_t(vertices.size());
+    for (const Node& n : f.nodes) nodes.push_back(relocate(n, nb, vb));
+    vertices.insert(vertices.end(), f.vertices.begin(), f.vertices.end());
+    for (const auto& [slot, n] : f.pending) pending.push_back({slot, relocate(n, nb, vb)});
+    return relocate(root, nb, vb);
+  }
+};
+
 class Combiner {
  public:
-  Combiner(Octree& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
-           CsgStats& stats)
+  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
+           int parallel_levels, bool parallel, CsgStats& stats)
       : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
-        stats_(stats), original_nodes_(out.nodes.size()) {}
+        parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
 
-  void run() {
+  /// The result's root node (its index may be fragment-local).
+  Node run() {
     Side sa = side_of(a_, 0, Cell{});
     Side sb = side_of(b_, 0, Cell{});
-    set(0, combine(Cell{}, sa, sb));
-    for (const auto& [slot, node] : pending_) out_.nodes[slot] = node;
+    return combine(Cell{}, sa, sb);
   }
 
  private:
   // ---- output ---------------------------------------------------------------------------
   void set(uint32_t slot, const Node& n) {
-    if (slot < original_nodes_) pending_.push_back({slot, n});
-    else out_.nodes[slot] = n;
+    if (Fragment::is_local(slot)) out_.nodes[slot & ~Fragment::kLocal] = n;
+    else out_.pending.push_back({slot, n});
   }
   uint32_t alloc8() {
     const auto first = static_cast<uint32_t>(out_.nodes.size());
     out_.nodes.resize(first + 8);
-    out_.stamps.resize(first + 8, stamp_);
-    return first;
+    return Fragment::kLocal | first;
   }
   Node gray(const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
-    return add_gray(out_.vertices, cell, signs, x, flags);
+    Node n = add_gray(out_.vertices, cell, signs, x, flags);
+    n.index |= Fragment::kLocal;
+    return n;
   }
   static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
 
@@ -295,11 +338,11 @@ class Combiner {
       case CellKind::Black: return uniform((n.kind == CellKind::Black) != invert);
       case CellKind::Gray:
         out_.vertices.push_back(src.vertices[n.index]);
-        return Node{static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray,
+        return Node{Fragment::kLocal | static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray,
                     invert ? uint8_t(~n.signs) : n.signs, n.flags, 0};
       case CellKind::Internal: {
         const uint32_t first = alloc8();
-        for (int c = 0; c < 8; ++c) out_.nodes[first + c] = copy_subtree(src, n.index + c, invert);
+        for (int c = 0; c < 8; ++c) set(first + c, copy_subtree(src, n.index + c, invert));
         return Node{first, CellKind::Internal, 0, 0, 0};
       }
     }
@@ -321,8 +364,13 @@ class Combiner {
     return append(sub);
   }
   Node append(const Builder& sub) {
-    const Node root = append_subtree(out_.nodes, out_.vertices, sub);
-    out_.stamps.resize(out_.nodes.size(), stamp_);
+    const size_t from = out_.nodes.size();
+    Node root = append_subtree(out_.nodes, out_.vertices, sub);
+    auto mark = [](Node& n) {
+      if (n.kind == CellKind::Internal || n.kind == CellKind::Gray) n.index |= Fragment::kLocal;
+    };
+    for (size_t k = from; k < out_.nodes.size(); ++k) mark(out_.nodes[k]);
+    mark(root);
     return root;
   }
 
@@ -418,12 +466,30 @@ class Combiner {
       if (a.kind == Side::Gray && a.real) ++stats_.forced_subdivisions;
     }
     if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
-    bool all_uniform = true;
     std::array<Node, 8> kids;
+    if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) {
+      // Near the root, each child is a task with its own fragment and caches, merged in child
+      // order: the same bytes whether the tasks run in parallel or not.
+      std::array<Fragment, 8> frags;
+      std::array<CsgStats, 8> sub_stats;
+      auto task = [&](int c) {
+        Operand ca(a_.t, a_.pc, stamp_), cb(b_.t, b_.pc, stamp_);
+        Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
+        kids[c] = sub.combine(cell.child(c), sub.child_side(ca, a, cell, c), sub.child_side(cb, b, cell, c));
+      };
+      if (parallel_) tbb::parallel_for(0, 8, task);
+      else for (int c = 0; c < 8; ++c) task(c);
+      for (int c = 0; c < 8; ++c) {
+        kids[c] = out_.absorb(frags[c], kids[c]);
+        stats_.cells_visited += sub_stats[c].cells_visited;
+        stats_.gray_pairs += sub_stats[c].gray_pairs;
+        stats_.forced_subdivisions += sub_stats[c].forced_subdivisions;
+      }
+    } else {
+      for (int c = 0; c < 8; ++c) kids[c] = combine(cell.child(c), child_side(a_, a, cell, c), child_side(b_, b, cell, c));
+    }
+    bool all_uniform = true;
     for (int c = 0; c < 8; ++c) {
-      const Side ca = child_side(a_, a, cell, c);
-      const Side cb = child_side(b_, b, cell, c);
-      kids[c] = combine(cell.child(c), ca, cb);
       set(first + c, kids[c]);
       all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
                     kids[c].kind == kids[0].kind;
@@ -589,16 +655,16 @@ class Combiner {
     return subdivide(cell, a, b);
   }
 
-  Octree& out_;
+  Fragment& out_;
   Operand& a_;
   Operand& b_;
   CsgOp op_;
   double error_;
   int max_depth_;
   uint32_t stamp_;
+  int parallel_levels_;
+  bool parallel_;
   CsgStats& stats_;
-  size_t original_nodes_;
-  std::vector<std::pair<uint32_t, Node>> pending_;
   std::vector<uint32_t> scratch_;
 };
 
@@ -638,7 +704,7 @@ void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, const Cell&
 /// uniform inside its gray leaf, so the result there is B's subtree or uniform, with no need
 /// for B's partial contour. This makes the cost of a coarse clay against a fine tool follow
 /// the clay's surface, not the tool's whole volume.
-void stamp_under_surface(const Operand& a, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
+void stamp_under_surface(const PartialContour& a, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
                          size_t& count, std::vector<uint32_t>& scratch) {
   const Node& y = b.nodes[nb];
   if (y.kind == CellKind::White || y.kind == CellKind::Black) return;
@@ -655,8 +721,7 @@ void stamp_under_surface(const Operand& a, const Octree& b, uint32_t nb, const C
 }
 
 /// The partial contour: dual polygons around stamped cells, indexed for box queries.
-void partial_contour(Operand& x, uint32_t stamp) {
-  const Octree& t = x.t;
+void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
     std::array<I3, 4> g;
@@ -766,9 +831,9 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   std::vector<Deferred> deferred;
   tag(a, 0, b, 0, Cell{}, stamp, stats.cells_stamped, deferred);
 
-  Operand oa(a, stamp), ob(b, stamp);
+  PartialContour pa, pb;
   auto tc = Clock::now();
-  partial_contour(oa, stamp);
+  partial_contour(a, stamp, pa);
   stats.contour_a_seconds = since(tc);
   tc = Clock::now();
   {
@@ -776,18 +841,27 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     for (const Deferred& d : deferred) {
       const Node& y = b.nodes[d.b_node];
       for (int c = 0; c < 8; ++c)
-        stamp_under_surface(oa, b, y.index + c, d.cell.child(c), stamp, stats.cells_stamped, scratch);
+        stamp_under_surface(pa, b, y.index + c, d.cell.child(c), stamp, stats.cells_stamped, scratch);
     }
   }
-  partial_contour(ob, stamp);
+  partial_contour(b, stamp, pb);
   stats.contour_b_seconds = since(tc);
 
   tc = Clock::now();
   const size_t before = a.nodes.size();
   {
-    Octree& out = a;  // in place; original slots are written only after the recursion
-    Combiner comb(out, oa, ob, op, options.error, depth, stamp, stats);
-    comb.run();
+    // Every task reads A as it was; the new nodes land after A's, and A's own slots are
+    // written only once all tasks are done.
+    Fragment f;
+    Operand oa(a, pa, stamp), ob(b, pb, stamp);
+    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, stats);
+    const Node root = comb.run();
+    const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
+    for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
+    a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
+    a.stamps.resize(a.nodes.size(), stamp);
+    for (const auto& [slot, n] : f.pending) a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+    a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
   }
   a.max_depth = depth;
   const auto tclean = Clock::now();

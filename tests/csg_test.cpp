@@ -361,6 +361,28 @@ TEST(Csg, CadToolMatchesTheExactSolid) {
   for (const auto& s : stats) EXPECT_GT(s.cells_stamped, 0u);
 }
 
+// Determinism: the parallel combine builds exactly the serial tree, over a chain of in-place
+// operations (the result is the next operation's A, so any difference would compound).
+TEST(Csg, ParallelEqualsSerial) {
+  const int depth = 9;
+  const Vec3 c{0.5, 0.5, 0.5};
+  auto chain = [&](bool parallel) {
+    CsgOptions o;
+    o.parallel = parallel;
+    Octree t = sample_in_unit(axis_box({0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}).mesh(), depth);
+    csg_inplace(t, sample_in_unit(make_cylinder(c, 0.15, 0.8, 2, 64), depth), CsgOp::Union, o);
+    csg_inplace(t, sample_in_unit(make_cylinder(c, 0.1, 0.8, 0, 64), depth), CsgOp::Subtract, o);
+    csg_inplace(t, sample_in_unit(make_sphere({0.75, 0.75, 0.6}, 0.1, 32), depth), CsgOp::Subtract, o);
+    csg_inplace(t, sample_in_unit(make_sphere({0.3, 0.5, 0.5}, 0.2, 32), depth), CsgOp::Intersect, o);
+    return t;
+  };
+  const Octree serial = chain(false), parallel = chain(true);
+  EXPECT_TRUE(serialize(serial) == serialize(parallel));
+  EXPECT_EQ(serial.nodes.size(), parallel.nodes.size());
+  EXPECT_TRUE(serial.vertices == parallel.vertices);
+  EXPECT_TRUE(IsClosedManifold(contour(parallel)));
+}
+
 // ---- cost follows the overlap -----------------------------------------------------------------
 
 size_t cells_for_stroke(const Octree& object, const Vec3& at, double radius, int depth) {

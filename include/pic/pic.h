@@ -108,6 +108,7 @@ std::optional<CsgOp> parse_csg_op(const std::string& s);
 
 struct CsgOptions {
   double error = 1e-8;  ///< QEF residual threshold for new vertices
+  bool parallel = true; ///< combine subtrees near the root with TBB (output identical to serial)
 };
 
 struct CsgStats {
