@@ -269,7 +269,7 @@ struct Side {
 };
 
 /// Levels whose cells split into parallel tasks when both operands are subdivided there.
-constexpr int kParallelLevels = 2;
+constexpr int kParallelLevels = 4;
 
 /// What one task of the combine step builds, kept apart from A (which every task reads) until
 /// the tasks are done: new nodes and vertices, and writes into A's existing slots. Indices with

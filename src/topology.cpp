@@ -41,9 +41,11 @@ LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nul
   return node_at(t, Cell{kMaxLevel, q}, path);
 }
 
-/// Every leaf whose closed cell meets the closed lattice box [lo, hi], in depth-first order.
+/// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
+/// in depth-first order.
 void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
-                     std::vector<LeafRef>& out) {
+                     int max_level, std::vector<LeafRef>& out) {
+  if (cell.level > max_level) return;
   const int64_t s = cell.span();
   for (int k = 0; k < 3; ++k)
     if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
@@ -52,7 +54,7 @@ void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat
     out.push_back({node, cell});
     return;
   }
-  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, out);
+  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
 }
 
 /// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
@@ -144,20 +146,79 @@ bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
 
 }  // namespace
 
-size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
-                      const std::function<void(uint32_t)>* touched) {
-  std::vector<std::pair<uint32_t, Cell>> leaves;
-  std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
+namespace {
+
+/// A leaf with the nodes from the root down to it (path[l] = its ancestor at level l), so
+/// that searches around it can start from a near ancestor instead of the root.
+struct PathLeaf {
+  uint32_t node;
+  Cell cell;
+  size_t path;  // offset of the ancestors in IslandSearch::paths
+};
+
+struct IslandSearch {
+  const Octree& t;
+  std::vector<PathLeaf> leaves;
+  std::vector<uint32_t> paths;
+
+  /// The ancestor of `l` at `level`, with its cell.
+  LeafRef ancestor(const PathLeaf& l, int level) const {
+    Cell c{level, l.cell.lat};
+    const int64_t span = c.span();
+    for (auto& x : c.lat) x -= x % span;
+    return {paths[l.path + size_t(level)], c};
+  }
+  /// The deepest ancestor of `l` whose cell holds the closed box [lo, hi] away from its
+  /// boundary (`strict`) or anywhere inside it: every leaf meeting the box is below it.
+  LeafRef start_for(const PathLeaf& l, const Lat& lo, const Lat& hi, bool strict) const {
+    for (int level = l.cell.level; level > 0; --level) {
+      const LeafRef a = ancestor(l, level);
+      const int64_t s = a.cell.span();
+      bool inside = true;
+      for (int k = 0; k < 3 && inside; ++k)
+        inside = strict ? (a.cell.lat[k] < lo[k] && hi[k] < a.cell.lat[k] + s)
+                        : (a.cell.lat[k] <= lo[k] && hi[k] <= a.cell.lat[k] + s);
+      if (inside) return a;
+    }
+    return {0, Cell{}};
+  }
+  /// The node covering `target` (or the leaf above it), searched from `from`.
+  LeafRef node_below(LeafRef from, const Cell& target) const {
+    while (from.cell.level < target.level && t.nodes[from.node].kind == CellKind::Internal) {
+      const int64_t h = from.cell.span() / 2;
+      int c = 0;
+      for (int k = 0; k < 3; ++k)
+        if (target.lat[k] >= from.cell.lat[k] + h) c |= 1 << k;
+      from = {t.nodes[from.node].index + c, from.cell.child(c)};
+    }
+    return from;
+  }
+
+  void collect(uint32_t node, const Cell& cell, const std::function<bool(uint32_t)>* active,
+               std::vector<uint32_t>& path) {
     if (active && !(*active)(node)) return;
     const Node& n = t.nodes[node];
+    path.push_back(node);
     if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
+      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c), active, path);
     } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 4) {
       // Islands are features near the finest cell size, next to leaves a few levels up.
-      leaves.push_back({node, cell});
+      leaves.push_back({node, cell, paths.size()});
+      paths.insert(paths.end(), path.begin(), path.end());
     }
-  };
-  walk(0, Cell{});
+    path.pop_back();
+  }
+};
+
+}  // namespace
+
+size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
+                      const std::function<void(uint32_t)>* touched) {
+  IslandSearch search{t, {}, {}};
+  {
+    std::vector<uint32_t> path;
+    search.collect(0, Cell{}, active, path);
+  }
   size_t flipped = 0;
   auto flip = [&](const Lat& p) {
     flip_point(t, p, touched);
@@ -166,12 +227,17 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   // A fine active leaf's corners against the coarser leaves around them (an old coarse
   // leaf next to new fine ones)...
   std::vector<LeafRef> near;
-  for (const auto& [node, cell] : leaves) {
+  for (const PathLeaf& l : search.leaves) {
+    const uint32_t node = l.node;
+    const Cell& cell = l.cell;
     if (cell.level < t.max_depth - 1) continue;  // the finest leaves carry the islands
-    // The leaves around its corners: one descent for the cell's closed box instead of one
-    // per corner and octant.
+    // The coarser leaves around its corners (a leaf as fine or finer touching a corner has it
+    // as a corner too): one descent for the cell's closed box, from the nearest ancestor that
+    // holds it.
     near.clear();
-    leaves_touching(t, 0, Cell{}, cell.lat, cell.corner(7), near);
+    const Lat lo = cell.lat, hi = cell.corner(7);
+    const LeafRef from = search.start_for(l, lo, hi, true);
+    leaves_touching(t, from.node, from.cell, lo, hi, cell.level - 1, near);
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
       const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
@@ -189,7 +255,9 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   // ... and an active coarse leaf against the finer leaves across its faces (a new coarse
   // leaf next to old fine ones).
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  for (const auto& [big, cell] : leaves) {
+  for (const PathLeaf& l : search.leaves) {
+    const uint32_t big = l.node;
+    const Cell& cell = l.cell;
     if (cell.level >= t.max_depth) continue;
     const int64_t sz = cell.span();
     for (int d = 0; d < 3; ++d)
@@ -197,7 +265,8 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
         Cell across = cell;
         across.lat[d] += side ? sz : -sz;
         if (across.lat[d] < 0 || across.lat[d] >= kLimit) continue;
-        const LeafRef n = node_at(t, across);
+        const Lat across_hi = across.corner(7);
+        const LeafRef n = search.node_below(search.start_for(l, across.lat, across_hi, false), across);
         if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
         const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
         // Leaves of the finer side touching the shared face, and their corners on it.
