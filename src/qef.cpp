@@ -57,7 +57,8 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
   m << a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5];
   const Eigen::Vector3d s(seed[0], seed[1], seed[2]);
   const Eigen::Vector3d r = Eigen::Vector3d(b[0], b[1], b[2]) - m * s;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(m);
   const Eigen::Vector3d ev = eig.eigenvalues();
   const double top = std::max({std::abs(ev[0]), std::abs(ev[1]), std::abs(ev[2])});
   Eigen::Vector3d inv = Eigen::Vector3d::Zero();
