@@ -10,6 +10,14 @@ int sgn(i128 v) { return (v > 0) - (v < 0); }
 
 // Sign of f(p + delta) for the plane function f(p) = n.p - d, delta = (e, e^2, e^3).
 int perturbed_plane_sign(const ITri& t, const I3& p) {
+  // Floating-point filter: n and d carry a relative error of 2^-53, p is exact, and each
+  // operation adds at most 2^-53 of its magnitude; 2^-48 of the terms' sum bounds it all.
+  const double t0 = t.n_approx[0] * double(p[0]), t1 = t.n_approx[1] * double(p[1]),
+               t2 = t.n_approx[2] * double(p[2]);
+  const double fa = t0 + t1 + t2 - t.d_approx;
+  const double bound = (std::abs(t0) + std::abs(t1) + std::abs(t2) + std::abs(t.d_approx)) * 0x1p-48;
+  if (fa > bound) return 1;
+  if (fa < -bound) return -1;
   const i128 f = t.n[0] * p[0] + t.n[1] * p[1] + t.n[2] * p[2] - t.d;
   if (f != 0) return sgn(f);
   if (t.n[0] != 0) return sgn(t.n[0]);
@@ -19,7 +27,13 @@ int perturbed_plane_sign(const ITri& t, const I3& p) {
 
 // Orientation of (u, w, q + delta) in the (i, j) projection, perturbed (never 0 unless u == w).
 int perturbed_orient(const I3& u, const I3& w, const I3& q, int i, int j) {
-  const i128 o = i128(w[i] - u[i]) * (q[j] - u[j]) - i128(w[j] - u[j]) * (q[i] - u[i]);
+  const i64 a = w[i] - u[i], b = q[j] - u[j], c = w[j] - u[j], d = q[i] - u[i];
+  // Floating-point filter (differences are exact in double below 2^53).
+  const double p1 = double(a) * double(b), p2 = double(c) * double(d), oa = p1 - p2;
+  const double bound = (std::abs(p1) + std::abs(p2)) * 0x1p-50;
+  if (oa > bound) return 1;
+  if (oa < -bound) return -1;
+  const i128 o = i128(a) * b - i128(c) * d;
   if (o != 0) return sgn(o);
   if (u[j] != w[j]) return u[j] > w[j] ? 1 : -1;  // coefficient of delta_i
   return w[i] > u[i] ? 1 : (w[i] < u[i] ? -1 : 0);  // coefficient of delta_j
@@ -100,6 +114,8 @@ ITri make_itri(const I3& a, const I3& b, const I3& c) {
     t.hi[k] = std::max({a[k], b[k], c[k]});
   }
   const double nx = double(t.n[0]), ny = double(t.n[1]), nz = double(t.n[2]);
+  t.n_approx = {nx, ny, nz};
+  t.d_approx = double(t.d);
   const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
   if (len > 0) {
     t.unit_normal = {nx / len, ny / len, nz / len};
@@ -117,8 +133,9 @@ bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
   if (a[i] < t.lo[i] || a[i] >= t.hi[i] || a[j] < t.lo[j] || a[j] >= t.hi[j]) return false;
   if (a[axis] + len < t.lo[axis] || a[axis] > t.hi[axis]) return false;
   if (t.n[axis] == 0) return false;  // parallel to the segment: never crossed after perturbation
-  const int orient = sgn(i128(t.v[1][i] - t.v[0][i]) * (t.v[2][j] - t.v[0][j]) -
-                         i128(t.v[1][j] - t.v[0][j]) * (t.v[2][i] - t.v[0][i]));
+  // The triangle's orientation in the (i, j) projection is n's component along the axis
+  // ((i, j, axis) is cyclic except for axis = y).
+  const int orient = axis == 1 ? -sgn(t.n[1]) : sgn(t.n[axis]);
   for (int e = 0; e < 3; ++e) {
     if (perturbed_orient(t.v[e], t.v[(e + 1) % 3], a, i, j) != orient) return false;
   }

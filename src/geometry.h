@@ -38,6 +38,8 @@ struct ITri {
   std::array<i128, 3> n;  // (v1-v0) x (v2-v0), < 2^70 per component
   i128 d;                 // n . v0
   I3 lo, hi;              // bounding box
+  std::array<double, 3> n_approx{};  // n and d rounded to double: filters for the exact
+  double d_approx = 0;               // predicates (decide the clear cases without i128)
   Vec3 unit_normal{0, 0, 0};  // double precision, for QEFs
   double plane = 0;           // unit_normal . v0 (unit-cube coordinates)
   double area = 0;            // unit-cube units
