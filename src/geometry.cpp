@@ -154,6 +154,18 @@ int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& 
 bool overlaps_box(const ITri& t, const I3& lo, const I3& hi) {
   for (int k = 0; k < 3; ++k)
     if (t.hi[k] < lo[k] || t.lo[k] > hi[k]) return false;
+  // Floating-point filter first (see perturbed_plane_sign): decide when the plane is clearly
+  // off the box or clearly through it.
+  double amin = -t.d_approx, amax = -t.d_approx, mag = std::abs(t.d_approx);
+  for (int k = 0; k < 3; ++k) {
+    const double x = t.n_approx[k] * double(lo[k]), y = t.n_approx[k] * double(hi[k]);
+    amin += std::min(x, y);
+    amax += std::max(x, y);
+    mag += std::max(std::abs(x), std::abs(y));
+  }
+  const double bound = mag * 0x1p-48;
+  if (amin > bound || amax < -bound) return false;
+  if (amin < -bound && amax > bound) return true;
   i128 fmin = -t.d, fmax = -t.d;
   for (int k = 0; k < 3; ++k) {
     const i128 x = t.n[k] * lo[k], y = t.n[k] * hi[k];
