@@ -59,54 +59,74 @@ class DualWalker {
   void root_faces_and_edges(const Ref& r) {
     std::array<Ref, 8> ch;
     for (int c = 0; c < 8; ++c) ch[c] = sub(r, c);
-    for (int d = 0; d < 3; ++d) {
-      for (int c = 0; c < 8; ++c)
-        if (!((c >> d) & 1)) face_proc(ch[c], ch[c | (1 << d)], d);
-      const int p = d == 0 ? 1 : 0, q = d == 2 ? 1 : 2;
-      for (int b = 0; b < 2; ++b) {
-        std::array<Ref, 4> e;
-        for (int k = 0; k < 4; ++k) e[k] = ch[((k & 1) << p) | ((k >> 1) << q) | (b << d)];
-        edge_proc(e, d);
-      }
+    faces_and_edges_along<0>(ch);
+    faces_and_edges_along<1>(ch);
+    faces_and_edges_along<2>(ch);
+  }
+
+ private:
+  // The axis is a template parameter: every child index below is then a constant.
+  template <int D>
+  void faces_and_edges_along(const std::array<Ref, 8>& ch) {
+    for (int c = 0; c < 8; ++c)
+      if (!((c >> D) & 1)) face_proc<D>(ch[c], ch[c | (1 << D)]);
+    constexpr int p = D == 0 ? 1 : 0, q = D == 2 ? 1 : 2;
+    for (int b = 0; b < 2; ++b) {
+      std::array<Ref, 4> e;
+      for (int k = 0; k < 4; ++k) e[k] = ch[((k & 1) << p) | ((k >> 1) << q) | (b << D)];
+      edge_proc<D>(e);
     }
   }
 
-  void face_proc(const Ref& lo, const Ref& hi, int d) {
+  // The checks that end most calls are inlined into the caller; the recursion is not.
+  template <int D>
+  void face_proc(const Ref& lo, const Ref& hi) {
     if ((leaf(lo) && leaf(hi)) || skip(lo) || skip(hi)) return;
     if (!on(lo) && !on(hi)) return;
-    const int i = d == 0 ? 1 : 0, j = d == 2 ? 1 : 2;
+    face_body<D>(lo, hi);
+  }
+  template <int D>
+  [[gnu::noinline]] void face_body(const Ref& lo, const Ref& hi) {
+    constexpr int i = D == 0 ? 1 : 0, j = D == 2 ? 1 : 2;
     for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b)
-        face_proc(sub(lo, (1 << d) | (a << i) | (b << j)), sub(hi, (a << i) | (b << j)), d);
-    for (int e : {i, j}) {
-      const int f = e == i ? j : i;  // the other in-face axis
-      const int p = e == 0 ? 1 : 0;  // first axis across the edge; the second is the other one
-      for (int b = 0; b < 2; ++b) {
-        std::array<Ref, 4> cells;
-        for (int k = 0; k < 4; ++k) {
-          const int bp = k & 1, bq = k >> 1;
-          const int bd = p == d ? bp : bq, bf = p == f ? bp : bq;
-          const Ref& parent = bd ? hi : lo;
-          cells[k] = sub(parent, ((1 - bd) << d) | (bf << f) | (b << e));
-        }
-        edge_proc(cells, e);
+      for (int b = 0; b < 2; ++b) face_proc<D>(sub(lo, (1 << D) | (a << i) | (b << j)), sub(hi, (a << i) | (b << j)));
+    face_edges<D, i, j>(lo, hi);
+    face_edges<D, j, i>(lo, hi);
+  }
+  /// The two edges along axis E inside the face (normal D) between lo and hi; F is the other
+  /// in-face axis.
+  template <int D, int E, int F>
+  void face_edges(const Ref& lo, const Ref& hi) {
+    constexpr int p = E == 0 ? 1 : 0;  // first axis across the edge; the second is the other one
+    for (int b = 0; b < 2; ++b) {
+      std::array<Ref, 4> cells;
+      for (int k = 0; k < 4; ++k) {
+        const int bp = k & 1, bq = k >> 1;
+        const int bd = p == D ? bp : bq, bf = p == F ? bp : bq;
+        const Ref& parent = bd ? hi : lo;
+        cells[k] = sub(parent, ((1 - bd) << D) | (bf << F) | (b << E));
       }
+      edge_proc<E>(cells);
     }
   }
 
-  void edge_proc(const std::array<Ref, 4>& n, int e) {
+  template <int E>
+  void edge_proc(const std::array<Ref, 4>& n) {
     if (!on(n[0]) && !on(n[1]) && !on(n[2]) && !on(n[3])) return;
     if (skip(n[0]) || skip(n[1]) || skip(n[2]) || skip(n[3])) return;
     if (leaf(n[0]) && leaf(n[1]) && leaf(n[2]) && leaf(n[3])) {
-      process_edge(n, e);
+      process_edge(n, E);
       return;
     }
-    const int p = e == 0 ? 1 : 0, q = e == 2 ? 1 : 2;
+    edge_body<E>(n);
+  }
+  template <int E>
+  [[gnu::noinline]] void edge_body(const std::array<Ref, 4>& n) {
+    constexpr int p = E == 0 ? 1 : 0, q = E == 2 ? 1 : 2;
     for (int b = 0; b < 2; ++b) {
       std::array<Ref, 4> c;
-      for (int k = 0; k < 4; ++k)
-        c[k] = sub(n[k], ((1 - (k & 1)) << p) | ((1 - (k >> 1)) << q) | (b << e));
-      edge_proc(c, e);
+      for (int k = 0; k < 4; ++k) c[k] = sub(n[k], ((1 - (k & 1)) << p) | ((1 - (k >> 1)) << q) | (b << E));
+      edge_proc<E>(c);
     }
   }
 
@@ -246,8 +266,12 @@ std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
   } else {
     // Both clean: fold along the diagonal that bends most (smaller cosine between its two
     // triangles), which keeps a crease whose two vertices lie on it.
-    use_a = dot3(a0, a1) / std::sqrt(dot3(a0, a0) * dot3(a1, a1)) <=
-            dot3(b0, b1) / std::sqrt(dot3(b0, b0) * dot3(b1, b1));
+    // cos_a <= cos_b with cos = dot / sqrt(norms), compared by squares (signs first).
+    const double da = dot3(a0, a1), na = dot3(a0, a0) * dot3(a1, a1);
+    const double db = dot3(b0, b1), nb = dot3(b0, b0) * dot3(b1, b1);
+    if ((da < 0) != (db < 0)) use_a = da < 0;
+    else if (da >= 0) use_a = da * da * nb <= db * db * na;
+    else use_a = da * da * nb >= db * db * na;
   }
   if (use_a) return {{{0, 1, 2}, {0, 2, 3}}};
   return {{{0, 1, 3}, {1, 2, 3}}};
