@@ -3,12 +3,14 @@
 // touches, not the size of the object).
 //
 //   pic_sculpt INPUT.pic [--strokes 1000] [--radius 0.02] [--segments 32] [--seed 1]
-//              [--repick 50] [--out OUT.pic] [--mesh OUT.obj]
+//              [--repick 50] [--out OUT.pic] [--mesh OUT.obj] [--check]
 //
 // --radius is relative to the root cube. Stroke centres are vertices of the current contour,
 // re-extracted every --repick strokes (the contour time is not part of a stroke). Each stroke
 // samples its tool sphere into the object's cube at the object's depth (reported separately as
-// tool_sample) and then subtracts it (reported as stroke). Prints one JSON object.
+// tool_sample) and then subtracts it (reported as stroke). --check contours the object after
+// every stroke (untimed) and reports which strokes left it open or non-manifold.
+// Prints one JSON object.
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -60,7 +62,7 @@ size_t peak_rss_bytes() {
 }
 
 int usage() {
-  std::cerr << "usage: pic_sculpt INPUT.pic [--strokes N] [--radius R] [--segments S] [--seed K] [--repick M] "
+  std::cerr << "usage: pic_sculpt INPUT.pic [--strokes N] [--radius R] [--segments S] [--seed K] [--repick M] [--check] "
                "[--out OUT.pic] [--mesh OUT.obj]\n";
   return 1;
 }
@@ -69,6 +71,7 @@ int usage() {
 int main(int argc, char** argv) {
   std::string input, out, mesh_out;
   int strokes = 1000, segments = 32, repick = 50;
+  bool check = false;
   double radius = 0.02;
   unsigned seed = 1;
   for (int i = 1; i < argc; ++i) {
@@ -85,6 +88,7 @@ int main(int argc, char** argv) {
       else if (a == "--repick") repick = std::max(1, std::stoi(next()));
       else if (a == "--out") out = next();
       else if (a == "--mesh") mesh_out = next();
+      else if (a == "--check") check = true;
       else if (input.empty() && a[0] != '-') input = a;
       else return usage();
     } catch (const std::exception&) {
@@ -108,6 +112,7 @@ int main(int argc, char** argv) {
     stroke_s.reserve(strokes);
     std::vector<pic::Vec3> candidates;
     double pick_s = 0;
+    int first_open = -1, first_nonmanifold = -1, open_count = 0, nonmanifold_count = 0;
     size_t skipped = 0;
     const auto t_all = Clock::now();
     for (int s = 0; s < strokes; ++s) {
@@ -143,6 +148,17 @@ int main(int argc, char** argv) {
       contour_s.push_back(st.contour_a_seconds + st.contour_b_seconds);
       combine_s.push_back(st.csg_seconds - st.cleanup_seconds);
       cleanup_s.push_back(st.cleanup_seconds);
+      if (check) {
+        const auto topo = pic::analyze_topology(pic::contour(tree));
+        if (!topo.closed()) {
+          ++open_count;
+          if (first_open < 0) first_open = s + 1;
+        }
+        if (!topo.manifold()) {
+          ++nonmanifold_count;
+          if (first_nonmanifold < 0) first_nonmanifold = s + 1;
+        }
+      }
     }
     const double total_s = since(t_all);
     const auto stats = pic::analyze(tree);
@@ -150,6 +166,11 @@ int main(int argc, char** argv) {
     {
       const pic::TriMesh m = pic::contour(tree);
       const auto topo = pic::analyze_topology(m);
+      if (check)
+        extra += ", \"check\": {\"open_strokes\": " + std::to_string(open_count) +
+                 ", \"first_open\": " + std::to_string(first_open) +
+                 ", \"nonmanifold_strokes\": " + std::to_string(nonmanifold_count) +
+                 ", \"first_nonmanifold\": " + std::to_string(first_nonmanifold) + "}";
       extra += ", \"triangles_after\": " + std::to_string(m.triangles.size()) +
                ", \"closed_after\": " + (topo.closed() ? "true" : "false") +
                ", \"manifold_after\": " + (topo.manifold() ? "true" : "false");
