@@ -212,6 +212,141 @@ struct IslandSearch {
 
 }  // namespace
 
+namespace {
+
+/// Face `f` (axis f / 2, high side if f % 2) of a coarse gray leaf, as the finer leaves
+/// across it see it. Dual contouring gives the coarse leaf one vertex, so what those leaves
+/// show on the face must look like a face of one cell:
+/// - along each edge of the face the sign changes at most once (never when its ends agree),
+///   else the edge gets several dual polygons through the same coarse vertices (a doubled
+///   sheet, non-manifold edges);
+/// - every connected region of one sign on the face reaches a corner of the face with that
+///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
+///   vertex).
+/// Returns the lattice points to flip (as few as possible along edges; whole stray regions
+/// on the face).
+std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vector<LeafRef>& scratch) {
+  const int d = f / 2, side = f % 2;
+  const int u = d == 0 ? 1 : 0, v = d == 2 ? 1 : 2;  // in-face axes
+  const int64_t span = big.cell.span();
+  Lat lo = big.cell.lat, hi = big.cell.corner(7);
+  lo[d] = hi[d] = big.cell.lat[d] + side * span;
+  const int64_t plane = lo[d];
+  // The finer leaves are below the node across the face, if that node is subdivided.
+  Cell across = big.cell;
+  across.lat[d] += side ? span : -span;
+  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return {};
+  const LeafRef n = node_at(t, across);
+  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return {};
+  scratch.clear();
+  leaves_touching(t, n.node, n.cell, lo, hi, kMaxLevel, scratch);
+  // Points on the face (key: in-face coordinates) with their signs, and same-sign links
+  // along the edges of the finer leaves' faces.
+  std::vector<std::pair<uint64_t, bool>> pts;
+  std::vector<std::pair<uint64_t, uint64_t>> links;
+  auto key = [&](const Lat& q) { return uint64_t(q[u]) << 32 | uint64_t(q[v]); };
+  for (const LeafRef& l : scratch) {
+    if (l.cell.level <= big.cell.level) continue;
+    // On the far side of the plane, with a face inside the rectangle.
+    const int64_t s = l.cell.span();
+    const int touching = side ? 0 : 1;  // which of its own sides lies on the plane
+    if (l.cell.lat[d] + touching * s != plane) continue;
+    if (l.cell.lat[u] < lo[u] || l.cell.lat[u] + s > hi[u] || l.cell.lat[v] < lo[v] || l.cell.lat[v] + s > hi[v])
+      continue;
+    const uint8_t sg = signs_of(t.nodes[l.node]);
+    std::array<std::pair<uint64_t, bool>, 4> c4;
+    for (int k = 0; k < 4; ++k) {
+      const int c = (touching << d) | ((k & 1) << u) | ((k >> 1) << v);
+      c4[k] = {key(l.cell.corner(c)), ((sg >> c) & 1) != 0};
+      pts.push_back(c4[k]);
+    }
+    for (const auto& [a, b] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
+      if (c4[a].second == c4[b].second) links.push_back({c4[a].first, c4[b].first});
+  }
+  std::vector<Lat> flips;
+  if (pts.empty()) return flips;
+  std::sort(pts.begin(), pts.end());
+  pts.erase(std::unique(pts.begin(), pts.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+            pts.end());
+  auto index_of = [&](uint64_t k) {
+    return size_t(std::lower_bound(pts.begin(), pts.end(), std::pair{k, false}) - pts.begin());
+  };
+  auto lat_of = [&](uint64_t k) {
+    Lat q;
+    q[d] = plane;
+    q[u] = int64_t(k >> 32);
+    q[v] = int64_t(k & 0xffffffffu);
+    return q;
+  };
+  const uint8_t sb = signs_of(t.nodes[big.node]);
+  auto corner_sign = [&](int cu, int cv) {
+    const int c = (side << d) | (cu << u) | (cv << v);
+    return ((sb >> c) & 1) != 0;
+  };
+  std::vector<char> flipped(pts.size(), 0);
+  // Edges of the face: points in order along each, ends from the coarse leaf.
+  for (int e = 0; e < 4; ++e) {
+    const int along = e < 2 ? u : v, across = along == u ? v : u;
+    const int64_t fixed = (e & 1) ? hi[across] : lo[across];
+    std::vector<size_t> run;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Lat q = lat_of(pts[i].first);
+      if (q[across] == fixed && q[along] > lo[along] && q[along] < hi[along]) run.push_back(i);
+    }
+    if (run.empty()) continue;
+    std::sort(run.begin(), run.end(), [&](size_t x, size_t y) { return lat_of(pts[x].first)[along] < lat_of(pts[y].first)[along]; });
+    const int fa = across == u ? int(e & 1) : 0, fb = across == v ? int(e & 1) : 0;
+    const bool s0 = corner_sign(fa, fb);
+    const bool s1 = corner_sign(along == u ? 1 : fa, along == v ? 1 : fb);
+    // Points before the cut take s0, the rest s1: the cut needing the fewest flips.
+    size_t best_cut = 0, best = SIZE_MAX, before = 0, after = 0;
+    for (size_t i : run) after += pts[i].second != s1;
+    for (size_t cut = 0; cut <= run.size(); ++cut) {
+      if (before + after < best) {
+        best = before + after;
+        best_cut = cut;
+      }
+      if (cut < run.size()) {
+        before += pts[run[cut]].second != s0;
+        after -= pts[run[cut]].second != s1;
+      }
+    }
+    for (size_t r = 0; r < run.size(); ++r) {
+      const bool want = r < best_cut ? s0 : s1;
+      if (pts[run[r]].second != want) {
+        pts[run[r]].second = want;
+        flipped[run[r]] = 1;
+      }
+    }
+  }
+  // Regions of one sign (union-find over same-sign links, with the edge flips applied).
+  std::vector<size_t> parent(pts.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto root = [&](size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const auto& [a, b] : links) {
+    const size_t ia = index_of(a), ib = index_of(b);
+    if (pts[ia].second == pts[ib].second) parent[root(ia)] = root(ib);
+  }
+  std::vector<char> anchored(pts.size(), 0);
+  for (int c = 0; c < 4; ++c) {
+    Lat q = lo;
+    if (c & 1) q[u] = hi[u];
+    if (c & 2) q[v] = hi[v];
+    const size_t i = index_of(key(q));
+    if (i < pts.size() && pts[i].first == key(q) && pts[i].second == corner_sign(c & 1, c >> 1)) anchored[root(i)] = 1;
+  }
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (!anchored[root(i)]) flipped[i] ^= 1;
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (flipped[i]) flips.push_back(lat_of(pts[i].first));
+  return flips;
+}
+
+}  // namespace
+
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
                       const std::function<void(uint32_t)>* touched) {
   IslandSearch search{t, {}, {}};
@@ -223,6 +358,19 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   auto flip = [&](const Lat& p) {
     flip_point(t, p, touched);
     ++flipped;
+  };
+  // Faces of coarse gray leaves with finer leaves across them, checked at the end.
+  std::vector<std::pair<LeafRef, int>> faces;
+  auto queue_faces = [&](const LeafRef& big, const Lat& lo, const Lat& hi) {
+    const int64_t s = big.cell.span();
+    for (int f = 0; f < 6; ++f) {
+      const int d = f / 2;
+      const int64_t plane = big.cell.lat[d] + (f % 2) * s;
+      bool meets = lo[d] <= plane && plane <= hi[d];
+      for (int k = 0; k < 3 && meets; ++k)
+        if (k != d) meets = big.cell.lat[k] < hi[k] && lo[k] < big.cell.lat[k] + s;
+      if (meets) faces.push_back({big, f});
+    }
   };
   // A fine active leaf's corners against the coarser leaves around them (an old coarse
   // leaf next to new fine ones)...
@@ -238,6 +386,8 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     const Lat lo = cell.lat, hi = cell.corner(7);
     const LeafRef from = search.start_for(l, lo, hi, true);
     leaves_touching(t, from.node, from.cell, lo, hi, cell.level - 1, near);
+    for (const LeafRef& big : near)
+      if (t.nodes[big.node].kind == CellKind::Gray) queue_faces(big, lo, hi);
     for (int k = 0; k < 8; ++k) {
       const Lat p = cell.corner(k);
       const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
@@ -268,6 +418,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
         const Lat across_hi = across.corner(7);
         const LeafRef n = search.node_below(search.start_for(l, across.lat, across_hi, false), across);
         if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
+        if (t.nodes[big].kind == CellKind::Gray) faces.push_back({{big, cell}, 2 * d + side});
         const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
         // Leaves of the finer side touching the shared face, and their corners on it.
         std::function<void(uint32_t, const Cell&)> visit = [&](uint32_t node, const Cell& c) {
@@ -289,6 +440,21 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
         visit(n.node, n.cell);
       }
   }
+  // ... and what the finer side shows on each coarse face (edges, stray regions).
+  auto check_faces = [&] {
+    std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
+      return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
+    });
+    faces.erase(std::unique(faces.begin(), faces.end(),
+                            [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
+                faces.end());
+    for (const auto& [big, f] : faces) {
+      if (t.nodes[big.node].kind != CellKind::Gray) continue;
+      for (const Lat& p : face_flips(t, big, f, near)) flip(p);
+    }
+    faces.clear();
+  };
+  check_faces();
   return flipped;
 }
 

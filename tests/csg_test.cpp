@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
 #include <functional>
 #include <vector>
 
@@ -391,6 +392,27 @@ size_t cells_for_stroke(const Octree& object, const Vec3& at, double radius, int
   Octree r = csg(object, tool, CsgOp::Subtract, {}, &st);
   EXPECT_TRUE(IsClosedManifold(contour(r)));
   return st.cells_visited;
+}
+
+// Sculpting: many small in-place subtractions where coarse old leaves meet the new fine ones.
+// Each result must stay closed and 2-manifold (a coarse leaf whose face or edge the finer side
+// sees with extra sign regions would get a doubled sheet or a pinched vertex).
+TEST(Csg, SculptingStaysClosedAndManifold) {
+  const int depth = 12;
+  Octree clay = sample_in_unit(axis_box({0.1, 0.25, 0.42}, {0.9, 0.75, 0.58}).mesh(), depth);
+  csg_inplace(clay, sample_in_unit(make_sphere({0.3, 0.5, 0.6}, 0.12, 48), depth), CsgOp::Subtract);
+  std::mt19937_64 rng(1);
+  int bad = 0;
+  for (int stroke = 0; stroke < 40; ++stroke) {
+    const TriMesh surface = contour(clay);
+    const Vec3 c = surface.positions[std::uniform_int_distribution<size_t>(0, surface.positions.size() - 1)(rng)];
+    csg_inplace(clay, sample_in_unit(make_sphere(c, 0.02, 24), depth), CsgOp::Subtract);
+    const TriMesh m = contour(clay);
+    const auto topo = analyze_topology(m);
+    EXPECT_TRUE(topo.closed()) << "stroke " << stroke;
+    if (!topo.manifold()) ++bad;
+  }
+  EXPECT_EQ(bad, 0) << "strokes leaving non-manifold results";
 }
 
 TEST(Csg, CostFollowsTheOverlapNotTheObject) {
