@@ -75,20 +75,14 @@ struct Around {
   int corner;
   Cell cell;
 };
-/// `on_coarse` (optional) is set when p lies inside a face or edge of a coarser leaf.
-std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr,
-                                  bool* on_coarse = nullptr) {
+std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr) {
   std::vector<Around> out;
-  if (on_coarse) *on_coarse = false;
   for (int o = 0; o < 8; ++o) {
     Lat q;
     if (!octant_cell(p, o, q)) continue;
     const LeafRef l = leaf_at(t, q, path);
     const int c = l.cell.corner_index(p);
-    if (c < 0) {
-      if (on_coarse) *on_coarse = true;
-      continue;
-    }
+    if (c < 0) continue;
     bool seen = false;
     for (const auto& a : out) seen = seen || a.node == l.node;
     if (!seen) out.push_back({l.node, c, l.cell});
@@ -491,14 +485,10 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
       const bool minority_inside = __builtin_popcount(s) <= 4;
       for (int k = 0; k < 8; ++k) {
         if (multi(uint8_t(s ^ (1 << k)))) continue;
-        bool on_coarse = false;
-        const auto around = leaves_around(t, l.cell.corner(k), nullptr, &on_coarse);
+        const auto around = leaves_around(t, l.cell.corner(k));
         int cost = 0;
         for (const auto& a : around) cost += 2 * multi(uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner)));
         cost += (((s >> k) & 1) != 0) != minority_inside;
-        // A point on a coarser leaf's face or edge is what that leaf's one vertex must agree
-        // with (remove_islands set it so): flip it only when nothing else will do.
-        cost += 3 * on_coarse;
         if (cost < best_cost) {
           best_cost = cost;
           best = k;
