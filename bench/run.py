@@ -31,6 +31,7 @@ MANIFOLD = os.path.join("bench", "manifold_peer.mjs")
 
 REPS = int(os.environ.get("PIC_BENCH_REPS", "5"))
 STROKES = int(os.environ.get("PIC_BENCH_STROKES", "1000"))
+CHECK_STROKES = int(os.environ.get("PIC_BENCH_CHECK_STROKES", "300"))
 VOXELS = os.environ.get("PIC_BENCH_VDB_VOXELS", "1/1024 1/2048").split()
 SUBDIV = int(os.environ.get("PIC_BENCH_SUBDIV", "4"))
 RUN_MICRO = os.environ.get("PIC_BENCH_MICRO", "1") != "0"
@@ -354,6 +355,12 @@ def sculpt():
                      "--seed", "1", "--out", os.path.join(OUT, "sculpted.pic")], "sculpt", timeout=max(TIMEOUT, 900))
     j["peak_rss_bytes_wait4"] = rss
     results["sculpt"] = j
+    # Topology after every stroke (contoured, untimed) over the first CHECK_STROKES strokes.
+    c, _, _ = run([SCULPT, os.path.join(IN, "slab_carved.pic"), "--strokes", str(CHECK_STROKES), "--radius", "0.02",
+                   "--seed", "1", "--check"], "sculpt_check", timeout=max(TIMEOUT, 900))
+    results["sculpt_check"] = dict(c["check"], strokes=c["strokes"])
+    log("checked %d strokes one by one: %d left the object open, %d non-manifold (first at stroke %d)"
+        % (c["strokes"], c["check"]["open_strokes"], c["check"]["nonmanifold_strokes"], c["check"]["first_nonmanifold"]))
     log("%d strokes (sphere r 0.02, depth %d): stroke (csg_inplace) median %.3f ms, p95 %.3f ms; tool sampling median %.3f ms; "
         "cells visited median %d, p95 %d; PICs %d -> %d; contour after: %s; peak %.0f MB"
         % (j["strokes"], j["depth"], j["stroke_ms"]["median"], j["stroke_ms"]["p95"], j["tool_sample_ms"]["median"],
@@ -472,6 +479,13 @@ def report():
         md.append("Stroke = `pic::csg_inplace(object, tool, Subtract)`; the tool sphere (32 segments) is sampled per stroke "
                   "and timed separately. Centres: random vertices of the current contour, re-extracted every 50 strokes.")
         md.append("")
+        chk = r.get("sculpt_check")
+        if chk:
+            md.append("Checked one by one (`pic_sculpt ... --strokes %d --check`, same seed): %d strokes left the object "
+                      "open; %d left it non-manifold, the first at stroke %s (a defect stays until a later stroke carves "
+                      "it away)." % (chk["strokes"], chk["open_strokes"], chk["nonmanifold_strokes"],
+                                     chk["first_nonmanifold"] if chk["first_nonmanifold"] > 0 else "—"))
+            md.append("")
     if r.get("micro"):
         md.append("### Micro-benchmarks (`pic_bench`, Google Benchmark)")
         md.append("")
@@ -541,9 +555,9 @@ def main():
     section("micro-benchmarks", micro)
     results["meta"]["loadavg_end"] = loadavg()
     results["meta"]["total_seconds"] = time.monotonic() - t0
-    md = report()
-    with open(os.path.join(OUT, "results.json"), "w") as f:
+    with open(os.path.join(OUT, "results.json"), "w") as f:  # first: kept even if the report fails
         json.dump(results, f, indent=1)
+    md = report()
     with open(os.path.join(OUT, "results.md"), "w") as f:
         f.write(md + "\n")
     log("\n" + md)
