@@ -869,9 +869,10 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
+  PinnedPoints pinned;
   for (int round = 0; round < 4; ++round) {
-    const size_t islands = remove_islands(a, &stamped, &stamp_it);
-    if (enforce_one_component(a, &stamped, &stamp_it).flipped == 0 && (islands == 0 || round > 0)) break;
+    const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
+    if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);

@@ -348,7 +348,7 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
 }  // namespace
 
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
-                      const std::function<void(uint32_t)>* touched) {
+                      const std::function<void(uint32_t)>* touched, PinnedPoints* pinned) {
   IslandSearch search{t, {}, {}};
   {
     std::vector<uint32_t> path;
@@ -357,6 +357,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   size_t flipped = 0;
   auto flip = [&](const Lat& p) {
     flip_point(t, p, touched);
+    if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
   };
   // Faces of coarse gray leaves with finer leaves across them, checked at the end.
@@ -459,7 +460,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
 }
 
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched) {
+                                  const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned) {
   TopologyFix fix;
   for (int pass = 0; pass < 6; ++pass) {
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
@@ -489,6 +490,8 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         int cost = 0;
         for (const auto& a : around) cost += 2 * multi(uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner)));
         cost += (((s >> k) & 1) != 0) != minority_inside;
+        // Undoing what remove_islands just set would bring its defect back.
+        if (pinned && pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;
         if (cost < best_cost) {
           best_cost = cost;
           best = k;

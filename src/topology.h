@@ -5,12 +5,21 @@
 // than the finest cell, which the octree cannot represent anyway.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
+#include <unordered_set>
 
 #include "octree_util.h"
 
 namespace pic::detail {
+
+/// Lattice points (key: x | y << 21 | z << 42) that remove_islands set in this operation, which
+/// enforce_one_component should not flip back when anything else will do.
+using PinnedPoints = std::unordered_set<uint64_t>;
+inline uint64_t lattice_key(const std::array<int64_t, 3>& p) {
+  return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42;
+}
 
 struct TopologyFix {
   size_t flipped = 0;    // lattice points whose sign changed
@@ -20,14 +29,15 @@ struct TopologyFix {
 /// Works on the leaves for which `active` is true (all leaves when null); `touched` is called
 /// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched = nullptr);
+                                  const std::function<void(uint32_t)>* touched = nullptr,
+                                  const PinnedPoints* pinned = nullptr);
 
 /// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
 /// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
 /// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
 /// to match, in every leaf that has it as a corner. Returns how many points changed.
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
-                      const std::function<void(uint32_t)>* touched = nullptr);
+                      const std::function<void(uint32_t)>* touched = nullptr, PinnedPoints* pinned = nullptr);
 
 /// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
 /// edges' midpoint), so the contour stays closed. Returns how many leaves changed.
