@@ -166,11 +166,33 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
                          const Cell& cell, uint8_t signs) {
   const I3 lo = lattice_to_grid(cell.lat);
   const int64_t s = lattice_to_grid(cell.span());
+  // Bounding boxes first: an edge needs 2 (3 with a sign change) triangles whose boxes reach
+  // its line before the exact count can get there.
+  std::array<int, 12> candidates{};
+  for (uint32_t k : idx) {
+    const ITri& t = tris[k];
+    std::array<unsigned, 3> on{};  // bit b: the line at lo + b s crosses the box (half-open)
+    std::array<bool, 3> spans{};
+    for (int d = 0; d < 3; ++d) {
+      for (int b = 0; b < 2; ++b) {
+        const i64 x = lo[d] + b * s;
+        on[d] |= unsigned(x >= t.lo[d] && x < t.hi[d]) << b;
+      }
+      spans[d] = lo[d] + s >= t.lo[d] && lo[d] <= t.hi[d];
+    }
+    for (int e = 0; e < 12; ++e) {
+      const int c0 = kEdgeCorners[e][0], axis = edge_axis(e);
+      const int i = axis == 0 ? 1 : 0, j = axis == 2 ? 1 : 2;
+      candidates[e] += spans[axis] && ((on[i] >> ((c0 >> i) & 1)) & 1) && ((on[j] >> ((c0 >> j) & 1)) & 1);
+    }
+  }
   for (int e = 0; e < 12; ++e) {
     const int c0 = kEdgeCorners[e][0];
-    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
     const bool change = ((signs >> c0) ^ (signs >> kEdgeCorners[e][1])) & 1;
-    if (count_crossings(tris, idx, a, edge_axis(e), s) >= (change ? 3 : 2)) return true;
+    const int needed = change ? 3 : 2;
+    if (candidates[e] < needed) continue;
+    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
+    if (count_crossings(tris, idx, a, edge_axis(e), s) >= needed) return true;
   }
   return false;
 }
