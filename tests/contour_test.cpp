@@ -1,6 +1,7 @@
 // Dual contouring (pic::contour) on hand-built octrees whose output can be counted by hand,
 // and on sampled boxes where the result is geometrically forced.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -277,6 +278,21 @@ TEST(Contour, VerticesAreTheLeafVertices) {
   });
   EXPECT_EQ(vertex_set(m), leaves);
   EXPECT_EQ(m.positions.size(), leaves.size()) << "each vertex emitted once";
+}
+
+// Determinism: the 9 contouring tasks are concatenated in a fixed order, so one thread and
+// all threads give the same mesh, vertex for vertex.
+TEST(Contour, OneThreadEqualsAllThreads) {
+  const Octree t = sample(read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj"), SampleOptions{});
+  const TriMesh all = contour(t);
+  TriMesh one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = contour(t);
+  }
+  ASSERT_GT(all.triangles.size(), 10000u);
+  EXPECT_TRUE(one.positions == all.positions);
+  EXPECT_TRUE(one.triangles == all.triangles);
 }
 
 }  // namespace
