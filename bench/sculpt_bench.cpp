@@ -9,7 +9,8 @@
 // re-extracted every --repick strokes (the contour time is not part of a stroke). Each stroke
 // samples its tool sphere into the object's cube at the object's depth (reported separately as
 // tool_sample) and then subtracts it (reported as stroke). --check contours the object after
-// every stroke (untimed) and reports which strokes left it open or non-manifold.
+// every stroke (untimed) and reports which strokes left it open or non-manifold, and after
+// how many the contour stays non-manifold even after pic::split_nonmanifold.
 // Prints one JSON object.
 #include <sys/resource.h>
 
@@ -112,7 +113,7 @@ int main(int argc, char** argv) {
     stroke_s.reserve(strokes);
     std::vector<pic::Vec3> candidates;
     double pick_s = 0;
-    int first_open = -1, first_nonmanifold = -1, open_count = 0, nonmanifold_count = 0;
+    int first_open = -1, first_nonmanifold = -1, open_count = 0, nonmanifold_count = 0, unsplittable_count = 0;
     size_t skipped = 0;
     const auto t_all = Clock::now();
     for (int s = 0; s < strokes; ++s) {
@@ -149,7 +150,12 @@ int main(int argc, char** argv) {
       combine_s.push_back(st.csg_seconds - st.cleanup_seconds);
       cleanup_s.push_back(st.cleanup_seconds);
       if (check) {
-        const auto topo = pic::analyze_topology(pic::contour(tree));
+        pic::TriMesh m = pic::contour(tree);
+        const auto topo = pic::analyze_topology(m);
+        if (!topo.manifold()) {
+          pic::split_nonmanifold(m);
+          if (!pic::analyze_topology(m).manifold()) ++unsplittable_count;
+        }
         if (!topo.closed()) {
           ++open_count;
           if (first_open < 0) first_open = s + 1;
@@ -164,16 +170,20 @@ int main(int argc, char** argv) {
     const auto stats = pic::analyze(tree);
     std::string extra;
     {
-      const pic::TriMesh m = pic::contour(tree);
+      pic::TriMesh m = pic::contour(tree);
       const auto topo = pic::analyze_topology(m);
+      const size_t split = pic::split_nonmanifold(m);
       if (check)
         extra += ", \"check\": {\"open_strokes\": " + std::to_string(open_count) +
                  ", \"first_open\": " + std::to_string(first_open) +
                  ", \"nonmanifold_strokes\": " + std::to_string(nonmanifold_count) +
-                 ", \"first_nonmanifold\": " + std::to_string(first_nonmanifold) + "}";
+                 ", \"first_nonmanifold\": " + std::to_string(first_nonmanifold) +
+                 ", \"nonmanifold_after_split_strokes\": " + std::to_string(unsplittable_count) + "}";
       extra += ", \"triangles_after\": " + std::to_string(m.triangles.size()) +
                ", \"closed_after\": " + (topo.closed() ? "true" : "false") +
-               ", \"manifold_after\": " + (topo.manifold() ? "true" : "false");
+               ", \"manifold_after\": " + (topo.manifold() ? "true" : "false") +
+               ", \"split_vertices_after\": " + std::to_string(split) +
+               ", \"manifold_after_split\": " + (pic::analyze_topology(m).manifold() ? "true" : "false");
       if (!mesh_out.empty()) pic::write_mesh(m, mesh_out);
     }
     if (!out.empty()) pic::save(tree, out);

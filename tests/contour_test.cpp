@@ -295,5 +295,47 @@ TEST(Contour, OneThreadEqualsAllThreads) {
   EXPECT_TRUE(one.triangles == all.triangles);
 }
 
+// ---- split_nonmanifold -------------------------------------------------------------------------
+
+/// Two meshes in one, with positions merged exactly (so touching boxes share vertices).
+TriMesh merged(const TriMesh& a, const TriMesh& b) {
+  TriMesh m = a;
+  std::vector<uint32_t> map;
+  for (const Vec3& p : b.positions) {
+    const auto it = std::find(m.positions.begin(), m.positions.end(), p);
+    map.push_back(static_cast<uint32_t>(it - m.positions.begin()));
+    if (it == m.positions.end()) m.positions.push_back(p);
+  }
+  for (const auto& t : b.triangles) m.triangles.push_back({map[t[0]], map[t[1]], map[t[2]]});
+  return m;
+}
+
+TEST(SplitNonmanifold, BoxesTouchingAlongAnEdgeBecomeTwoSheets) {
+  // Diagonal neighbours share the edge x = y = 1: four triangles on it.
+  TriMesh m = merged(make_box({0, 0, 0}, {1, 1, 1}), make_box({1, 1, 0}, {2, 2, 1}));
+  ASSERT_GT(analyze_topology(m).nonmanifold_edges, 0u);
+  const double v = volume(m);
+  const size_t before = m.positions.size();
+  EXPECT_EQ(split_nonmanifold(m), 2u);  // one copy of each end of the shared edge
+  EXPECT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.positions.size(), before + 2);
+  EXPECT_NEAR(volume(m), v, 1e-12);
+}
+
+TEST(SplitNonmanifold, BoxesTouchingAtAVertexBecomeTwoSheets) {
+  TriMesh m = merged(make_box({0, 0, 0}, {1, 1, 1}), make_box({1, 1, 1}, {2, 2, 2}));
+  ASSERT_FALSE(analyze_topology(m).manifold());
+  EXPECT_EQ(split_nonmanifold(m), 1u);
+  EXPECT_TRUE(IsClosedManifold(m));
+}
+
+TEST(SplitNonmanifold, ManifoldMeshIsUnchanged) {
+  TriMesh m = make_sphere({0, 0, 0}, 1, 16);
+  const TriMesh before = m;
+  EXPECT_EQ(split_nonmanifold(m), 0u);
+  EXPECT_TRUE(m.positions == before.positions);
+  EXPECT_TRUE(m.triangles == before.triangles);
+}
+
 }  // namespace
 }  // namespace pic

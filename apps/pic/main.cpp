@@ -197,10 +197,12 @@ int main(int argc, char** argv) {
   // mesh
   auto* cmd_mesh = app.add_subcommand("mesh", "Extract the surface of a PIC object");
   std::string m_in, m_out;
-  bool m_json = false;
+  bool m_json = false, m_no_split = false;
   cmd_mesh->add_option("input", m_in, "Input .pic file")->required();
   cmd_mesh->add_option("-o,--output", m_out, "Output mesh (.obj, .stl, .ply, .off, .glb)")->required();
   cmd_mesh->add_flag("--json", m_json, "Print one JSON object on stdout");
+  cmd_mesh->add_flag("--no-split", m_no_split,
+                     "Write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
 
   // info
   auto* cmd_info = app.add_subcommand("info", "Cells per level, PIC count, bytes, bounding box");
@@ -316,8 +318,9 @@ int main(int argc, char** argv) {
     } else if (*cmd_mesh) {
       const pic::Octree tree = pic::load(m_in);
       const auto t0 = Clock::now();
-      const pic::TriMesh mesh = pic::contour(tree);
+      pic::TriMesh mesh = pic::contour(tree);
       const double secs = since(t0);
+      const size_t split = m_no_split ? 0 : pic::split_nonmanifold(mesh);
       pic::write_mesh(mesh, m_out);
       const auto topo = pic::analyze_topology(mesh);
       if (m_json) {
@@ -325,6 +328,7 @@ int main(int argc, char** argv) {
                          .add("vertices", mesh.positions.size())
                          .add("triangles", mesh.triangles.size())
                          .add("seconds", secs)
+                         .add("split_vertices", split)
                          .add("volume", pic::volume(mesh))
                          .raw("topology", topology_json(topo))
                          .str()
@@ -390,9 +394,11 @@ int main(int argc, char** argv) {
       const size_t pics = pic::analyze(acc).pics;
       j.add("pics", pics).add("seconds", secs).raw("ops", ops);
       if (!c_mesh.empty()) {
-        const pic::TriMesh mesh = pic::contour(acc);
+        pic::TriMesh mesh = pic::contour(acc);
+        const size_t split = pic::split_nonmanifold(mesh);
         pic::write_mesh(mesh, c_mesh);
-        j.add("triangles", mesh.triangles.size()).raw("topology", topology_json(pic::analyze_topology(mesh)));
+        j.add("triangles", mesh.triangles.size()).add("split_vertices", split)
+            .raw("topology", topology_json(pic::analyze_topology(mesh)));
       }
       if (c_json) std::cout << j.str() << "\n";
       else std::printf("%zu PICs -> %s\n", pics, c_out.c_str());

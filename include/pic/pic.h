@@ -174,6 +174,16 @@ struct MeshTopology {
   }
 };
 MeshTopology analyze_topology(const TriMesh& mesh);
+
+/// Makes a closed mesh 2-manifold where it touches itself: an edge with four or more
+/// triangles (sheets meeting along a line) or a vertex whose triangles form several fans
+/// (sheets meeting at a point) gets one copy of its vertices per sheet; the copies coincide.
+/// Around such an edge, triangles are paired so that each pair bounds one wedge of the solid
+/// (solids that touch stay apart), or else one wedge of the outside, whichever makes the whole
+/// mesh manifold. Dual contouring leaves these spots where a feature is finer than a coarse
+/// neighbouring cell (see docs/algorithms.md). Returns how many vertices were added; a mesh
+/// that is already manifold, or that neither pairing repairs, is left unchanged (0).
+size_t split_nonmanifold(TriMesh& mesh);
 /// Signed volume (positive for outward orientation).
 double volume(const TriMesh& mesh);
 
