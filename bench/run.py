@@ -476,7 +476,7 @@ def report():
             s["stroke_ms"]["median"], s["stroke_ms"]["p95"], s["tool_sample_ms"]["median"], s["cells_visited"]["median"],
             s["cells_visited"]["p95"], s["pics_before"], s["pics_after"],
             "closed manifold" if s["manifold_after"] else (
-                ("closed, NOT manifold (manifold after splitting %d vertices)" % s.get("split_vertices_after", 0))
+                ("closed, NOT manifold; manifold after `split_nonmanifold` (%d vertex copies)" % s.get("split_vertices_after", 0))
                 if s.get("manifold_after_split") else ("closed, NOT manifold" if s["closed_after"] else "NOT closed")),
             mb(s["peak_rss_bytes_wait4"])))
         md.append("")
