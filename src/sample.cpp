@@ -14,6 +14,28 @@ namespace pic::detail {
 
 namespace {
 
+/// Which axis-parallel grid lines a triangle's bounding box lets it cross: lines at
+/// base + b step (b < count) on each axis, for segments from base to base + step along it.
+struct LineMask {
+  std::array<unsigned, 3> on{};  // bit b of on[d]: coordinate base[d] + b step within [lo, hi)
+  std::array<bool, 3> spans{};   // segments along axis d overlap the box
+  /// A segment along `axis` at grid steps ci (axis i) and cj (axis j), i < j the other two.
+  bool may_cross(int axis, int i, int ci, int j, int cj) const {
+    return spans[axis] && ((on[i] >> ci) & 1) && ((on[j] >> cj) & 1);
+  }
+};
+LineMask line_mask(const ITri& t, const I3& base, i64 step, int count) {
+  LineMask m;
+  for (int d = 0; d < 3; ++d) {
+    for (int b = 0; b < count; ++b) {
+      const i64 x = base[d] + b * step;
+      m.on[d] |= unsigned(x >= t.lo[d] && x < t.hi[d]) << b;
+    }
+    m.spans[d] = base[d] + step >= t.lo[d] && base[d] <= t.hi[d];
+  }
+  return m;
+}
+
 /// The 19 segments that carry signs from a cell's corners to the rest of its child grid: grid
 /// point `to` is reached from `from` along `axis`; the segment's other two coordinates are
 /// grid steps `ci` (axis i) and `cj` (axis j), i < j. Ordered so that `from` is always known.
@@ -47,17 +69,9 @@ void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&
   uint32_t parity = 0;
   for (uint32_t k : idx) {
     const ITri& t = (*tris_)[k];
-    std::array<unsigned, 3> on{};  // bit b: grid line coordinate base + b h within [lo, hi)
-    std::array<bool, 3> spans{};   // the segments along this axis overlap the triangle's box
-    for (int d = 0; d < 3; ++d) {
-      for (int b = 0; b < 3; ++b) {
-        const i64 x = base[d] + b * h;
-        on[d] |= unsigned(x >= t.lo[d] && x < t.hi[d]) << b;
-      }
-      spans[d] = base[d] + h >= t.lo[d] && base[d] <= t.hi[d];
-    }
+    const LineMask mask = line_mask(t, base, h, 3);
     for (const GridSegment& s : kGridSegments) {
-      if (!spans[s.axis] || !((on[s.i] >> s.ci) & 1) || !((on[s.j] >> s.cj) & 1)) continue;
+      if (!mask.may_cross(s.axis, s.i, s.ci, s.j, s.cj)) continue;
       I3 start = base;
       start[s.i] += s.ci * h;
       start[s.j] += s.cj * h;
@@ -170,20 +184,11 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
   // its line before the exact count can get there.
   std::array<int, 12> candidates{};
   for (uint32_t k : idx) {
-    const ITri& t = tris[k];
-    std::array<unsigned, 3> on{};  // bit b: the line at lo + b s crosses the box (half-open)
-    std::array<bool, 3> spans{};
-    for (int d = 0; d < 3; ++d) {
-      for (int b = 0; b < 2; ++b) {
-        const i64 x = lo[d] + b * s;
-        on[d] |= unsigned(x >= t.lo[d] && x < t.hi[d]) << b;
-      }
-      spans[d] = lo[d] + s >= t.lo[d] && lo[d] <= t.hi[d];
-    }
+    const LineMask mask = line_mask(tris[k], lo, s, 2);
     for (int e = 0; e < 12; ++e) {
       const int c0 = kEdgeCorners[e][0], axis = edge_axis(e);
       const int i = axis == 0 ? 1 : 0, j = axis == 2 ? 1 : 2;
-      candidates[e] += spans[axis] && ((on[i] >> ((c0 >> i) & 1)) & 1) && ((on[j] >> ((c0 >> j) & 1)) & 1);
+      candidates[e] += mask.may_cross(axis, i, (c0 >> i) & 1, j, (c0 >> j) & 1);
     }
   }
   for (int e = 0; e < 12; ++e) {
