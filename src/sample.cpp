@@ -81,12 +81,12 @@ void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&
   for (const GridSegment& s : kGridSegments) g[s.to] = g[s.from] ^ ((parity >> s.to) & 1);
 }
 
-bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q) {
-  return box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
+  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
 }
 
-bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
+void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
              double face, Qef& q) {
   // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
@@ -107,7 +107,6 @@ bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
     for (uint32_t k : idx)
       if (!is_degenerate(tris[k])) add(tris[k], kFloor);
   }
-  return any;
 }
 
 bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell) {

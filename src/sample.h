@@ -45,11 +45,11 @@ struct SampleParams {
 
 /// QEF of the triangles meeting `cell` (weights: clipped area / cell face area + a floor, so
 /// planes that touch the cell only along its boundary still count — box corners on octree
-/// planes need them). Returns whether any triangle meets the cell.
-bool cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+/// planes need them).
+void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q);
 /// The same over an arbitrary box; `face_area` normalizes the weights (unit-space area).
-bool box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
+void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
              double face_area, Qef& q);
 
 /// Whether any triangle of `idx` meets the cell under the perturbation convention (a triangle
