@@ -240,8 +240,8 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
   if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return {};
   scratch.clear();
   leaves_touching(t, n.node, n.cell, lo, hi, kMaxLevel, scratch);
-  // Points on the face (key: in-face coordinates) with their signs, and same-sign links
-  // along the edges of the finer leaves' faces.
+  // Points on the face (key: in-face coordinates) with their signs, and links along the edges
+  // of the finer leaves' faces (which join a region once the edge pass below has set signs).
   std::vector<std::pair<uint64_t, bool>> pts;
   std::vector<std::pair<uint64_t, uint64_t>> links;
   auto key = [&](const Lat& q) { return uint64_t(q[u]) << 32 | uint64_t(q[v]); };
@@ -261,7 +261,7 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
       pts.push_back(c4[k]);
     }
     for (const auto& [a, b] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
-      if (c4[a].second == c4[b].second) links.push_back({c4[a].first, c4[b].first});
+      links.push_back({c4[a].first, c4[b].first});
   }
   std::vector<Lat> flips;
   if (pts.empty()) return flips;
@@ -442,20 +442,16 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
       }
   }
   // ... and what the finer side shows on each coarse face (edges, stray regions).
-  auto check_faces = [&] {
-    std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
-      return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
-    });
-    faces.erase(std::unique(faces.begin(), faces.end(),
-                            [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
-                faces.end());
-    for (const auto& [big, f] : faces) {
-      if (t.nodes[big.node].kind != CellKind::Gray) continue;
-      for (const Lat& p : face_flips(t, big, f, near)) flip(p);
-    }
-    faces.clear();
-  };
-  check_faces();
+  std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
+    return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
+  });
+  faces.erase(std::unique(faces.begin(), faces.end(),
+                          [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
+              faces.end());
+  for (const auto& [big, f] : faces) {
+    if (t.nodes[big.node].kind != CellKind::Gray) continue;
+    for (const Lat& p : face_flips(t, big, f, near)) flip(p);
+  }
   return flipped;
 }
 
