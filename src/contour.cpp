@@ -218,7 +218,6 @@ struct MeshVisitor {
   std::vector<Tri>& tris;
 
   static bool active(uint32_t) { return true; }
-  void crack(const LevelRef&, const LevelRef&, int, int) {}
   void polygon(const std::array<LevelRef, 4>& r, int count) {
     std::array<uint32_t, 4> v;
     for (int k = 0; k < count; ++k) v[k] = nodes[r[k].node].index;

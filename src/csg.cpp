@@ -34,7 +34,6 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 std::atomic<uint32_t> g_timestamp{0};
 
-uint64_t lat_key(const Lat& p) { return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42; }
 
 bool apply(CsgOp op, bool a, bool b) {
   switch (op) {
@@ -194,7 +193,7 @@ struct Operand {
   bool sign(const Lat& p) {
     // Every lattice point is asked for by up to 8 cells: remember all answers, not only the
     // ones that needed a parity walk.
-    const uint64_t key = lat_key(p);
+    const uint64_t key = lattice_key(p);
     if (const int m = memo.find(key); m >= 0) return m;
     const Hit h = find(0, Cell{}, p);
     if (h.state != 2) {
@@ -210,14 +209,14 @@ struct Operand {
     const int64_t s = cell.span();
     for (int k = 0; k < 3; ++k)
       if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return sign(p);
-    if (const int m = memo.find(lat_key(p)); m >= 0) return m;
+    if (const int m = memo.find(lattice_key(p)); m >= 0) return m;
     return classify(p, leaf, cell);
   }
 
   /// Parity walk for p in gray leaf `leaf` (callers have checked the memo).
   bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
     const Hit h{2, false, leaf, cell};
-    const uint64_t key = lat_key(p);
+    const uint64_t key = lattice_key(p);
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
     const auto& idx = triangles_in(h.leaf, h.cell);

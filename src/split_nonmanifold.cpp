@@ -167,11 +167,12 @@ void drop_flat_pockets(TriMesh& m) {
 
 size_t split_nonmanifold(TriMesh& m) {
   if (analyze_topology(m).manifold()) return 0;
+  TriMesh base = m;
+  drop_flat_pockets(base);
   // The two pairings around a crowded edge are both manifold there; which one also gives
   // consistent fans at its end vertices depends on the neighbourhood, so try both.
   for (const bool solids_apart : {true, false}) {
-    TriMesh c = m;
-    drop_flat_pockets(c);
+    TriMesh c = base;
     const size_t added = split_sheets(c, solids_apart);
     if (analyze_topology(c).manifold()) {
       m = std::move(c);

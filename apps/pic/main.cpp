@@ -215,11 +215,13 @@ int main(int argc, char** argv) {
   auto* cmd_csg = app.add_subcommand("csg", "Booleans on PIC objects, left to right: A union|intersect|subtract B ...");
   std::vector<std::string> c_args;
   std::string c_out, c_mesh;
-  bool c_json = false;
+  bool c_json = false, c_no_split = false;
   double c_error = 1e-8;
   cmd_csg->add_option("args", c_args, "A.pic OP B.pic [OP C.pic ...]")->required();
   cmd_csg->add_option("-o,--output", c_out, "Output .pic file")->required();
   cmd_csg->add_option("--mesh", c_mesh, "Also contour the result to this mesh file");
+  cmd_csg->add_flag("--no-split", c_no_split,
+                    "With --mesh: write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   cmd_csg->add_option("--error", c_error, "QEF residual threshold for new vertices")->capture_default_str();
   cmd_csg->add_flag("--json", c_json, "Print one JSON object on stdout");
 
@@ -395,7 +397,7 @@ int main(int argc, char** argv) {
       j.add("pics", pics).add("seconds", secs).raw("ops", ops);
       if (!c_mesh.empty()) {
         pic::TriMesh mesh = pic::contour(acc);
-        const size_t split = pic::split_nonmanifold(mesh);
+        const size_t split = c_no_split ? 0 : pic::split_nonmanifold(mesh);
         pic::write_mesh(mesh, c_mesh);
         j.add("triangles", mesh.triangles.size()).add("split_vertices", split)
             .raw("topology", topology_json(pic::analyze_topology(mesh)));

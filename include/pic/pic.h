@@ -181,8 +181,9 @@ MeshTopology analyze_topology(const TriMesh& mesh);
 /// Around such an edge, triangles are paired so that each pair bounds one wedge of the solid
 /// (solids that touch stay apart), or else one wedge of the outside, whichever makes the whole
 /// mesh manifold. Dual contouring leaves these spots where a feature is finer than a coarse
-/// neighbouring cell (see docs/algorithms.md). Returns how many vertices were added; a mesh
-/// that is already manifold, or that neither pairing repairs, is left unchanged (0).
+/// neighbouring cell (see docs/algorithms.md). Zero-volume pockets (two opposite triangles on
+/// the same vertices) are dropped. Returns how many vertices were added; a mesh that is
+/// already manifold, or that neither pairing repairs, is left unchanged (and 0 returned).
 size_t split_nonmanifold(TriMesh& mesh);
 /// Signed volume (positive for outward orientation).
 double volume(const TriMesh& mesh);
