@@ -1,4 +1,5 @@
 #include "contour.h"
+#include "vec3.h"
 
 #include <tbb/parallel_for.h>
 
@@ -202,11 +203,6 @@ struct CallbackVisitor {
   }
 };
 
-inline Vec3 sub3(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline Vec3 cross3(const Vec3& u, const Vec3& v) {
-  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-}
-inline double dot3(const Vec3& x, const Vec3& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; }
 
 /// Whole-contour visitor: triangles as triples of the tree's vertex indices, positions
 /// looked up from a per-vertex table.

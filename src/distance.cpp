@@ -8,19 +8,18 @@
 #include <numeric>
 
 #include "geometry.h"
+#include "vec3.h"
 #include "pic/pic.h"
 
 namespace pic {
 namespace {
 
-Vec3 sub3(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 Vec3 mul3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot3(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross3(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm3(const Vec3& a) { return std::sqrt(dot3(a, a)); }
+using detail::cross3;
+using detail::dot3;
+using detail::norm3;
+using detail::sub3;
 
 double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   return std::sqrt(detail::point_triangle_distance2(p, a, b, c));

@@ -1,4 +1,5 @@
 #include "geometry.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -63,11 +64,6 @@ void clip(const Poly& in, Poly& out, int axis, double value, bool keep_below) {
   }
 }
 
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 std::array<uint8_t, 256> make_component_table() {
   std::array<uint8_t, 256> table{};
@@ -208,10 +204,10 @@ double clipped_area(const ITri& t, const IBox& box) {
   }
   Vec3 acc{0, 0, 0};
   for (int q = 1; q + 1 < poly.n; ++q) {
-    const Vec3 c = cross(sub(poly.p[q], poly.p[0]), sub(poly.p[q + 1], poly.p[0]));
+    const Vec3 c = cross3(sub3(poly.p[q], poly.p[0]), sub3(poly.p[q + 1], poly.p[0]));
     acc = {acc[0] + c[0], acc[1] + c[1], acc[2] + c[2]};
   }
-  return 0.5 * std::sqrt(dot(acc, acc));
+  return 0.5 * std::sqrt(dot3(acc, acc));
 }
 
 double crossing_param(const ITri& t, const I3& a, int axis, i64 len) {
@@ -227,16 +223,16 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
   }
   const std::array<Vec3, 3> pa = {to_unit(a.v[0]), to_unit(a.v[1]), to_unit(a.v[2])};
   const std::array<Vec3, 3> pb = {to_unit(b.v[0]), to_unit(b.v[1]), to_unit(b.v[2])};
-  const Vec3 na = cross(sub(pa[1], pa[0]), sub(pa[2], pa[0]));
-  const Vec3 nb = cross(sub(pb[1], pb[0]), sub(pb[2], pb[0]));
-  const double la = std::sqrt(dot(na, na)), lb = std::sqrt(dot(nb, nb));
+  const Vec3 na = cross3(sub3(pa[1], pa[0]), sub3(pa[2], pa[0]));
+  const Vec3 nb = cross3(sub3(pb[1], pb[0]), sub3(pb[2], pb[0]));
+  const double la = std::sqrt(dot3(na, na)), lb = std::sqrt(dot3(nb, nb));
   if (la == 0 || lb == 0) return false;
   const Vec3 lo = to_unit(box.lo), hi = to_unit(box.hi);
   // Signed distances of each triangle's vertices to the other's plane.
   std::array<double, 3> da, db;
   for (int k = 0; k < 3; ++k) {
-    db[k] = dot(nb, sub(pa[k], pb[0])) / lb;  // a's vertices vs plane b
-    da[k] = dot(na, sub(pb[k], pa[0])) / la;  // b's vertices vs plane a
+    db[k] = dot3(nb, sub3(pa[k], pb[0])) / lb;  // a's vertices vs plane b
+    da[k] = dot3(na, sub3(pb[k], pa[0])) / la;  // b's vertices vs plane a
   }
   constexpr double kEps = 1e-13;  // root-cube units: snap near-zero distances to the plane
   for (auto* d : {&da, &db})
@@ -281,8 +277,8 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
   };
   Vec3 a0, a1, b0, b1;
   if (!plane_segment(pa, db, a0, a1) || !plane_segment(pb, da, b0, b1)) return false;
-  const Vec3 dir = cross(na, nb);
-  const double ta0 = dot(dir, a0), ta1 = dot(dir, a1), tb0 = dot(dir, b0), tb1 = dot(dir, b1);
+  const Vec3 dir = cross3(na, nb);
+  const double ta0 = dot3(dir, a0), ta1 = dot3(dir, a1), tb0 = dot3(dir, b0), tb1 = dot3(dir, b1);
   const double amin = std::min(ta0, ta1), amax = std::max(ta0, ta1);
   const double bmin = std::min(tb0, tb1), bmax = std::max(tb0, tb1);
   const double smin = std::max(amin, bmin), smax = std::min(amax, bmax);
@@ -317,20 +313,20 @@ double point_triangle_distance2(const Vec3& p, const ITri& t) {
 
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Ericson, Real-Time Collision Detection 5.1.5: closest point by Voronoi regions.
-  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  auto d2 = [&](const Vec3& q) { const Vec3 v = sub(p, q); return dot(v, v); };
-  const double d1 = dot(ab, ap), d2v = dot(ac, ap);
+  const Vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
+  auto d2 = [&](const Vec3& q) { const Vec3 v = sub3(p, q); return dot3(v, v); };
+  const double d1 = dot3(ab, ap), d2v = dot3(ac, ap);
   if (d1 <= 0 && d2v <= 0) return d2(a);
-  const Vec3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  const Vec3 bp = sub3(p, b);
+  const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
   if (d3 >= 0 && d4 <= d3) return d2(b);
   const double vc = d1 * d4 - d3 * d2v;
   if (vc <= 0 && d1 >= 0 && d3 <= 0) {
     const double v = d1 / (d1 - d3);
     return d2({a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]});
   }
-  const Vec3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  const Vec3 cp = sub3(p, c);
+  const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
   if (d6 >= 0 && d5 <= d6) return d2(c);
   const double vb = d5 * d2v - d1 * d6;
   if (vb <= 0 && d2v >= 0 && d6 <= 0) {

@@ -11,25 +11,16 @@
 #include <vector>
 
 #include "pic/pic.h"
+#include "union_find.h"
+#include "vec3.h"
 
 namespace pic {
 namespace {
 
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-struct UnionFind {
-  std::vector<uint32_t> parent;
-  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  uint32_t root(uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void join(uint32_t a, uint32_t b) { parent[root(a)] = root(b); }
-};
+using detail::UnionFind;
+constexpr auto sub = detail::sub3;
+constexpr auto cross = detail::cross3;
+constexpr auto dot = detail::dot3;
 
 /// Half-edges (3 t + k: from corner k to corner k+1 of triangle t) around one edge, ordered
 /// by angle about it, paired so that each pair bounds one wedge of the solid (`solids_apart`:
@@ -116,7 +107,7 @@ size_t split_sheets(TriMesh& m, bool solids_apart) {
   size_t added = 0;
   for (uint32_t c = 0; c < 3 * nt; ++c) {
     const uint32_t v = m.triangles[c / 3][c % 3];
-    const uint32_t r = fans.root(c);
+    const auto r = static_cast<uint32_t>(fans.root(c));
     if (first_root[v] == UINT32_MAX) first_root[v] = r;
     if (first_root[v] == r) continue;
     auto [it, fresh] = copy_of_fan.try_emplace(r, static_cast<uint32_t>(m.positions.size()));

@@ -3,6 +3,7 @@
 #include <unordered_map>
 
 #include "octree_util.h"
+#include "union_find.h"
 
 namespace pic {
 
@@ -64,16 +65,11 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
     for (size_t i = 0; i < fan.size(); ++i)
       for (uint32_t w : mesh.triangles[fan[i]])
         if (w != v) by_other[w].push_back(i);
-    std::vector<size_t> parent(fan.size());
-    for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-    auto find = [&](size_t x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
-      return x;
-    };
+    detail::UnionFind fans(fan.size());
     for (const auto& [w, list] : by_other)
-      for (size_t i = 1; i < list.size(); ++i) parent[find(list[i])] = find(list[0]);
+      for (size_t i = 1; i < list.size(); ++i) fans.join(list[i], list[0]);
     size_t roots = 0;
-    for (size_t i = 0; i < parent.size(); ++i) roots += find(i) == i;
+    for (size_t i = 0; i < fan.size(); ++i) roots += fans.root(i) == i;
     if (roots > 1) ++r.nonmanifold_vertices;
   }
   return r;

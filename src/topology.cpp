@@ -2,6 +2,7 @@
 
 #include "contour.h"
 #include "sample.h"
+#include "union_find.h"
 
 #include <algorithm>
 #include <array>
@@ -320,15 +321,10 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
     }
   }
   // Regions of one sign (union-find over same-sign links, with the edge flips applied).
-  std::vector<size_t> parent(pts.size());
-  for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  auto root = [&](size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  UnionFind regions(pts.size());
   for (const auto& [a, b] : links) {
     const size_t ia = index_of(a), ib = index_of(b);
-    if (pts[ia].second == pts[ib].second) parent[root(ia)] = root(ib);
+    if (pts[ia].second == pts[ib].second) regions.join(ia, ib);
   }
   std::vector<char> anchored(pts.size(), 0);
   for (int c = 0; c < 4; ++c) {
@@ -336,10 +332,10 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
     if (c & 1) q[u] = hi[u];
     if (c & 2) q[v] = hi[v];
     const size_t i = index_of(key(q));
-    if (i < pts.size() && pts[i].first == key(q) && pts[i].second == corner_sign(c & 1, c >> 1)) anchored[root(i)] = 1;
+    if (i < pts.size() && pts[i].first == key(q) && pts[i].second == corner_sign(c & 1, c >> 1)) anchored[regions.root(i)] = 1;
   }
   for (size_t i = 0; i < pts.size(); ++i)
-    if (!anchored[root(i)]) flipped[i] ^= 1;
+    if (!anchored[regions.root(i)]) flipped[i] ^= 1;
   for (size_t i = 0; i < pts.size(); ++i)
     if (flipped[i]) flips.push_back(lat_of(pts[i].first));
   return flips;
