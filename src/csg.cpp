@@ -297,10 +297,21 @@ struct Fragment {
   }
 };
 
+/// What the recursion counts; each task counts its own, summed when the tasks merge.
+struct CombineCounts {
+  size_t cells_visited = 0, gray_pairs = 0, forced_subdivisions = 0;
+  CombineCounts& operator+=(const CombineCounts& o) {
+    cells_visited += o.cells_visited;
+    gray_pairs += o.gray_pairs;
+    forced_subdivisions += o.forced_subdivisions;
+    return *this;
+  }
+};
+
 class Combiner {
  public:
   Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
-           int parallel_levels, bool parallel, CsgStats& stats)
+           int parallel_levels, bool parallel, CombineCounts& stats)
       : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
         parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
 
@@ -470,7 +481,7 @@ class Combiner {
       // Near the root, each child is a task with its own fragment and caches, merged in child
       // order: the same bytes whether the tasks run in parallel or not.
       std::array<Fragment, 8> frags;
-      std::array<CsgStats, 8> sub_stats;
+      std::array<CombineCounts, 8> sub_stats;
       auto task = [&](int c) {
         Operand ca(a_.t, a_.pc, stamp_), cb(b_.t, b_.pc, stamp_);
         Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
@@ -480,9 +491,7 @@ class Combiner {
       else for (int c = 0; c < 8; ++c) task(c);
       for (int c = 0; c < 8; ++c) {
         kids[c] = out_.absorb(frags[c], kids[c]);
-        stats_.cells_visited += sub_stats[c].cells_visited;
-        stats_.gray_pairs += sub_stats[c].gray_pairs;
-        stats_.forced_subdivisions += sub_stats[c].forced_subdivisions;
+        stats_ += sub_stats[c];
       }
     } else {
       for (int c = 0; c < 8; ++c) kids[c] = combine(cell.child(c), child_side(a_, a, cell, c), child_side(b_, b, cell, c));
@@ -663,7 +672,7 @@ class Combiner {
   uint32_t stamp_;
   int parallel_levels_;
   bool parallel_;
-  CsgStats& stats_;
+  CombineCounts& stats_;
   std::vector<uint32_t> scratch_;
 };
 
@@ -853,8 +862,12 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     // written only once all tasks are done.
     Fragment f;
     Operand oa(a, pa, stamp), ob(b, pb, stamp);
-    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, stats);
+    CombineCounts counts;
+    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
     const Node root = comb.run();
+    stats.cells_visited = counts.cells_visited;
+    stats.gray_pairs = counts.gray_pairs;
+    stats.forced_subdivisions = counts.forced_subdivisions;
     const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
     for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
     a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
