@@ -226,7 +226,19 @@ namespace {
 ///   vertex).
 /// Returns the lattice points to flip (as few as possible along edges; whole stray regions
 /// on the face).
-std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vector<LeafRef>& scratch) {
+/// Buffers face_flips reuses from face to face.
+struct FaceScratch {
+  std::vector<LeafRef> leaves;
+  std::vector<std::pair<uint64_t, bool>> pts;
+  std::vector<std::pair<uint64_t, uint64_t>> links;
+  std::vector<size_t> run;
+  std::vector<char> flipped, anchored;
+  UnionFind regions{0};
+  std::vector<Lat> flips;
+};
+
+const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
+  s.flips.clear();
   const int d = f / 2, side = f % 2;
   const int u = d == 0 ? 1 : 0, v = d == 2 ? 1 : 2;  // in-face axes
   const int64_t span = big.cell.span();
@@ -236,15 +248,18 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
   // The finer leaves are below the node across the face, if that node is subdivided.
   Cell across = big.cell;
   across.lat[d] += side ? span : -span;
-  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return {};
+  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return s.flips;
   const LeafRef n = node_at(t, across);
-  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return {};
+  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return s.flips;
+  std::vector<LeafRef>& scratch = s.leaves;
   scratch.clear();
   leaves_touching(t, n.node, n.cell, lo, hi, kMaxLevel, scratch);
   // Points on the face (key: in-face coordinates) with their signs, and links along the edges
   // of the finer leaves' faces (which join a region once the edge pass below has set signs).
-  std::vector<std::pair<uint64_t, bool>> pts;
-  std::vector<std::pair<uint64_t, uint64_t>> links;
+  auto& pts = s.pts;
+  auto& links = s.links;
+  pts.clear();
+  links.clear();
   auto key = [&](const Lat& q) { return uint64_t(q[u]) << 32 | uint64_t(q[v]); };
   for (const LeafRef& l : scratch) {
     if (l.cell.level <= big.cell.level) continue;
@@ -264,8 +279,7 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
     for (const auto& [a, b] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
       links.push_back({c4[a].first, c4[b].first});
   }
-  std::vector<Lat> flips;
-  if (pts.empty()) return flips;
+  if (pts.empty()) return s.flips;
   std::sort(pts.begin(), pts.end());
   pts.erase(std::unique(pts.begin(), pts.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
             pts.end());
@@ -284,12 +298,14 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
     const int c = (side << d) | (cu << u) | (cv << v);
     return ((sb >> c) & 1) != 0;
   };
-  std::vector<char> flipped(pts.size(), 0);
+  std::vector<char>& flipped = s.flipped;
+  flipped.assign(pts.size(), 0);
   // Edges of the face: points in order along each, ends from the coarse leaf.
   for (int e = 0; e < 4; ++e) {
     const int along = e < 2 ? u : v, across = along == u ? v : u;
     const int64_t fixed = (e & 1) ? hi[across] : lo[across];
-    std::vector<size_t> run;
+    std::vector<size_t>& run = s.run;
+    run.clear();
     for (size_t i = 0; i < pts.size(); ++i) {
       const Lat q = lat_of(pts[i].first);
       if (q[across] == fixed && q[along] > lo[along] && q[along] < hi[along]) run.push_back(i);
@@ -321,12 +337,14 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
     }
   }
   // Regions of one sign (union-find over same-sign links, with the edge flips applied).
-  UnionFind regions(pts.size());
+  UnionFind& regions = s.regions;
+  regions.reset(pts.size());
   for (const auto& [a, b] : links) {
     const size_t ia = index_of(a), ib = index_of(b);
     if (pts[ia].second == pts[ib].second) regions.join(ia, ib);
   }
-  std::vector<char> anchored(pts.size(), 0);
+  std::vector<char>& anchored = s.anchored;
+  anchored.assign(pts.size(), 0);
   for (int c = 0; c < 4; ++c) {
     Lat q = lo;
     if (c & 1) q[u] = hi[u];
@@ -337,8 +355,8 @@ std::vector<Lat> face_flips(const Octree& t, const LeafRef& big, int f, std::vec
   for (size_t i = 0; i < pts.size(); ++i)
     if (!anchored[regions.root(i)]) flipped[i] ^= 1;
   for (size_t i = 0; i < pts.size(); ++i)
-    if (flipped[i]) flips.push_back(lat_of(pts[i].first));
-  return flips;
+    if (flipped[i]) s.flips.push_back(lat_of(pts[i].first));
+  return s.flips;
 }
 
 }  // namespace
@@ -438,6 +456,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
       }
   }
   // ... and what the finer side shows on each coarse face (edges, stray regions).
+  FaceScratch face_scratch;
   std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
     return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
   });
@@ -446,7 +465,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
               faces.end());
   for (const auto& [big, f] : faces) {
     if (t.nodes[big.node].kind != CellKind::Gray) continue;
-    for (const Lat& p : face_flips(t, big, f, near)) flip(p);
+    for (const Lat& p : face_flips(t, big, f, face_scratch)) flip(p);
   }
   return flipped;
 }

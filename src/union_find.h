@@ -9,7 +9,11 @@ namespace pic::detail {
 
 struct UnionFind {
   std::vector<size_t> parent;
-  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), size_t{0}); }
+  explicit UnionFind(size_t n) { reset(n); }
+  void reset(size_t n) {
+    parent.resize(n);
+    std::iota(parent.begin(), parent.end(), size_t{0});
+  }
   size_t root(size_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
