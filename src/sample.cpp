@@ -125,6 +125,33 @@ void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx
     if (overlaps_box(tris[k], b.lo, b.hi)) out.push_back(k);
 }
 
+void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                std::array<std::vector<uint32_t>, 8>& out) {
+  std::array<IBox, 8> boxes;
+  for (int c = 0; c < 8; ++c) {
+    out[c].clear();
+    boxes[c] = cell.child(c).box();
+  }
+  const IBox b = cell.box();
+  const I3 mid = boxes[7].lo;
+  for (uint32_t k : idx) {
+    const ITri& t = tris[k];
+    // Per axis, which halves (closed) the box reaches: bit 0 low, bit 1 high.
+    std::array<unsigned, 3> halves{};
+    for (int a = 0; a < 3; ++a)
+      halves[a] = unsigned(t.lo[a] <= mid[a] && t.hi[a] >= b.lo[a]) | unsigned(t.hi[a] >= mid[a] && t.lo[a] <= b.hi[a]) << 1;
+    for (int c = 0; c < 8; ++c) {
+      if (!((halves[0] >> (c & 1)) & 1) || !((halves[1] >> ((c >> 1) & 1)) & 1) || !((halves[2] >> ((c >> 2) & 1)) & 1))
+        continue;
+      const IBox& cb = boxes[c];
+      // A triangle inside the child's box meets it; otherwise the exact plane test decides.
+      const bool inside = t.lo[0] >= cb.lo[0] && t.lo[1] >= cb.lo[1] && t.lo[2] >= cb.lo[2] && t.hi[0] <= cb.hi[0] &&
+                          t.hi[1] <= cb.hi[1] && t.hi[2] <= cb.hi[2];
+      if (inside || overlaps_box(t, cb.lo, cb.hi)) out[c].push_back(k);
+    }
+  }
+}
+
 bool inside_cell(const Vec3& x, const Cell& cell) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
@@ -244,11 +271,11 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   if (cell.level < p.parallel_levels) {
     std::array<Builder, 8> subs;
     std::array<size_t, 8> caps{};
+    std::array<std::vector<uint32_t>, 8> cidx;
+    split_tris(src.tris(), idx, cell, cidx);
     tbb::parallel_for(0, 8, [&](int c) {
-      std::vector<uint32_t> cidx;
-      filter_tris(src.tris(), idx, cell.child(c), cidx);
       subs[c].nodes.resize(1);
-      sample_cell(src, p, cell.child(c), child_signs(grid, c), std::move(cidx), subs[c], 0, caps[c]);
+      sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], subs[c], 0, caps[c]);
     });
     for (int c = 0; c < 8; ++c) {
       out.splice(first + c, subs[c]);
@@ -256,11 +283,9 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     }
     return;
   }
-  std::vector<uint32_t> cidx;
-  for (int c = 0; c < 8; ++c) {
-    filter_tris(src.tris(), idx, cell.child(c), cidx);
-    sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx, out, first + c, capped);
-  }
+  std::array<std::vector<uint32_t>, 8> cidx;
+  split_tris(src.tris(), idx, cell, cidx);
+  for (int c = 0; c < 8; ++c) sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], out, first + c, capped);
 }
 
 }  // namespace pic::detail

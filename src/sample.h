@@ -56,6 +56,10 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
 /// lying in one of the cell's low faces belongs to the neighbour below).
 bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell);
 
+/// Triangles of `idx` overlapping the closed boxes of the 8 children of `cell` (conservative;
+/// the same lists as filter_tris per child, in one pass).
+void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                std::array<std::vector<uint32_t>, 8>& out);
 /// Triangles of `idx` overlapping the closed box of `cell` (conservative).
 void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
                  std::vector<uint32_t>& out);
