@@ -149,6 +149,23 @@ std::vector<uint8_t> serialize(const Octree& tree);
 Octree deserialize(const std::vector<uint8_t>& bytes);
 ///@}
 
+/// An oriented point cloud (a scan): one normal per point, pointing out of the solid.
+struct PointCloud {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;  ///< same length as positions (need not be unit length)
+};
+
+/// What a geometry file holds: a triangle mesh, or (PLY with vertices and no faces, or .xyz
+/// text "x y z nx ny nz" per line) an oriented point cloud. Exactly one of the two is filled.
+struct Geometry {
+  TriMesh mesh;
+  PointCloud points;
+  bool is_point_cloud() const { return mesh.triangles.empty() && !points.positions.empty(); }
+};
+/// Reads a mesh file or a point cloud file. A point cloud without normals is InvalidInput
+/// ("normals are needed"). \throws IoError, InvalidInput as read_mesh.
+Geometry read_geometry(const std::filesystem::path& path);
+
 /// @name Mesh files: OBJ, STL, PLY, OFF, glTF/GLB (assimp), duplicate vertices welded.
 ///@{
 /// \throws IoError (missing/unreadable/unknown format) or InvalidInput (empty, non-finite).
