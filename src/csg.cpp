@@ -243,7 +243,8 @@ struct Operand {
 class FanSource : public SurfaceSource {
  public:
   explicit FanSource(Operand& x) : x_(x) { tris_ = &x.tris; }
-  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g) const override {
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g,
+                        Wind27*) const override {
     const int64_t h = cell.span() / 2;
     for (int i = 0; i < 27; ++i) {
       const int a = i % 3, b = (i / 3) % 3, c = i / 9;

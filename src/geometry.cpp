@@ -122,6 +122,8 @@ ITri make_itri(const I3& a, const I3& b, const I3& c) {
   return t;
 }
 
+int plane_side(const ITri& t, const I3& p) { return perturbed_plane_sign(t, p); }
+
 bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
   const int i = axis == 0 ? 1 : 0;
   const int j = axis == 2 ? 1 : 2;
@@ -143,7 +145,7 @@ bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
 int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
                     int axis, i64 len) {
   int n = 0;
-  for (uint32_t k : idx) n += crosses(tris[k], a, axis, len);
+  for (uint32_t k : idx) n += (tris[k].use & kUseCrossing) && crosses(tris[k], a, axis, len);
   return n;
 }
 
@@ -311,10 +313,10 @@ double point_triangle_distance2(const Vec3& p, const ITri& t) {
   return point_triangle_distance2(p, to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2]));
 }
 
-double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Ericson, Real-Time Collision Detection 5.1.5: closest point by Voronoi regions.
   const Vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
-  auto d2 = [&](const Vec3& q) { const Vec3 v = sub3(p, q); return dot3(v, v); };
+  auto d2 = [](const Vec3& q) { return q; };
   const double d1 = dot3(ab, ap), d2v = dot3(ac, ap);
   if (d1 <= 0 && d2v <= 0) return d2(a);
   const Vec3 bp = sub3(p, b);
@@ -341,6 +343,11 @@ double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, con
   const double denom = 1 / (va + vb + vc);
   const double v = vb * denom, w = vc * denom;
   return d2({a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
+}
+
+double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 v = sub3(p, closest_point_on_triangle(p, a, b, c));
+  return dot3(v, v);
 }
 
 I3 to_grid(const Vec3& u) {

@@ -43,13 +43,25 @@ struct ITri {
   Vec3 unit_normal{0, 0, 0};  // double precision, for QEFs
   double plane = 0;           // unit_normal . v0 (unit-cube coordinates)
   double area = 0;            // unit-cube units
+  uint8_t use = 0xff;         // kUse* bits: which roles the triangle plays in sampling
 };
+/// Roles of a triangle in sampling. Every triangle counts in the signs' crossings; a triangle
+/// of a robust (winding-number) input that does not bound the solid, a cap closing the input's
+/// boundary, or a point cloud's splat plays only some of the other roles.
+inline constexpr uint8_t kUseQef = 1;       ///< its plane enters the cells' QEFs
+inline constexpr uint8_t kUseMeets = 2;     ///< a uniform cell it meets is subdivided
+inline constexpr uint8_t kUseCrossing = 4;  ///< counted by the double-crossing test
+inline constexpr uint8_t kUseAll = 0xff;
 ITri make_itri(const I3& a, const I3& b, const I3& c);
 inline bool is_degenerate(const ITri& t) { return t.n[0] == 0 && t.n[1] == 0 && t.n[2] == 0; }
 
 /// Whether the axis-parallel segment from `a` to `a + len * e_axis` (len > 0) crosses `t`,
 /// under the symbolic perturbation above. Exact.
 bool crosses(const ITri& t, const I3& a, int axis, i64 len);
+
+/// Side of p relative to the plane of t (sign of n.p - d) under the symbolic perturbation:
+/// never 0 for a non-degenerate triangle. Exact.
+int plane_side(const ITri& t, const I3& p);
 
 /// Number of crossings of `tris[idx]` with the segment (exact, perturbed).
 int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
@@ -82,6 +94,7 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box);
 /// Squared distance from a unit-space point to a grid triangle (double precision).
 double point_triangle_distance2(const Vec3& p, const ITri& t);
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// Unit-space position of a grid point.
 inline Vec3 to_unit(const I3& g) { return {grid_to_unit(g[0]), grid_to_unit(g[1]), grid_to_unit(g[2])}; }

@@ -1,5 +1,7 @@
 #include "sample.h"
 
+#include "classify.h"
+#include "mesh_repair.h"
 #include "topology.h"
 
 #include <tbb/parallel_for.h>
@@ -60,7 +62,7 @@ constexpr std::array<GridSegment, 19> kGridSegments = make_grid_segments();
 }  // namespace
 
 void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
-                                  std::array<bool, 27>& g) const {
+                                  std::array<bool, 27>& g, Wind27*) const {
   const i64 h = lattice_to_grid(cell.span() / 2);
   const I3 base = lattice_to_grid(cell.lat);
   // One pass over the triangles (not one per segment): each triangle's box says which grid
@@ -81,6 +83,10 @@ void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&
   for (const GridSegment& s : kGridSegments) g[s.to] = g[s.from] ^ ((parity >> s.to) & 1);
 }
 
+bool SurfaceSource::surface_matters(const Cell& cell, uint8_t, const Wind8*, const std::vector<uint32_t>& idx) const {
+  return meets_cell(tris(), idx, cell);
+}
+
 void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
               Qef& q) {
   box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
@@ -95,7 +101,7 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
   auto add = [&](const ITri& t, double w) { q.add_plane(t.unit_normal, t.plane, w); };
   for (uint32_t k : idx) {
     const ITri& t = tris[k];
-    if (is_degenerate(t)) continue;
+    if (is_degenerate(t) || !(t.use & kUseQef)) continue;
     const double area = clipped_area(t, box);
     if (area < 0) continue;
     any = true;
@@ -105,7 +111,7 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
     // The surface only grazes the cell (e.g. a mesh vertex exactly on a cell corner): the
     // perturbation still puts a sliver inside, so use the planes that touch the closed cell.
     for (uint32_t k : idx)
-      if (!is_degenerate(tris[k])) add(tris[k], kFloor);
+      if (!is_degenerate(tris[k]) && (tris[k].use & kUseQef)) add(tris[k], kFloor);
   }
 }
 
@@ -113,7 +119,7 @@ bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
   // An exact clip: the conservative list also holds triangles that pass beside the cell.
   const IBox box = cell.box();
   for (uint32_t k : idx)
-    if (!is_degenerate(tris[k]) && clipped_area(tris[k], box) >= 0) return true;
+    if ((tris[k].use & kUseMeets) && !is_degenerate(tris[k]) && clipped_area(tris[k], box) >= 0) return true;
   return false;
 }
 
@@ -210,6 +216,7 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
   // its line before the exact count can get there.
   std::array<int, 12> candidates{};
   for (uint32_t k : idx) {
+    if (!(tris[k].use & kUseCrossing)) continue;
     const LineMask mask = line_mask(tris[k], lo, s, 2);
     for (int e = 0; e < 12; ++e) {
       const int c0 = kEdgeCorners[e][0], axis = edge_axis(e);
@@ -233,7 +240,8 @@ constexpr uint8_t kAll = 0xff;
 }  // namespace
 
 void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
-                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped) {
+                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped,
+                 const Wind8* wind) {
   const uint8_t written = p.invert ? uint8_t(~signs) : signs;
   const bool uniform = signs == 0 || signs == kAll;
   if (idx.empty() && uniform) {
@@ -243,7 +251,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   const bool at_cap = cell.level >= p.max_depth;
   if (uniform) {
     // No vertex here: only whether surface enters the cell matters, not its QEF.
-    const bool meets = meets_cell(src.tris(), idx, cell);
+    const bool meets = src.surface_matters(cell, signs, wind, idx);
     if (!meets || at_cap) {
       if (meets) ++capped;  // a feature thinner than the deepest cell is dropped
       out.set_uniform(slot, (written & 1) != 0);
@@ -253,6 +261,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     // (Two components by the signs always split, below the cap: no QEF needed to know.)
     Qef q;
     cell_qef(src.tris(), idx, cell, q);
+    src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
                     !has_double_crossing(src.tris(), idx, cell, signs);
@@ -265,7 +274,13 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   // Subdivide: signs of the 27-point child grid, then each child with its own triangles.
   std::array<bool, 27> grid{};
   for (int k = 0; k < 8; ++k) grid[grid_index_of_corner(k)] = (signs >> k) & 1;
-  src.child_grid_signs(cell, idx, grid);
+  Wind27 wgrid{};
+  if (wind)
+    for (int k = 0; k < 8; ++k) wgrid[grid_index_of_corner(k)] = (*wind)[k];
+  src.child_grid_signs(cell, idx, grid, wind ? &wgrid : nullptr);
+  std::array<Wind8, 8> cwind{};
+  if (wind)
+    for (int c = 0; c < 8; ++c) cwind[c] = child_wind(wgrid, c);
   const uint32_t first = out.alloc_children();
   out.nodes[slot] = Node{first, CellKind::Internal, 0, 0, 0};
   if (cell.level < p.parallel_levels) {
@@ -275,7 +290,8 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     split_tris(src.tris(), idx, cell, cidx);
     tbb::parallel_for(0, 8, [&](int c) {
       subs[c].nodes.resize(1);
-      sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], subs[c], 0, caps[c]);
+      sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], subs[c], 0, caps[c],
+                  wind ? &cwind[c] : nullptr);
     });
     for (int c = 0; c < 8; ++c) {
       out.splice(first + c, subs[c]);
@@ -285,7 +301,9 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   }
   std::array<std::vector<uint32_t>, 8> cidx;
   split_tris(src.tris(), idx, cell, cidx);
-  for (int c = 0; c < 8; ++c) sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], out, first + c, capped);
+  for (int c = 0; c < 8; ++c)
+    sample_cell(src, p, cell.child(c), child_signs(grid, c), cidx[c], out, first + c, capped,
+                wind ? &cwind[c] : nullptr);
 }
 
 }  // namespace pic::detail
@@ -313,16 +331,31 @@ Cube bounding_cube(const TriMesh& mesh, double margin) {
 
 namespace {
 
-void validate_mesh(const TriMesh& mesh) {
-  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
-  for (const Vec3& p : mesh.positions)
+void check_options(const SampleOptions& options) {
+  if (options.depth < 1 || options.depth > kMaxLevel)
+    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
+  if (!(options.error >= 0) || !std::isfinite(options.error)) throw InvalidInput("error must be a finite number >= 0");
+}
+
+void check_finite(const std::vector<Vec3>& points, const char* what) {
+  for (const Vec3& p : points)
     for (double x : p)
-      if (!std::isfinite(x)) throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
+      if (!std::isfinite(x)) throw InvalidInput(std::string(what) + " has non-finite (NaN or inf) coordinates");
+}
+
+void check_mesh(const TriMesh& mesh) {
+  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+  check_finite(mesh.positions, "mesh");
+  for (const auto& t : mesh.triangles)
+    for (uint32_t v : t)
+      if (v >= mesh.positions.size()) throw InvalidInput("mesh has a triangle with an invalid vertex index");
+}
+
+/// Crossing parity needs every edge on an even number of triangles.
+void check_closed(const TriMesh& mesh) {
   std::unordered_map<uint64_t, uint32_t> edges;
   edges.reserve(mesh.triangles.size() * 3);
   for (const auto& t : mesh.triangles) {
-    for (uint32_t v : t)
-      if (v >= mesh.positions.size()) throw InvalidInput("mesh has a triangle with an invalid vertex index");
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
     for (int e = 0; e < 3; ++e) {
       const uint64_t a = t[e], b = t[(e + 1) % 3];
@@ -333,57 +366,181 @@ void validate_mesh(const TriMesh& mesh) {
   for (const auto& [k, n] : edges) odd += n & 1;
   if (odd > 0)
     throw InvalidInput("mesh is not closed: " + std::to_string(odd) +
-                       " boundary edges (PIC sampling needs a closed, watertight mesh)");
+                       " boundary edges (crossing parity needs a closed mesh; use --inside winding or auto)");
 }
 
-}  // namespace
-
-Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (options.depth < 1 || options.depth > kMaxLevel)
-    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
-  if (!(options.error >= 0) || !std::isfinite(options.error)) throw InvalidInput("error must be a finite number >= 0");
-  validate_mesh(mesh);
-  const Cube cube = options.cube ? *options.cube : bounding_cube(mesh, options.margin);
+Cube checked_cube(const SampleOptions& options, const std::vector<Vec3>& points) {
+  const Cube cube = options.cube ? *options.cube : bounding_cube(TriMesh{points, {}}, options.margin);
   if (!(cube.size > 0) || !std::isfinite(cube.size) || !std::isfinite(cube.origin[0]) ||
       !std::isfinite(cube.origin[1]) || !std::isfinite(cube.origin[2]))
     throw InvalidInput("root cube must have a finite origin and a positive size");
+  return cube;
+}
 
-  std::vector<I3> grid(mesh.positions.size());
+std::vector<I3> to_grid_inside(const Cube& cube, const std::vector<Vec3>& points, const char* what) {
+  std::vector<I3> grid(points.size());
   for (size_t i = 0; i < grid.size(); ++i) {
-    grid[i] = to_grid(world_to_unit(cube, mesh.positions[i]));
+    grid[i] = to_grid(world_to_unit(cube, points[i]));
     for (int k = 0; k < 3; ++k)
       if (grid[i][k] <= 0 || grid[i][k] >= (int64_t{1} << kGridBits))
-        throw InvalidInput("mesh does not fit strictly inside the root cube");
+        throw InvalidInput(std::string(what) + " does not fit strictly inside the root cube");
   }
-  std::vector<ITri> tris;
-  tris.reserve(mesh.triangles.size());
-  for (const auto& t : mesh.triangles) tris.push_back(make_itri(grid[t[0]], grid[t[1]], grid[t[2]]));
-  std::vector<uint32_t> idx(tris.size());
-  for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
+  return grid;
+}
 
-  MeshSource src(tris);
+SampleParams params_of(const SampleOptions& options) {
   SampleParams p;
   p.max_depth = options.depth;
   p.error = options.error;
   p.parallel_levels = options.parallel ? 2 : 0;
+  return p;
+}
+
+/// Runs the sampler from the root and assembles the tree. `settle`: the signs may change
+/// inside uniform leaves (a winding number's level set can cross a cell without touching its
+/// corners), so finer neighbours can show islands and cracks on their faces; the CSG
+/// clean-up settles them.
+Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
+                  const Wind8* root_wind, size_t& capped, bool settle = false) {
+  std::vector<uint32_t> idx(src.tris().size());
+  for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
   Builder b;
   b.nodes.resize(1);
-  size_t capped = 0;
-  // Root corners are outside: the mesh lies strictly inside the cube.
-  sample_cell(src, p, Cell{}, 0, std::move(idx), b, 0, capped);
-
+  sample_cell(src, params_of(options), Cell{}, root_signs, idx, b, 0, capped, root_wind);
   Octree tree;
   tree.cube = cube;
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
-  // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
-  if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) repair_cracks(tree, nullptr);
+  if (settle) {
+    PinnedPoints pinned;
+    for (int round = 0; round < 4; ++round) {
+      const size_t islands = remove_islands(tree, nullptr, nullptr, &pinned);
+      if (enforce_one_component(tree, nullptr, nullptr, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
+    }
+    repair_cracks(tree, nullptr);
+  } else if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) {
+    // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
+    repair_cracks(tree, nullptr);
+  }
+  return tree;
+}
+
+Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
+                      const Cube& cube, SampleStats& st, size_t& capped) {
+  // Close the input's boundary with caps: input + caps has an exact integer winding number.
+  const auto chain = boundary_chain(clean.mesh);
+  const auto cones = cap_loops(chain, &st.boundary_loops);
+  const std::vector<I3>& g = grid;
+  std::vector<ITri> tris;
+  tris.reserve(clean.mesh.triangles.size() + cones.size());
+  for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+  for (const auto& t : cones) {
+    tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+    tris.back().use = 0;  // a cap: counts in the winding number, is no part of the surface
+  }
+  std::vector<std::array<Vec3, 2>> boundary;
+  boundary.reserve(chain.size());
+  for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
+  WindingSource src(std::move(tris), clean.mesh.triangles.size(), std::move(boundary));
+  // Interior walls exist only where parts meet or overlap.
+  if (clean.defects.shells > 1 || clean.defects.nonmanifold_edges > 0)
+    st.interior_triangles = src.drop_interior_triangles();
+  // Nothing lies outside the cube: the root's corners have winding number 0.
+  const Wind8 root_wind{};
+  uint8_t signs = 0;
+  for (int c = 0; c < 8; ++c)
+    signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
+  Octree tree = build_tree(src, options, cube, signs, &root_wind, capped, true);
+  if (tree.vertices.empty())
+    throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
+  return tree;
+}
+
+}  // namespace
+
+std::string to_string(InsideMode mode) {
+  switch (mode) {
+    case InsideMode::Auto: return "auto";
+    case InsideMode::Parity: return "parity";
+    case InsideMode::Winding: return "winding";
+  }
+  return "auto";
+}
+
+std::optional<InsideMode> parse_inside_mode(const std::string& s) {
+  if (s == "auto") return InsideMode::Auto;
+  if (s == "parity") return InsideMode::Parity;
+  if (s == "winding") return InsideMode::Winding;
+  return std::nullopt;
+}
+
+Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_options(options);
+  check_mesh(mesh);
+  const Cube cube = checked_cube(options, mesh.positions);
+  const CleanMesh clean = clean_mesh(mesh);
+  if (clean.mesh.triangles.empty()) throw InvalidInput("mesh has no triangles (all degenerate or cancelling)");
+  InsideMode mode = options.inside;
+  if (mode == InsideMode::Auto) mode = clean.defects.clean() ? InsideMode::Parity : InsideMode::Winding;
+  const std::vector<I3> grid = to_grid_inside(cube, clean.mesh.positions, "mesh");
+
+  SampleStats st;
+  st.defects = clean.defects;
+  st.classifier = to_string(mode);
+  size_t capped = 0;
+  Octree tree;
+  if (mode == InsideMode::Parity) {
+    check_closed(clean.mesh);
+    std::vector<ITri> tris;
+    tris.reserve(clean.mesh.triangles.size());
+    for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(grid[t[0]], grid[t[1]], grid[t[2]]));
+    // Root corners are outside: the mesh lies strictly inside the cube.
+    tree = build_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
+  } else {
+    tree = sample_winding(clean, grid, options, cube, st, capped);
+  }
   if (stats) {
-    stats->triangles_in = mesh.triangles.size();
+    st.triangles_in = mesh.triangles.size();
+    st.pics = tree.vertices.size();
+    st.capped = capped;
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    *stats = st;
+  }
+  return tree;
+}
+
+Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_options(options);
+  if (cloud.positions.empty()) throw InvalidInput("point cloud has no points");
+  if (cloud.normals.size() != cloud.positions.size())
+    throw InvalidInput("point cloud needs one normal per point: normals are needed to tell inside from outside");
+  check_finite(cloud.positions, "point cloud");
+  check_finite(cloud.normals, "point cloud normals");
+  size_t zero = 0;
+  for (const Vec3& n : cloud.normals) zero += n[0] == 0 && n[1] == 0 && n[2] == 0;
+  if (zero > 0)
+    throw InvalidInput("point cloud has " + std::to_string(zero) +
+                       " points with a zero normal: normals are needed to tell inside from outside");
+  const Cube cube = checked_cube(options, cloud.positions);
+  to_grid_inside(cube, cloud.positions, "point cloud");
+  std::vector<Vec3> unit(cloud.positions.size());
+  for (size_t i = 0; i < unit.size(); ++i) unit[i] = world_to_unit(cube, cloud.positions[i]);
+  const PointSource src(unit, cloud.normals);
+  uint8_t signs = 0;
+  for (int c = 0; c < 8; ++c) signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)))) << c;
+  size_t capped = 0;
+  Octree tree = build_tree(src, options, cube, signs, nullptr, capped, true);
+  if (tree.vertices.empty())
+    throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
+  if (stats) {
+    *stats = SampleStats{};
+    stats->triangles_in = 0;
     stats->pics = tree.vertices.size();
     stats->capped = capped;
+    stats->classifier = "points";
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return tree;

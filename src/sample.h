@@ -13,15 +13,29 @@
 
 namespace pic::detail {
 
+/// Integer winding numbers of the closed triangle set at a cell's corners / child grid.
+using Wind8 = std::array<int32_t, 8>;
+using Wind27 = std::array<int32_t, 27>;
+
 /// Where the sampler gets triangles and corner signs.
 class SurfaceSource {
  public:
   virtual ~SurfaceSource() = default;
   const std::vector<ITri>& tris() const { return *tris_; }
   /// Signs of the 3x3x3 child grid of `cell` (index a + 3b + 9c); the 8 entries at the
-  /// parent's corners are already filled in.
+  /// parent's corners are already filled in (in `wind` too, for a source that tracks_winding).
   virtual void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
-                                std::array<bool, 27>& grid) const = 0;
+                                std::array<bool, 27>& grid, Wind27* wind) const = 0;
+  /// Whether corner signs derive from integer winding numbers the sampler carries down.
+  virtual bool tracks_winding() const { return false; }
+  /// Whether the surface meeting uniform `cell` can change the sign inside it, so the cell
+  /// must be subdivided. By default: any triangle meeting the cell (a feature may hide there).
+  virtual bool surface_matters(const Cell& cell, uint8_t signs, const Wind8* wind,
+                               const std::vector<uint32_t>& idx) const;
+  /// Planes for a gray cell whose sign changes the triangles do not explain (where the solid's
+  /// boundary crosses a hole of the input, or a gap of a point cloud).
+  virtual void add_fill_planes(const Cell&, uint8_t /*signs*/, const Wind8* /*wind*/,
+                               const std::vector<uint32_t>& /*idx*/, Qef& /*q*/) const {}
 
  protected:
   const std::vector<ITri>* tris_ = nullptr;
@@ -33,7 +47,7 @@ class MeshSource : public SurfaceSource {
  public:
   explicit MeshSource(const std::vector<ITri>& t) { tris_ = &t; }
   void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
-                        std::array<bool, 27>& grid) const override;
+                        std::array<bool, 27>& grid, Wind27* wind) const override;
 };
 
 struct SampleParams {
@@ -70,9 +84,17 @@ void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx
 Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs);
 bool inside_cell(const Vec3& x, const Cell& cell);
 
-/// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`.
+/// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`. `wind`:
+/// the corners' winding numbers, for a source that tracks_winding.
 void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
-                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped);
+                 const std::vector<uint32_t>& idx, Builder& out, uint32_t slot, size_t& capped,
+                 const Wind8* wind = nullptr);
+
+/// The grid of `cell`'s lattice point with child-grid index g (a + 3b + 9c).
+inline I3 child_grid_point(const Cell& cell, int g) {
+  const int64_t h = cell.span() / 2;
+  return lattice_to_grid({cell.lat[0] + (g % 3) * h, cell.lat[1] + ((g / 3) % 3) * h, cell.lat[2] + (g / 9) * h});
+}
 
 /// Corner signs of the 8 children of a cell from its child grid.
 inline uint8_t child_signs(const std::array<bool, 27>& g, int c) {
@@ -85,5 +107,11 @@ inline uint8_t child_signs(const std::array<bool, 27>& g, int c) {
   return s;
 }
 inline int grid_index_of_corner(int k) { return (k & 1) * 2 + ((k >> 1) & 1) * 6 + ((k >> 2) & 1) * 18; }
+/// Child c's corner windings from the child grid.
+inline Wind8 child_wind(const Wind27& w, int c) {
+  Wind8 out;
+  for (int k = 0; k < 8; ++k) out[k] = w[grid_index_of_corner(k) / 2 + grid_index_of_corner(c) / 2];
+  return out;
+}
 
 }  // namespace pic::detail

@@ -168,7 +168,14 @@ TEST_F(Cli, SampleFailuresLeaveTheOutputUntouched) {
   write_text_file(path("open.obj"),
                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
                   "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\n");
-  expect_clean_failure("sample open.obj -o out.pic", "out.pic", "boundary edges");
+  expect_clean_failure("sample open.obj -o out.pic --inside parity", "out.pic", "boundary edges");
+  // A single open sheet encloses no solid, whichever classifier.
+  write_text_file(path("sheet.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  expect_clean_failure("sample sheet.obj -o out.pic", "out.pic", "no solid");
+  // A point cloud without normals.
+  write_text_file(path("cloud.xyz"), "0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+  expect_clean_failure("sample cloud.xyz -o out.pic", "out.pic", "normals are needed");
+  expect_clean_failure("sample open.obj -o out.pic --inside sideways", "out.pic", "--inside");
   // NaN coordinate.
   write_text_file(path("nan.obj"), "v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
   expect_clean_failure("sample nan.obj -o out.pic", "out.pic", "non-finite");

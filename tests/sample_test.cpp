@@ -317,11 +317,14 @@ TEST(Sample, RejectsEmptyAndNonFiniteMeshes) {
   EXPECT_THROW(sample(bad_index), InvalidInput);
 }
 
+// Crossing parity (asked for explicitly; `auto` takes open meshes by their winding number).
 TEST(Sample, OpenMeshIsRejectedWithBoundaryEdgeCount) {
+  SampleOptions parity;
+  parity.inside = InsideMode::Parity;
   TriMesh box = make_box({0, 0, 0}, {1, 1, 1});
   box.triangles.pop_back();
   try {
-    sample(box);
+    sample(box, parity);
     FAIL() << "an open mesh was accepted";
   } catch (const InvalidInput& e) {
     const std::string msg = e.what();
@@ -333,7 +336,7 @@ TEST(Sample, OpenMeshIsRejectedWithBoundaryEdgeCount) {
   box2.triangles.erase(box2.triangles.begin());
   box2.triangles.pop_back();
   try {
-    sample(box2);
+    sample(box2, parity);
     FAIL() << "an open mesh was accepted";
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("6 boundary edges"), std::string::npos) << e.what();

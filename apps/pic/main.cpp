@@ -168,7 +168,8 @@ pic::Octree load_any(const std::string& path, int depth, pic::TriMesh* contour_o
   }
   pic::SampleOptions o;
   o.depth = depth;
-  auto t = pic::sample(pic::read_mesh(path), o);
+  const pic::Geometry geo = pic::read_geometry(path);
+  auto t = geo.is_point_cloud() ? pic::sample(geo.points, o) : pic::sample(geo.mesh, o);
   if (contour_out) *contour_out = pic::contour(t);
   return t;
 }
@@ -181,18 +182,21 @@ int main(int argc, char** argv) {
   app.set_help_all_flag("--help-all", "Help for every subcommand");
 
   // sample
-  auto* cmd_sample = app.add_subcommand("sample", "Sample a closed triangle mesh into a PIC object");
-  std::string s_in, s_out, s_cube;
+  auto* cmd_sample = app.add_subcommand("sample", "Sample a triangle mesh or an oriented point cloud into a PIC object");
+  std::string s_in, s_out, s_cube, s_inside = "auto";
   int s_depth = 12;
   double s_error = 1e-8;
   bool s_json = false, s_serial = false;
-  cmd_sample->add_option("input", s_in, "Mesh file (obj, stl, ply, off, gltf, glb)")->required();
+  cmd_sample->add_option("input", s_in, "Mesh file (obj, stl, ply, off, gltf, glb) or point cloud (ply with normals, xyz)")->required();
   cmd_sample->add_option("-o,--output", s_out, "Output .pic file")->required();
   cmd_sample->add_option("--depth", s_depth, "Maximum octree level")->capture_default_str();
   cmd_sample->add_option("--error", s_error, "QEF residual threshold (root-cube units squared)")->capture_default_str();
   cmd_sample->add_option("--cube", s_cube, "Root cube X,Y,Z,SIZE (min corner, side) in input coordinates");
   cmd_sample->add_flag("--json", s_json, "Print one JSON object on stdout");
   cmd_sample->add_flag("--serial", s_serial, "Do not use threads");
+  cmd_sample->add_option("--inside", s_inside,
+                         "Inside/outside: auto (parity for clean closed meshes, else winding), parity, winding")
+      ->capture_default_str();
 
   // mesh
   auto* cmd_mesh = app.add_subcommand("mesh", "Extract the surface of a PIC object");
@@ -296,13 +300,23 @@ int main(int argc, char** argv) {
       o.error = s_error;
       o.parallel = !s_serial;
       if (!s_cube.empty()) o.cube = parse_cube(s_cube);
+      const auto mode = pic::parse_inside_mode(s_inside);
+      if (!mode) throw pic::InvalidInput("--inside must be auto, parity or winding");
+      o.inside = *mode;
       progress("reading " + s_in);
-      const pic::TriMesh mesh = pic::read_mesh(s_in);
-      progress("sampling " + std::to_string(mesh.triangles.size()) + " triangles");
+      const pic::Geometry geo = pic::read_geometry(s_in);
       pic::SampleStats st;
-      const pic::Octree tree = pic::sample(mesh, o, &st);
+      pic::Octree tree;
+      if (geo.is_point_cloud()) {
+        progress("sampling " + std::to_string(geo.points.positions.size()) + " points");
+        tree = pic::sample(geo.points, o, &st);
+      } else {
+        progress("sampling " + std::to_string(geo.mesh.triangles.size()) + " triangles");
+        tree = pic::sample(geo.mesh, o, &st);
+      }
       pic::save(tree, s_out);
       if (s_json) {
+        const pic::MeshDefects& d = st.defects;
         std::cout << Json()
                          .add("pics", st.pics)
                          .add("seconds", st.seconds)
@@ -310,6 +324,19 @@ int main(int argc, char** argv) {
                          .add("error", s_error)
                          .add("triangles_in", st.triangles_in)
                          .add("capped", st.capped)
+                         .add("points_in", geo.points.positions.size())
+                         .add("inside", st.classifier)
+                         .raw("defects", Json()
+                                             .add("boundary_edges", d.boundary_edges)
+                                             .add("nonmanifold_edges", d.nonmanifold_edges)
+                                             .add("inconsistent_edges", d.inconsistent_edges)
+                                             .add("duplicated_faces", d.duplicated_faces)
+                                             .add("degenerate_faces", d.degenerate_faces)
+                                             .add("shells", d.shells)
+                                             .add("overlapping_shells", d.overlapping_shells)
+                                             .str())
+                         .add("interior_triangles", st.interior_triangles)
+                         .add("boundary_loops", st.boundary_loops)
                          .add("file_bytes", static_cast<size_t>(std::filesystem::file_size(s_out)))
                          .raw("cube", Json().raw("origin", vec_json(tree.cube.origin)).add("size", tree.cube.size).str())
                          .str()

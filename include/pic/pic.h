@@ -40,6 +40,12 @@ struct TriMesh {
   std::vector<std::array<uint32_t, 3>> triangles;
 };
 
+/// An oriented point cloud (a scan): one normal per point, pointing out of the solid.
+struct PointCloud {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;  ///< same length as positions (need not be unit length)
+};
+
 /// The root cube: minimum corner and side length, in the input's own coordinates.
 struct Cube {
   Vec3 origin{0, 0, 0};
@@ -73,13 +79,41 @@ struct Octree {
   mutable std::vector<uint32_t> stamps;
 };
 
-/// Options for sampling a closed triangle mesh (paper section 4).
+/// How sample() tells inside from outside.
+enum class InsideMode {
+  Auto,     ///< Parity for a clean closed mesh (see MeshDefects::clean), Winding otherwise
+  Parity,   ///< exact crossing parity: closed meshes only (an open one is refused)
+  Winding,  ///< generalized winding number |w| >= 1/2: any triangle soup (docs/algorithms.md)
+};
+std::string to_string(InsideMode mode);
+/// Parses "auto", "parity", "winding".
+std::optional<InsideMode> parse_inside_mode(const std::string& s);
+
+/// Defects of a triangle mesh, counted after exact welding of equal positions.
+struct MeshDefects {
+  size_t boundary_edges = 0;      ///< edges with one triangle
+  size_t nonmanifold_edges = 0;   ///< edges with more than two triangles
+  size_t inconsistent_edges = 0;  ///< edges whose two triangles traverse them the same way
+  size_t duplicated_faces = 0;    ///< extra copies of a triangle, in either orientation
+  size_t degenerate_faces = 0;    ///< triangles with a repeated vertex
+  size_t shells = 0;              ///< edge-connected components
+  bool overlapping_shells = false;  ///< the bounding boxes of two shells overlap
+  /// The domain of exact crossing parity: closed, every edge on exactly two triangles, no
+  /// duplicates, shells apart. (Orientation does not matter to parity.)
+  bool clean() const {
+    return boundary_edges == 0 && nonmanifold_edges == 0 && duplicated_faces == 0 && !overlapping_shells;
+  }
+};
+MeshDefects find_defects(const TriMesh& mesh);
+
+/// Options for sampling a triangle mesh or a point cloud (paper section 4).
 struct SampleOptions {
   int depth = 12;          ///< maximum octree level, 1..kMaxLevel
   double error = 1e-8;     ///< QEF residual threshold delta^2, in root-cube units squared
   std::optional<Cube> cube;  ///< root cube; default: bounding cube plus a margin
   double margin = 1.0 / 16;  ///< automatic cube: margin on each side, relative to the extent
   bool parallel = true;      ///< build subtrees with TBB (output identical to serial)
+  InsideMode inside = InsideMode::Auto;  ///< meshes only; point clouds use their winding number
 };
 
 /// Statistics of a sampling run.
@@ -88,12 +122,24 @@ struct SampleStats {
   size_t pics = 0;
   size_t capped = 0;  ///< leaves accepted at the depth cap although a refinement rule failed
   double seconds = 0;
+  std::string classifier;   ///< "parity", "winding" or "points"
+  MeshDefects defects;      ///< of the input mesh (meshes only)
+  size_t interior_triangles = 0;  ///< winding: triangles with the solid on both sides (dropped)
+  size_t boundary_loops = 0;      ///< winding: closed curves of the input's boundary, capped
 };
 
-/// Adaptively samples a closed, consistently oriented triangle mesh into a PIC object.
-/// \throws InvalidInput for an empty or open mesh, non-finite coordinates, bad options, or a
-///         mesh that does not fit strictly inside the given cube.
+/// Adaptively samples a triangle mesh into a PIC object. A clean closed mesh is classified by
+/// exact crossing parity; any other (holes, non-manifold edges, flipped or duplicated triangles,
+/// overlapping shells, unwelded soups) by its generalized winding number, after welding,
+/// removing duplicates and orienting each edge-connected part by its majority (InsideMode).
+/// \throws InvalidInput for an empty mesh, non-finite coordinates, bad options, a mesh that
+///         does not fit strictly inside the given cube, an open mesh with InsideMode::Parity,
+///         or a mesh that encloses no solid (its winding number never reaches 1/2).
 Octree sample(const TriMesh& mesh, const SampleOptions& options = {}, SampleStats* stats = nullptr);
+/// Samples an oriented point cloud: signs from the points' winding number (each point a small
+/// disc of the area its neighbours leave it), vertices from their tangent planes.
+/// \throws InvalidInput for an empty cloud, missing or zero normals, non-finite values.
+Octree sample(const PointCloud& cloud, const SampleOptions& options = {}, SampleStats* stats = nullptr);
 
 /// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.
 Cube bounding_cube(const TriMesh& mesh, double margin = 1.0 / 16);
@@ -148,12 +194,6 @@ Octree load(const std::filesystem::path& path);
 std::vector<uint8_t> serialize(const Octree& tree);
 Octree deserialize(const std::vector<uint8_t>& bytes);
 ///@}
-
-/// An oriented point cloud (a scan): one normal per point, pointing out of the solid.
-struct PointCloud {
-  std::vector<Vec3> positions;
-  std::vector<Vec3> normals;  ///< same length as positions (need not be unit length)
-};
 
 /// What a geometry file holds: a triangle mesh, or (PLY with vertices and no faces, or .xyz
 /// text "x y z nx ny nz" per line) an oriented point cloud. Exactly one of the two is filled.

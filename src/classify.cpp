@@ -1,0 +1,335 @@
+#include "classify.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "vec3.h"
+
+namespace pic::detail {
+namespace {
+
+int sgn(i128 v) { return (v > 0) - (v < 0); }
+
+constexpr i64 kGridMax = i64{1} << kGridBits;
+
+// Winding-number decisions stop refining once the far field's truncation bound is below these
+// (docs/algorithms.md): a cap's level set may move to where w is within the tolerance of 1/2.
+// A point cloud's w is itself an estimate (Barill et al. 2018): its decisions take the
+// far-field sum as it is.
+constexpr double kCapTolerance = 0.05;
+constexpr double kPointTolerance = 1e300;
+
+/// Segments carrying the child grid's values from the parent's corners (see sample.cpp).
+struct Segment {
+  int to, from, axis;
+};
+std::array<Segment, 19> make_segments() {
+  std::array<Segment, 19> out{};
+  int n = 0;
+  for (int ones = 1; ones <= 3; ++ones)
+    for (int g = 0; g < 27; ++g) {
+      const int a[3] = {g % 3, (g / 3) % 3, g / 9};
+      if ((a[0] == 1) + (a[1] == 1) + (a[2] == 1) != ones) continue;
+      const int axis = a[0] == 1 ? 0 : (a[1] == 1 ? 1 : 2);
+      out[n++] = {g, g - (axis == 0 ? 1 : axis == 1 ? 3 : 9), axis};
+    }
+  return out;
+}
+const std::array<Segment, 19> kSegments = make_segments();
+
+Vec3 unit_vec(const Vec3& v) {
+  const double l = norm3(v);
+  return l > 0 ? Vec3{v[0] / l, v[1] / l, v[2] / l} : Vec3{0, 0, 0};
+}
+
+/// Bisects the edge of `cell` from corner c0 to c1 (signs differ) for the sign change, with
+/// `inside_at(offset)` the sign at c0 + offset along the edge. Returns the unit-space point.
+template <class F>
+Vec3 bisect_edge(const Cell& cell, int c0, int axis, bool s0, F&& inside_at) {
+  const I3 a = lattice_to_grid(cell.corner(c0));
+  i64 lo = 0, hi = lattice_to_grid(cell.span());
+  for (int it = 0; it < 16 && hi - lo > 1; ++it) {
+    const i64 mid = lo + (hi - lo) / 2;
+    (inside_at(mid) == s0 ? lo : hi) = mid;
+  }
+  I3 p = a;
+  p[axis] += lo + (hi - lo) / 2;
+  return to_unit(p);
+}
+
+}  // namespace
+
+// ---- triangle soups -----------------------------------------------------------------------
+
+WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary)
+    : all_(std::move(tris)), mesh_count_(mesh_count), boundary_(std::move(boundary)) {
+  tris_ = &all_;
+  bvh_.build(all_);
+  if (all_.size() > mesh_count_) caps_.build_triangles({all_.begin() + long(mesh_count_), all_.end()});
+}
+
+int32_t WindingSource::ray_winding(const I3& p) const {
+  // w(p) = sum over the triangles the ray p -> +x crosses of sign(n_x): w is 0 beyond the cube.
+  std::vector<uint32_t> hits;
+  bvh_.query(all_, p, {kGridMax, p[1], p[2]}, hits);
+  int32_t w = 0;
+  for (uint32_t k : hits)
+    if (crosses(all_[k], p, 0, kGridMax - p[0])) w += sgn(all_[k].n[0]);
+  return w;
+}
+
+bool WindingSource::inside(const I3& p, int32_t w) const {
+  if (caps_.empty()) return w != 0;
+  return caps_.inside(to_unit(p), &p, w, kCapTolerance);
+}
+
+void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
+                                     std::array<bool, 27>& g, Wind27* wind) const {
+  // Crossing a triangle along +axis changes w by -sign(n_axis) (its normal points out).
+  const i64 h = lattice_to_grid(cell.span() / 2);
+  std::array<int32_t, 27> jump{};
+  for (uint32_t k : idx) {
+    const ITri& t = all_[k];
+    for (const Segment& s : kSegments) {
+      const I3 start = child_grid_point(cell, s.from);
+      if (crosses(t, start, s.axis, h)) jump[s.to] -= sgn(t.n[s.axis]);
+    }
+  }
+  Wind27& w = *wind;
+  for (const Segment& s : kSegments) {
+    w[s.to] = w[s.from] + jump[s.to];
+    g[s.to] = inside(child_grid_point(cell, s.to), w[s.to]);
+  }
+}
+
+void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind,
+                                    const std::vector<uint32_t>& idx, Qef& q) const {
+  if (!wind || boundary_.empty()) return;
+  const i64 len = lattice_to_grid(cell.span());
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const bool s0 = (signs >> c0) & 1;
+    if (s0 == bool((signs >> c1) & 1)) continue;
+    const I3 a = lattice_to_grid(cell.corner(c0));
+    int surface = 0;
+    for (uint32_t k : idx) surface += (all_[k].use & kUseQef) && crosses(all_[k], a, axis, len);
+    if (surface & 1) continue;  // the input's own surface changes the sign here
+    const Vec3 x = bisect_edge(cell, c0, axis, s0, [&](i64 off) {
+      int32_t w = (*wind)[c0];
+      for (uint32_t k : idx)
+        if (crosses(all_[k], a, axis, off)) w -= sgn(all_[k].n[axis]);
+      I3 p = a;
+      p[axis] += off;
+      return inside(p, w);
+    });
+    // Across a hole the level set's normal is the gradient of w: the field of the boundary.
+    const Vec3 n = unit_vec(boundary_field(boundary_, x));
+    if (n == Vec3{0, 0, 0}) continue;
+    q.add_plane(n, dot3(n, x), 0.5);
+  }
+}
+
+int32_t WindingSource::winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx,
+                                       const I3& p) const {
+  I3 a = lattice_to_grid(cell.lat);
+  int32_t w = wind[0];
+  for (int axis = 0; axis < 3; ++axis) {
+    const i64 len = p[axis] - a[axis];
+    if (len > 0)
+      for (uint32_t k : idx)
+        if (crosses(all_[k], a, axis, len)) w -= sgn(all_[k].n[axis]);
+    a[axis] = p[axis];
+  }
+  return w;
+}
+
+bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind,
+                                    const std::vector<uint32_t>& idx) const {
+  // Past this many triangles the test costs more than subdividing (coarse cells split anyway).
+  constexpr size_t kMaxTested = 64;
+  if (!wind || idx.size() > kMaxTested) return meets_cell(all_, idx, cell);
+  const IBox box = cell.box();
+  const i64 delta = std::max<i64>(1, (box.hi[0] - box.lo[0]) / 1024);
+  const Vec3 centre = to_unit({(box.lo[0] + box.hi[0]) / 2, (box.lo[1] + box.hi[1]) / 2, (box.lo[2] + box.hi[2]) / 2});
+  for (uint32_t k : idx) {
+    const ITri& t = all_[k];
+    if (!(t.use & kUseMeets) || is_degenerate(t) || clipped_area(t, box) < 0) continue;
+    // The triangle's point nearest the cell's centre, and one point on each side of it.
+    const Vec3 x = closest_point_on_triangle(centre, to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2]));
+    I3 side[2];
+    for (int s = 0; s < 2; ++s) {
+      const I3 g = to_grid(x);
+      for (int a = 0; a < 3; ++a) {
+        const i64 off = i64(std::llround((s ? -1.0 : 1.0) * t.unit_normal[a] * double(delta)));
+        side[s][a] = std::clamp<i64>(g[a] + off, box.lo[a], box.hi[a]);
+      }
+    }
+    if (inside(side[0], winding_in_cell(cell, *wind, idx, side[0])) !=
+        inside(side[1], winding_in_cell(cell, *wind, idx, side[1])))
+      return true;
+  }
+  return false;
+}
+
+size_t WindingSource::drop_interior_triangles() {
+  std::atomic<size_t> dropped{0};
+  tbb::parallel_for(size_t{0}, mesh_count_, [&](size_t i) {
+    ITri& t = all_[i];
+    if (is_degenerate(t)) return;
+    const Vec3 v[3] = {to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2])};
+    const Vec3 c{(v[0][0] + v[1][0] + v[2][0]) / 3, (v[0][1] + v[1][1] + v[2][1]) / 3, (v[0][2] + v[1][2] + v[2][2]) / 3};
+    const double delta = 1e-6;
+    // The centroid, then halfway to each vertex: a triangle is kept when the sign differs
+    // across it anywhere we look.
+    for (int s = 0; s < 4; ++s) {
+      Vec3 p = c;
+      if (s > 0)
+        for (int k = 0; k < 3; ++k) p[k] = (c[k] + v[s - 1][k]) / 2;
+      I3 side[2];
+      for (int k = 0; k < 2; ++k) {
+        const double o = k ? -delta : delta;
+        side[k] = to_grid({p[0] + o * t.unit_normal[0], p[1] + o * t.unit_normal[1], p[2] + o * t.unit_normal[2]});
+      }
+      if (inside(side[0], ray_winding(side[0])) != inside(side[1], ray_winding(side[1]))) return;
+    }
+    t.use = 0;
+    ++dropped;
+  });
+  return dropped;
+}
+
+// ---- point clouds -------------------------------------------------------------------------
+
+namespace {
+
+/// Distance from each point to its k-th nearest neighbour (a uniform grid of buckets).
+std::vector<double> kth_neighbour_distance(const std::vector<Vec3>& pos, int k) {
+  const size_t n = pos.size();
+  std::vector<double> out(n, 0);
+  if (n < 2) return out;
+  Vec3 lo = pos[0], hi = pos[0];
+  for (const Vec3& p : pos)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  // Points on a surface: about 2 per bucket of this size.
+  const double g = 2 * extent / std::sqrt(double(n));
+  auto key_of = [&](int64_t x, int64_t y, int64_t z) { return (uint64_t(x) * 73856093u) ^ (uint64_t(y) * 19349663u) ^ (uint64_t(z) * 83492791u); };
+  auto cell_of = [&](const Vec3& p) {
+    return std::array<int64_t, 3>{int64_t((p[0] - lo[0]) / g), int64_t((p[1] - lo[1]) / g), int64_t((p[2] - lo[2]) / g)};
+  };
+  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;
+  for (uint32_t i = 0; i < n; ++i) {
+    const auto c = cell_of(pos[i]);
+    buckets[key_of(c[0], c[1], c[2])].push_back(i);
+  }
+  const int64_t max_ring = int64_t(extent / g) + 2;
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const auto c = cell_of(pos[i]);
+    std::vector<double> best;  // k smallest squared distances, sorted
+    for (int64_t r = 0; r <= max_ring; ++r) {
+      // Points in ring r are at least (r - 1) * g away.
+      if (int(best.size()) == k && r > 0 && double(r - 1) * g * double(r - 1) * g > best.back()) break;
+      for (int64_t dx = -r; dx <= r; ++dx)
+        for (int64_t dy = -r; dy <= r; ++dy)
+          for (int64_t dz = -r; dz <= r; ++dz) {
+            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
+            const auto it = buckets.find(key_of(c[0] + dx, c[1] + dy, c[2] + dz));
+            if (it == buckets.end()) continue;
+            for (uint32_t j : it->second) {
+              if (j == i) continue;
+              const Vec3 d = sub3(pos[j], pos[i]);
+              const double d2 = dot3(d, d);
+              if (int(best.size()) < k || d2 < best.back()) {
+                best.insert(std::upper_bound(best.begin(), best.end(), d2), d2);
+                if (int(best.size()) > k) best.pop_back();
+              }
+            }
+          }
+    }
+    out[i] = best.empty() ? 0 : std::sqrt(best.back());
+  });
+  return out;
+}
+
+ITri clamp_itri(I3 a, I3 b, I3 c) {
+  for (I3* p : {&a, &b, &c})
+    for (i64& x : *p) x = std::clamp<i64>(x, 1, kGridMax - 2);
+  return make_itri(a, b, c);
+}
+
+}  // namespace
+
+PointSource::PointSource(const std::vector<Vec3>& pos, const std::vector<Vec3>& normals) {
+  constexpr int kNeighbours = 8;
+  const std::vector<double> r = kth_neighbour_distance(pos, kNeighbours);
+  std::vector<double> area(pos.size());
+  for (size_t i = 0; i < pos.size(); ++i) area[i] = std::numbers::pi * r[i] * r[i] / kNeighbours;
+  tree_.build_points(pos, normals, area);
+  prims_.reserve(2 * pos.size());
+  for (size_t i = 0; i < pos.size(); ++i) {
+    const Vec3 n = unit_vec(normals[i]);
+    // A splat: an equilateral triangle in the tangent plane reaching the k-th neighbour.
+    const Vec3 helper = std::abs(n[0]) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 u = unit_vec(cross3(n, helper)), v = cross3(n, u);
+    I3 corner[3];
+    for (int k = 0; k < 3; ++k) {
+      const double th = 2 * std::numbers::pi * k / 3;
+      const double cu = std::cos(th) * r[i], cv = std::sin(th) * r[i];
+      corner[k] = to_grid({pos[i][0] + cu * u[0] + cv * v[0], pos[i][1] + cu * u[1] + cv * v[1],
+                           pos[i][2] + cu * u[2] + cv * v[2]});
+    }
+    ITri splat = clamp_itri(corner[0], corner[1], corner[2]);
+    splat.use = kUseQef;
+    // Its plane is the point's tangent plane, not the rounded corners'.
+    splat.unit_normal = n;
+    splat.plane = dot3(n, pos[i]);
+    prims_.push_back(splat);
+    // A marker the size of one grid step: "surface here" for the cells that hold the point.
+    const I3 g = to_grid(pos[i]);
+    ITri marker = clamp_itri(g, {g[0] + 1, g[1], g[2]}, {g[0], g[1] + 1, g[2]});
+    marker.use = kUseMeets;
+    prims_.push_back(marker);
+  }
+  tris_ = &prims_;
+}
+
+bool PointSource::inside(const I3& p) const { return tree_.inside(to_unit(p), nullptr, 0, kPointTolerance); }
+
+void PointSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g,
+                                   Wind27*) const {
+  for (const Segment& s : kSegments) g[s.to] = inside(child_grid_point(cell, s.to));
+}
+
+void PointSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8*, const std::vector<uint32_t>&,
+                                  Qef& q) const {
+  if (!q.empty()) return;  // the splats in the cell say where the surface is
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const bool s0 = (signs >> c0) & 1;
+    if (s0 == bool((signs >> c1) & 1)) continue;
+    const I3 a = lattice_to_grid(cell.corner(c0));
+    const Vec3 x = bisect_edge(cell, c0, axis, s0, [&](i64 off) {
+      I3 p = a;
+      p[axis] += off;
+      return inside(p);
+    });
+    const double h = cell.size() / 16;
+    Vec3 grad;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 lo = x, hi = x;
+      lo[k] -= h;
+      hi[k] += h;
+      grad[k] = std::abs(tree_.evaluate(lo).w) - std::abs(tree_.evaluate(hi).w);
+    }
+    const Vec3 n = unit_vec(grad);
+    if (n == Vec3{0, 0, 0}) continue;
+    q.add_plane(n, dot3(n, x), 0.5);
+  }
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,70 @@
+// Inside/outside for inputs that are not clean closed meshes (docs/algorithms.md, "Any input").
+//
+// Triangle soups: the generalized winding number w of the input M is split as
+//   w_M(p) = w_{M+C}(p) - w_C(p),
+// where C is a set of cones closing M's boundary chain. M + C has no boundary, so w_{M+C} is an
+// integer that the sampler carries from corner to corner by signed crossing counts — exact, with
+// the same predicates and tie-break as crossing parity. Only w_C, the few cone triangles, is a
+// real number; a dipole tree evaluates it, exactly where the decision |w| >= 1/2 is close.
+// Every sign is a function of the lattice point alone.
+//
+// Point clouds: w is the points' winding number (each point a disc of its neighbours' spacing),
+// evaluated per lattice point with the same tree.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "bvh.h"
+#include "sample.h"
+#include "winding.h"
+
+namespace pic::detail {
+
+class WindingSource : public SurfaceSource {
+ public:
+  /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it.
+  WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary);
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
+                        Wind27* wind) const override;
+  bool tracks_winding() const override { return true; }
+  bool surface_matters(const Cell& cell, uint8_t signs, const Wind8* wind,
+                       const std::vector<uint32_t>& idx) const override;
+  void add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind, const std::vector<uint32_t>& idx,
+                       Qef& q) const override;
+
+  /// Integer winding number of input + cones at a grid point (a ray to the cube's boundary).
+  int32_t ray_winding(const I3& p) const;
+  /// The sign at grid point p whose integer winding number is w.
+  bool inside(const I3& p, int32_t w) const;
+  /// Integer winding number at grid point p of `cell` (corner windings `wind`), by a path
+  /// along the cell's edges directions from its first corner.
+  int32_t winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx, const I3& p) const;
+  /// Marks input triangles with the solid on both sides or on neither (interior walls of
+  /// overlapping shells, stray sheets) as playing no part in the surface. Returns how many.
+  size_t drop_interior_triangles();
+
+ private:
+  std::vector<ITri> all_;
+  size_t mesh_count_;
+  TriangleBvh bvh_;
+  DipoleTree caps_;
+  std::vector<std::array<Vec3, 2>> boundary_;  // unit space
+};
+
+class PointSource : public SurfaceSource {
+ public:
+  /// Points and normals in unit space (root cube [0,1]^3).
+  PointSource(const std::vector<Vec3>& pos, const std::vector<Vec3>& normals);
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
+                        Wind27* wind) const override;
+  void add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind, const std::vector<uint32_t>& idx,
+                       Qef& q) const override;
+  bool inside(const I3& p) const;
+
+ private:
+  std::vector<ITri> prims_;  // per point: a splat (QEF) and a tiny marker (meets)
+  DipoleTree tree_;
+};
+
+}  // namespace pic::detail

@@ -1,0 +1,90 @@
+// Winding numbers: the dipole tree's decisions against exact sums, and the boundary caps.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "mesh_repair.h"
+#include "support/shapes.h"
+#include "winding.h"
+
+namespace pic {
+namespace {
+
+using detail::DipoleTree;
+using detail::I3;
+using detail::ITri;
+
+std::vector<ITri> grid_tris(const TriMesh& m) {
+  std::vector<ITri> out;
+  for (const auto& t : m.triangles)
+    out.push_back(detail::make_itri(detail::to_grid(m.positions[t[0]]), detail::to_grid(m.positions[t[1]]),
+                                    detail::to_grid(m.positions[t[2]])));
+  return out;
+}
+
+double exact_winding(const TriMesh& m, const Vec3& p) {
+  double w = 0;
+  for (const auto& t : m.triangles)
+    w += detail::triangle_winding(p, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]);
+  return w;
+}
+
+TEST(Winding, ClosedSphereIsOneInsideZeroOutside) {
+  const TriMesh s = make_sphere({0.5, 0.5, 0.5}, 0.3, 32);
+  EXPECT_NEAR(exact_winding(s, {0.5, 0.5, 0.5}), 1.0, 1e-9);
+  EXPECT_NEAR(exact_winding(s, {0.55, 0.42, 0.61}), 1.0, 1e-9);
+  EXPECT_NEAR(exact_winding(s, {0.95, 0.5, 0.5}), 0.0, 1e-9);
+  EXPECT_NEAR(exact_winding(s, {0.1, 0.1, 0.9}), 0.0, 1e-9);
+}
+
+// The tree's inside() must take the same decision as the exact sum wherever that sum is not
+// within rounding of 1/2, for an open mesh (a sphere with a cap cut off) at random points.
+TEST(Winding, TreeDecisionsMatchExactSums) {
+  TriMesh s = make_sphere({0.5, 0.5, 0.5}, 0.3, 48);
+  std::erase_if(s.triangles, [&](const auto& t) { return s.positions[t[0]][2] > 0.72 && s.positions[t[1]][2] > 0.72; });
+  DipoleTree tree;
+  tree.build_triangles(grid_tris(s));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.1, 0.9);
+  int checked = 0, inside = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p{u(rng), u(rng), u(rng)};
+    const double w = tree.evaluate(p, nullptr, 0).w;
+    EXPECT_NEAR(w, exact_winding(s, p), 1e-7);  // the tree's vertices are on the 2^-32 grid
+    if (std::abs(std::abs(w) - 0.5) < 1e-7) continue;
+    ++checked;
+    inside += std::abs(w) >= 0.5;
+    ASSERT_EQ(tree.inside(p), std::abs(w) >= 0.5) << "at " << p[0] << " " << p[1] << " " << p[2] << " w " << w;
+  }
+  EXPECT_GT(checked, 3900);
+  EXPECT_GT(inside, 100);  // the test sees both answers
+}
+
+// The caps close the boundary chain: every edge of mesh + caps has net count 0.
+TEST(Winding, CapsCloseTheBoundaryChain) {
+  TriMesh s = make_sphere({0.5, 0.5, 0.5}, 0.3, 32);
+  // Two holes and a flipped triangle.
+  std::erase_if(s.triangles, [&](const auto& t) { return s.positions[t[0]][2] > 0.75 || s.positions[t[0]][0] < 0.25; });
+  std::swap(s.triangles[10][1], s.triangles[10][2]);
+  const auto chain = detail::boundary_chain(s);
+  ASSERT_FALSE(chain.empty());
+  size_t loops = 0;
+  TriMesh closed = s;
+  for (const auto& t : detail::cap_loops(chain, &loops)) closed.triangles.push_back(t);
+  EXPECT_GE(loops, 2u);
+  EXPECT_TRUE(detail::boundary_chain(closed).empty());
+}
+
+TEST(Winding, BoundaryFieldIsTheLevelSetNormalOfAFlatHole) {
+  // A unit square loop in the plane z = 0.5, counter-clockwise seen from +z: on its axis the
+  // field is along z.
+  const std::vector<std::array<Vec3, 2>> loop = {{Vec3{0.4, 0.4, 0.5}, Vec3{0.6, 0.4, 0.5}},
+                                                 {Vec3{0.6, 0.4, 0.5}, Vec3{0.6, 0.6, 0.5}},
+                                                 {Vec3{0.6, 0.6, 0.5}, Vec3{0.4, 0.6, 0.5}},
+                                                 {Vec3{0.4, 0.6, 0.5}, Vec3{0.4, 0.4, 0.5}}};
+  const Vec3 f = detail::boundary_field(loop, {0.5, 0.5, 0.52});
+  EXPECT_NEAR(std::abs(f[2]) / std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), 1.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace pic
