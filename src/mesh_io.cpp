@@ -101,9 +101,9 @@ TriMesh to_mesh(const detail::RawGeometry& g, const std::string& name) {
 
 namespace detail {
 
-std::string declares_too_many(uint64_t count, const std::string& what, size_t bytes) {
+std::string declares_too_many(uint64_t count, const std::string& what, size_t bytes, size_t left) {
   return "declares " + std::to_string(count) + " " + what + " but the file has only " + std::to_string(bytes) +
-         " bytes";
+         " bytes (" + std::to_string(left) + " after the header)";
 }
 
 TriMesh read_mesh_bytes(const std::vector<uint8_t>& bytes, const std::string& ext, const std::string& name) {

@@ -26,7 +26,9 @@ std::string_view next_token(TextCursor& t) {
 // The next token on this line, ignoring a comment.
 std::string_view line_token(TextCursor& t) {
   const std::string_view tok = t.token_on_line();
-  return !tok.empty() && tok[0] == '#' ? std::string_view() : tok;
+  if (tok.empty() || tok[0] != '#') return tok;
+  t.skip_to_line_end();
+  return {};
 }
 
 uint64_t count(std::string_view tok, size_t line, const char* what) {
@@ -54,8 +56,8 @@ RawGeometry read_off(Bytes bytes) {
   const uint64_t nf = count(next_token(t), t.line(), "face");
   t.skip_line();  // the edge count (unused) and anything after it
   // A vertex takes at least "0 0 0\n" and a face at least "0\n".
-  if (nv > t.remaining() / 5 + 1) fail(declares_too_many(nv, "vertices", bytes.size));
-  if (nf > t.remaining() / 2 + 1) fail(declares_too_many(nf, "faces", bytes.size));
+  if (nv > t.remaining() / 5 + 1) fail(declares_too_many(nv, "vertices", bytes.size, t.remaining()));
+  if (nf > t.remaining() / 2 + 1) fail(declares_too_many(nf, "faces", bytes.size, t.remaining()));
   RawGeometry g;
   g.positions.resize(size_t(nv));
   for (uint64_t i = 0; i < nv; ++i) {

@@ -224,7 +224,7 @@ RawGeometry read_ply(Bytes bytes) {
     const uint64_t left = in.remaining() + (in.ascii() ? 1 : 0);
     if (e.count > left / need) {
       const std::string what = e.name == "vertex" ? "vertices" : e.name == "face" ? "faces" : "'" + e.name + "' elements";
-      fail(declares_too_many(e.count, what, bytes.size));
+      fail(declares_too_many(e.count, what, bytes.size, in.remaining()));
     }
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;

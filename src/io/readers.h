@@ -41,8 +41,9 @@ inline void add_fan(const uint32_t* corners, size_t n, std::vector<std::array<ui
   for (size_t k = 1; k + 1 < n; ++k) out.push_back({corners[0], corners[k], corners[k + 1]});
 }
 
-/// The message for a header that declares more records than the file can hold.
-std::string declares_too_many(uint64_t count, const std::string& what, size_t bytes);
+/// The message for a header that declares more records than the file can hold: `bytes` in
+/// the file, `left` of them after the header.
+std::string declares_too_many(uint64_t count, const std::string& what, size_t bytes, size_t left);
 
 /// Entries by content (for the fuzz harnesses and tests): `ext` is the lower-case extension
 /// with its dot; `name` prefixes error messages. \throws IoError, InvalidInput as read_mesh.

@@ -53,6 +53,11 @@ class TextCursor {
 
   void skip_line() { rest_of_line(); }
 
+  /// Moves to the end of the current line, staying on it (for a comment).
+  void skip_to_line_end() {
+    while (p_ < end_ && *p_ != '\n') ++p_;
+  }
+
  private:
   const char* p_;
   const char* end_;
