@@ -1,7 +1,8 @@
 // Replays files through the fuzz harness bodies without libFuzzer (any compiler), plus a few
 // seeded mutations of each file (bit flips, truncations, duplicated and deleted spans), so
 // the normal g++ build and CI keep a fuzz smoke run over the committed corpus.
-//   fuzz_replay [--mutations N] KIND=DIR_OR_FILE ...     KIND: obj stl ply off gltf pic
+//   fuzz_replay [--mutations N] KIND=DIR_OR_FILE ...     KIND: obj stl ply off gltf pic, or
+//   auto (the file's own extension picks the reader, as for tests/data/fuzz/)
 // Exit 0 when every input is either accepted or refused with InvalidInput/IoError; any other
 // outcome is a crash (or an escaped exception reported here, exit 1).
 #include <algorithm>
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
     std::vector<std::filesystem::path> files;
     if (std::filesystem::is_directory(path)) {
       for (const auto& e : std::filesystem::directory_iterator(path))
-        if (e.is_regular_file()) files.push_back(e.path());
+        if (e.is_regular_file() && e.path().extension() != ".md") files.push_back(e.path());
     } else {
       files.push_back(path);
     }
@@ -90,7 +91,13 @@ int main(int argc, char** argv) {
       for (int m = -1; m < mutations; ++m) {
         const std::vector<uint8_t> input = m < 0 ? bytes : mutate(bytes, rng);
         try {
-          pic::fuzz::run_harness(kind, input.data(), input.size());
+          if (kind != "auto") {
+            pic::fuzz::run_harness(kind, input.data(), input.size());
+          } else if (f.extension() == ".pic") {
+            pic::fuzz::run_pic(input.data(), input.size());
+          } else {
+            pic::fuzz::run_reader(input.data(), input.size(), f.extension().string());
+          }
         } catch (const std::exception& e) {
           const std::string out = "fuzz-finding-" + kind + "-" + f.filename().string() + "-" + std::to_string(m);
           std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(input.data()), long(input.size()));

@@ -29,7 +29,9 @@ for h in "${harnesses[@]}"; do
   rc=$?
   done_line=$(grep -E '^Done [0-9]+ runs' "$log" | tail -1)
   execs=$(grep -E 'stat::number_of_executed_units' "$log" | awk '{print $2}')
-  echo "fuzz $h: rc=$rc executions=${execs:-?} ${done_line:-} corpus=$(ls "$corpus" | wc -l)"
+  line="fuzz $h: rc=$rc executions=${execs:-?} ${done_line:-} corpus=$(ls "$corpus" | wc -l)"
+  echo "$line"
+  echo "$(date -u +%FT%TZ) $line" >> "$build/findings/summary.txt"
   if (( rc != 0 )); then
     status=1
     grep -E 'ERROR|SUMMARY|runtime error|Test unit written' "$log" | head -5

@@ -3,6 +3,7 @@
 // files — each checked for the geometry read back, or for the error and how fast it comes.
 // The files under tests/data/fuzz/ (inputs the fuzzers once broke) are replayed here too.
 #include <gtest/gtest.h>
+#include <dlfcn.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -403,6 +404,25 @@ TEST(Readers, CliRefusesAGiganticDepth) {
   std::string err;
   EXPECT_EQ(run_cli("sample '" + (dir / "t.off").string() + "' --depth 1000000 -o '" + (dir / "o.pic").string() + "'", err), 2);
   EXPECT_EQ(err.rfind("pic: error: depth must be between 1 and", 0), 0u) << err;
+}
+
+}  // namespace
+}  // namespace pic
+
+namespace Assimp {
+void aiAssertViolation(const char* expression, const char* file, int line);
+}
+
+namespace pic {
+namespace {
+
+// assimp's internal asserts call Assimp::aiAssertViolation through the dynamic linker; PIC's
+// definition (src/io/assimp.cpp) must be the one the process resolves, and it must throw.
+TEST(Readers, AssimpAssertsBecomeExceptions) {
+  void* resolved = dlsym(RTLD_DEFAULT, "_ZN6Assimp17aiAssertViolationEPKcS1_i");
+  ASSERT_NE(resolved, nullptr);
+  EXPECT_EQ(resolved, reinterpret_cast<void*>(&Assimp::aiAssertViolation));
+  EXPECT_THROW(Assimp::aiAssertViolation("numOut != pMesh->mNumFaces", "TriangulateProcess.cpp", 238), InvalidInput);
 }
 
 }  // namespace
