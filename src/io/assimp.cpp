@@ -8,6 +8,7 @@
 //   "GLB" that the DXF importer then took, using 1.9 GB);
 // - a GLB header's declared lengths are checked against the file size before assimp sees it
 //   (assimp 5.2 allocates what the header declares);
+// - the import runs in a forked child with a time and memory budget (see "Isolation" below);
 // - the scene is validated (aiProcess_ValidateDataStructure) and every face index is checked
 //   again while collecting;
 // - the work of flattening the node tree (instances) is budgeted against the file size, and the
@@ -17,6 +18,15 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <poll.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -32,6 +42,15 @@ void aiAssertViolation(const char* expression, const char* file, int line) {
                           file + ":" + std::to_string(line) + ")");
 }
 }  // namespace Assimp
+
+// AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it.
+#if defined(__SANITIZE_ADDRESS__)
+#define PIC_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PIC_UNDER_ASAN 1
+#endif
+#endif
 
 namespace pic::detail {
 namespace {
@@ -108,7 +127,8 @@ bool is_gltf_importer(const aiImporterDesc* d) {
 
 }  // namespace
 
-RawGeometry read_with_assimp(Bytes bytes, const std::string& ext) {
+// The import itself, in this process.
+RawGeometry import_here(Bytes bytes, const std::string& ext) {
   Assimp::Importer importer;
   const bool gltf = ext == ".gltf" || ext == ".glb";
   if (gltf) {
@@ -133,6 +153,139 @@ RawGeometry read_with_assimp(Bytes bytes, const std::string& ext) {
   // Instancing may repeat a mesh; allow a generous multiple of what the file itself holds.
   Collector c{scene, g, 64 * uint64_t(bytes.size) + (uint64_t(1) << 20)};
   c.node(scene->mRootNode, aiMatrix4x4(), 0);
+  return g;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Isolation. assimp 5.2 still dereferences null on some malformed glTF that passes every
+// check above (fuzzing: a primitive whose "indices" names a float accessor), and no pre-check
+// short of a full glTF validator catches them all. So the import runs in a forked child with a
+// time budget (and, outside sanitizer builds, an address-space budget); the child sends the
+// raw geometry or the error back through a pipe. A child that dies or overruns becomes
+// InvalidInput in the caller, which never shares assimp's fate.
+
+enum class Outcome : uint8_t { Ok = 0, Invalid = 1, Io = 2 };
+
+bool write_all(int fd, const void* p, size_t n) {
+  const auto* b = static_cast<const uint8_t*>(p);
+  while (n > 0) {
+    const ssize_t w = ::write(fd, b, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    b += w;
+    n -= size_t(w);
+  }
+  return true;
+}
+
+[[noreturn]] void child(Bytes bytes, const std::string& ext, int fd) {
+#if !defined(PIC_UNDER_ASAN)
+  // Address space: what the process already maps plus 4 GiB plus 64 bytes per input byte.
+  long pages = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
+    std::fclose(f);
+  }
+  const rlim_t limit = rlim_t(pages) * rlim_t(::sysconf(_SC_PAGESIZE)) + (rlim_t(4) << 30) + 64 * rlim_t(bytes.size);
+  const rlimit rl{limit, limit};
+  ::setrlimit(RLIMIT_AS, &rl);
+#endif
+  Outcome outcome = Outcome::Ok;
+  std::string message;
+  RawGeometry g;
+  try {
+    g = import_here(bytes, ext);
+  } catch (const InvalidInput& e) {
+    outcome = Outcome::Invalid;
+    message = e.what();
+  } catch (const IoError& e) {
+    outcome = Outcome::Io;
+    message = e.what();
+  } catch (const std::bad_alloc&) {
+    outcome = Outcome::Invalid;
+    message = "the importer (assimp) ran out of its memory budget";
+  } catch (const std::exception& e) {
+    outcome = Outcome::Invalid;
+    message = std::string("malformed file (assimp: ") + e.what() + ")";
+  }
+  const uint64_t head[3] = {message.size(), g.positions.size(), g.triangles.size()};
+  const bool ok = write_all(fd, &outcome, 1) && write_all(fd, head, sizeof head) &&
+                  write_all(fd, message.data(), message.size()) &&
+                  write_all(fd, g.positions.data(), g.positions.size() * sizeof(Vec3)) &&
+                  write_all(fd, g.triangles.data(), g.triangles.size() * sizeof(g.triangles[0]));
+  ::_exit(ok ? 0 : 1);  // no atexit handlers or destructors of the parent's state
+}
+
+// Reads everything the child sends until it closes the pipe or the deadline passes.
+bool read_until_eof(int fd, std::vector<uint8_t>& out, std::chrono::steady_clock::time_point deadline) {
+  uint8_t buf[1 << 16];
+  while (true) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    pollfd p{fd, POLLIN, 0};
+    const int r = ::poll(&p, 1, int(std::min<long long>(left.count(), 1000)));
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) return false;
+    if (r == 0) continue;
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n == 0;
+    out.insert(out.end(), buf, buf + n);
+  }
+}
+
+}  // namespace
+
+RawGeometry read_with_assimp(Bytes bytes, const std::string& ext) {
+  int fds[2];
+  if (::pipe(fds) != 0) throw IoError(std::string("cannot start the importer: ") + std::strerror(errno));
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw IoError(std::string("cannot start the importer: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    child(bytes, ext, fds[1]);
+  }
+  ::close(fds[1]);
+  // Time budget: 10 s plus 1 s per MB, generous for a real file, short for a hang.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10 + bytes.size / 1000000);
+  std::vector<uint8_t> reply;
+  const bool complete = read_until_eof(fds[0], reply, deadline);
+  ::close(fds[0]);
+  if (!complete) ::kill(pid, SIGKILL);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!complete) throw InvalidInput("the importer (assimp) did not finish within its time budget");
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || reply.size() < 1 + 24) {
+    if (WIFSIGNALED(status))
+      throw InvalidInput("malformed file: the importer (assimp) crashed on it (signal " +
+                         std::to_string(WTERMSIG(status)) + ")");
+    throw InvalidInput("malformed file: the importer (assimp) failed on it");
+  }
+  uint64_t head[3];
+  std::memcpy(head, reply.data() + 1, sizeof head);
+  const size_t need = 25 + head[0] + head[1] * sizeof(Vec3) + head[2] * sizeof(std::array<uint32_t, 3>);
+  if (head[0] > reply.size() || head[1] > reply.size() || head[2] > reply.size() || reply.size() != need)
+    throw InvalidInput("malformed file: the importer (assimp) failed on it");
+  const auto outcome = Outcome(reply[0]);
+  const std::string message(reinterpret_cast<const char*>(reply.data()) + 25, size_t(head[0]));
+  if (outcome == Outcome::Io) throw IoError(message);
+  if (outcome != Outcome::Ok) throw InvalidInput(message);
+  RawGeometry g;
+  g.positions.resize(size_t(head[1]));
+  g.triangles.resize(size_t(head[2]));
+  const uint8_t* p = reply.data() + 25 + head[0];
+  std::memcpy(g.positions.data(), p, g.positions.size() * sizeof(Vec3));
+  std::memcpy(g.triangles.data(), p + g.positions.size() * sizeof(Vec3), g.triangles.size() * sizeof(g.triangles[0]));
+  for (const auto& t : g.triangles)
+    for (uint32_t i : t)
+      if (i >= g.positions.size()) throw InvalidInput("malformed file: the importer (assimp) failed on it");
   return g;
 }
 
