@@ -4,7 +4,7 @@
 BUILD ?= build
 JOBS  ?= 2
 
-.PHONY: setup build demo test bench clean
+.PHONY: setup build demo test bench fuzz clean
 
 setup:
 	bash scripts/setup.sh
@@ -24,6 +24,17 @@ bench:
 	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DPIC_BUILD_TESTS=ON -DPIC_BUILD_BENCH=ON
 	cmake --build $(BUILD) -j$(JOBS)
 	bash bench/run.sh $(BUILD)
+
+# Fuzzing (docs/reliability.md): libFuzzer + ASan/UBSan harnesses built with clang in build-fuzz,
+# each run for FUZZ_RUNS executions (glTF: a tenth).
+FUZZ_BUILD ?= build-fuzz
+FUZZ_RUNS  ?= 1000000
+fuzz:
+	bash scripts/setup.sh --fuzz
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DPIC_BUILD_FUZZ=ON -DPIC_BUILD_TESTS=OFF -DPIC_BUILD_CLI=OFF
+	cmake --build $(FUZZ_BUILD) -j$(JOBS)
+	bash fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_RUNS)
 
 clean:
 	rm -rf $(BUILD) out

@@ -2,12 +2,16 @@
 # Installs the Debian packages PIC needs when they are missing (idempotent; needs root or sudo).
 #   scripts/setup.sh            build + tests
 #   scripts/setup.sh --bench    also the benchmark peers (OpenVDB, Google Benchmark)
+#   scripts/setup.sh --fuzz     also clang and libFuzzer (make fuzz)
 set -euo pipefail
 
 pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
       libcli11-dev libgtest-dev chromium)
 if [[ "${1:-}" == "--bench" ]]; then
   pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3)
+fi
+if [[ "${1:-}" == "--fuzz" ]]; then
+  pkgs+=(clang libclang-rt-14-dev)
 fi
 
 missing=()

@@ -1,10 +1,10 @@
-// Mesh files. Reading goes through assimp (OBJ, STL ascii/binary, PLY, OFF, glTF/GLB, ...)
-// followed by exact welding of duplicate positions, since many files repeat vertices per face.
+// Mesh files. Reading: PIC's own readers for PLY, OFF, STL, OBJ and XYZ point clouds (src/io/,
+// small grammars whose every count is checked against the file size), assimp only for glTF/GLB
+// and other formats (guarded, src/io/assimp.cpp); see docs/reliability.md for why. Then exact
+// welding of duplicate positions, since many files repeat vertices per face.
 // Writing OBJ/STL/PLY/OFF is done here (small, streaming, no side files such as .mtl);
 // GLB goes through assimp's exporter (one file; .gltf would need a side .bin).
 #include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
@@ -18,6 +18,7 @@
 #include <unordered_map>
 
 #include "file_util.h"
+#include "io/readers.h"
 #include "pic/pic.h"
 
 namespace pic {
@@ -42,70 +43,100 @@ struct PosHash {
   }
 };
 
-void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
-             std::unordered_map<Vec3, uint32_t, PosHash>& weld) {
-  const aiMatrix4x4 m = parent * node->mTransformation;
-  for (unsigned k = 0; k < node->mNumMeshes; ++k) {
-    const aiMesh* mesh = scene->mMeshes[node->mMeshes[k]];
-    std::vector<uint32_t> ids(mesh->mNumVertices);
-    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-      const aiVector3D p = m * mesh->mVertices[v];
-      Vec3 q{p.x, p.y, p.z};
-      for (double& x : q) x = x == 0 ? 0 : x;
-      if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
-        throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
-      auto [it, fresh] = weld.try_emplace(q, static_cast<uint32_t>(out.positions.size()));
-      if (fresh) out.positions.push_back(q);
-      ids[v] = it->second;
-    }
-    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-      const aiFace& face = mesh->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      out.triangles.push_back({ids[face.mIndices[0]], ids[face.mIndices[1]], ids[face.mIndices[2]]});
-    }
+bool finite(const Vec3& p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+// Exact welding of equal positions (-0 == +0); refuses NaN and inf.
+TriMesh weld(const detail::RawGeometry& g) {
+  TriMesh out;
+  std::unordered_map<Vec3, uint32_t, PosHash> seen;
+  std::vector<uint32_t> ids(g.positions.size());
+  for (size_t v = 0; v < g.positions.size(); ++v) {
+    Vec3 q = g.positions[v];
+    for (double& x : q) x = x == 0 ? 0 : x;
+    if (!finite(q)) throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
+    auto [it, fresh] = seen.try_emplace(q, static_cast<uint32_t>(out.positions.size()));
+    if (fresh) out.positions.push_back(q);
+    ids[v] = it->second;
   }
-  for (unsigned c = 0; c < node->mNumChildren; ++c) collect(scene, node->mChildren[c], m, out, weld);
+  out.triangles.reserve(g.triangles.size());
+  for (const auto& t : g.triangles) out.triangles.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
+  return out;
 }
 
-// Assimp's OBJ/PLY readers accept "nan" silently or turn it into 0; check the raw text too.
-void check_text_for_nan(const std::vector<uint8_t>& bytes) {
-  const size_t n = std::min<size_t>(bytes.size(), size_t{1} << 30);
-  for (size_t i = 0; i + 3 <= n; ++i) {
-    const uint8_t first = bytes[i] | 0x20;  // ASCII lower case
-    if (first != 'n' && first != 'i') continue;
-    const char a = char(first), b = char(bytes[i + 1] | 0x20), c = char(bytes[i + 2] | 0x20);
-    const bool word_start = i == 0 || std::isspace(bytes[i - 1]) || bytes[i - 1] == '-' || bytes[i - 1] == '+';
-    if (word_start && ((a == 'n' && b == 'a' && c == 'n') || (a == 'i' && b == 'n' && c == 'f')))
-      throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
+detail::RawGeometry read_raw(const std::vector<uint8_t>& bytes, const std::string& ext, const std::string& name) {
+  if (bytes.empty()) throw InvalidInput(name + ": file is empty");
+  const detail::Bytes b{bytes.data(), bytes.size()};
+  try {
+    if (ext == ".ply") return detail::read_ply(b);
+    if (ext == ".off") return detail::read_off(b);
+    if (ext == ".stl") return detail::read_stl(b);
+    if (ext == ".obj") return detail::read_obj(b);
+    if (ext == ".xyz") return detail::read_xyz(b);
+    return detail::read_with_assimp(b, ext);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(name + ": " + e.what());
+  } catch (const IoError& e) {
+    throw IoError(name + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw InvalidInput(name + ": out of memory while reading (file too large for this machine)");
+  }
+}
+
+TriMesh to_mesh(const detail::RawGeometry& g, const std::string& name) {
+  try {
+    TriMesh m = weld(g);
+    if (m.triangles.empty()) {
+      if (g.point_cloud && !g.positions.empty())
+        throw InvalidInput("has no triangles: it is a point cloud of " + std::to_string(g.positions.size()) +
+                           " points, not a mesh");
+      throw InvalidInput("mesh has no triangles");
+    }
+    return m;
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(name + ": " + e.what());
   }
 }
 
 }  // namespace
 
-TriMesh read_mesh(const std::filesystem::path& path) {
-  const auto bytes = detail::read_file(path);  // clear errors for missing/unreadable files
-  if (bytes.empty()) throw InvalidInput(path.string() + ": file is empty");
-  const std::string ext = lower_ext(path);
-  const bool text = ext == ".obj" || ext == ".off" ||
-                    (ext == ".ply" && bytes.size() > 20 && std::memcmp(bytes.data(), "ply", 3) == 0 &&
-                     std::string(bytes.begin(), bytes.begin() + std::min<size_t>(bytes.size(), 200)).find("ascii") != std::string::npos) ||
-                    (ext == ".stl" && bytes.size() > 5 && std::memcmp(bytes.data(), "solid", 5) == 0);
-  if (text) check_text_for_nan(bytes);
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(),
-                                                     aiProcess_Triangulate | aiProcess_SortByPType,
-                                                     ext.empty() ? "" : ext.c_str() + 1);
-  if (!scene || !scene->mRootNode) {
-    std::string why = importer.GetErrorString();
-    if (why.find("No suitable reader") != std::string::npos || why.find("unsupported") != std::string::npos)
-      throw IoError(path.string() + ": unknown or unsupported mesh format '" + ext + "'");
-    throw InvalidInput(path.string() + ": malformed mesh (" + why + ")");
+namespace detail {
+
+std::string declares_too_many(uint64_t count, const std::string& what, size_t bytes, size_t left) {
+  return "declares " + std::to_string(count) + " " + what + " but the file has only " + std::to_string(bytes) +
+         " bytes (" + std::to_string(left) + " after the header)";
+}
+
+TriMesh read_mesh_bytes(const std::vector<uint8_t>& bytes, const std::string& ext, const std::string& name) {
+  if (ext == ".xyz")
+    throw IoError(name + ": unknown or unsupported mesh format '.xyz' (a point cloud format: it has no triangles)");
+  return to_mesh(read_raw(bytes, ext, name), name);
+}
+
+Geometry read_geometry_bytes(const std::vector<uint8_t>& bytes, const std::string& ext, const std::string& name) {
+  const RawGeometry g = read_raw(bytes, ext, name);
+  Geometry out;
+  if (!g.point_cloud || g.positions.empty()) {
+    out.mesh = to_mesh(g, name);
+    return out;
   }
-  TriMesh out;
-  std::unordered_map<Vec3, uint32_t, PosHash> weld;
-  collect(scene, scene->mRootNode, aiMatrix4x4(), out, weld);
-  if (out.triangles.empty()) throw InvalidInput(path.string() + ": mesh has no triangles");
+  if (g.normals.size() != g.positions.size())
+    throw InvalidInput(name + ": point cloud has no normals (nx ny nz): normals are needed to tell inside from outside");
+  for (size_t i = 0; i < g.positions.size(); ++i)
+    if (!finite(g.positions[i]) || !finite(g.normals[i]))
+      throw InvalidInput(name + ": point cloud has non-finite (NaN or inf) coordinates or normals");
+  out.points.positions = g.positions;
+  out.points.normals = g.normals;
   return out;
+}
+
+}  // namespace detail
+
+TriMesh read_mesh(const std::filesystem::path& path) {
+  return detail::read_mesh_bytes(detail::read_file(path), lower_ext(path), path.string());
+}
+
+Geometry read_geometry(const std::filesystem::path& path) {
+  return detail::read_geometry_bytes(detail::read_file(path), lower_ext(path), path.string());
 }
 
 namespace {

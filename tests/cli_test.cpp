@@ -174,7 +174,7 @@ TEST_F(Cli, SampleFailuresLeaveTheOutputUntouched) {
   expect_clean_failure("sample sheet.obj -o out.pic", "out.pic", "no solid");
   // A point cloud without normals.
   write_text_file(path("cloud.xyz"), "0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
-  expect_clean_failure("sample cloud.xyz -o out.pic", "out.pic", "normals are needed");
+  expect_clean_failure("sample cloud.xyz -o out.pic", "out.pic", "need normals");
   expect_clean_failure("sample open.obj -o out.pic --inside sideways", "out.pic", "--inside");
   // NaN coordinate.
   write_text_file(path("nan.obj"), "v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
