@@ -415,6 +415,12 @@ class Lowering {
     return s;
   }
 
+  template <class F>
+  static void for_each_point(const Shape& s, const F& f) {
+    for (const Ring& r : s.rings)
+      for (const P2& p : r) f(p);
+    for (const Shape& c : s.children) for_each_point(c, f);
+  }
   static void bounds2(const Shape& s, double& lo, double& hi) {
     for (const Ring& r : s.rings)
       for (const P2& p : r) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
@@ -491,13 +497,49 @@ class Lowering {
     }
     e.scale = {std::max(0.0, e.scale[0]), std::max(0.0, e.scale[1])};
     check_finite(n, {e.height, e.twist, e.scale[0], e.scale[1]});
-    // OpenSCAD 2021 (linearextrude.cc): without `slices`, a twisted extrusion gets
-    // max(2, |fragments(height) twist / 360|) slices; otherwise one.
+    // Slices when `slices` is not given, as OpenSCAD 2021.01 does (measured against its
+    // output; Calc::get_helix_slices / get_diagonal_slices): a twist takes the fewer of
+    // |twist| / $fa and (helix length of the outermost vertex) / $fs, at least one per 120
+    // degrees, or |twist| $fn / 360 when $fn is set; a non-uniform scale without twist takes
+    // (length of the longest vertex path) / $fs; otherwise one slice.
     int slices = static_cast<int>(number(n, "slices", 0));
-    if (e.twist != 0 && slices == 0)
-      slices = static_cast<int>(std::fmax(
-          2, std::fabs(fragments_from_r(e.height, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12)) *
-                       e.twist / 360)));
+    if (slices <= 0) {
+      const double fn = number(n, "$fn", 0), fs = number(n, "$fs", 2), fa = number(n, "$fa", 12);
+      double r2 = 0, d2 = 0;
+      for_each_point(s, [&](const P2& p) {
+        r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
+        const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
+        d2 = std::max(d2, dx * dx + dy * dy);
+      });
+      const double tw = std::abs(e.twist);
+      slices = 1;
+      if (tw > 0) {
+        const int min_slices = std::max(static_cast<int>(std::ceil(tw / 120.0)), 1);
+        if (fn > 0) {
+          slices = std::max(static_cast<int>(std::ceil(tw / 360.0 * fn)), min_slices);
+        } else if (std::sqrt(r2) >= 0.00000095367431640625) {
+          // Length of the outermost vertex's path: a conical helix when scaled (Simpson's rule).
+          const double r0 = std::sqrt(r2), th = tw * std::numbers::pi / 180;
+          const double sc = std::max(e.scale[0], e.scale[1]);
+          auto speed = [&](double t) {
+            const double r = r0 * (1 + (sc - 1) * t), dr = r0 * (sc - 1);
+            return std::sqrt(r * r * th * th + dr * dr + e.height * e.height);
+          };
+          constexpr int kSteps = 64;
+          double len = speed(0) + speed(1);
+          for (int i = 1; i < kSteps; ++i) len += (i % 2 ? 4 : 2) * speed(double(i) / kSteps);
+          len /= 3.0 * kSteps;
+          const int fa_slices = static_cast<int>(std::ceil(tw / fa));
+          const int fs_slices = static_cast<int>(std::ceil(len / fs));
+          slices = std::max(std::min(fa_slices, fs_slices), min_slices);
+        } else {
+          slices = min_slices;
+        }
+      } else if (e.scale[0] != e.scale[1]) {
+        slices = fn > 0 ? std::max(static_cast<int>(fn), 1)
+                        : std::max(static_cast<int>(std::ceil(std::sqrt(d2 + e.height * e.height) / fs)), 1);
+      }
+    }
     if (opt_.smooth && e.twist != 0) {
       // The walls follow helices: keep the chord of the largest radius below the tolerance.
       double lo = 0, hi = 0;

@@ -196,7 +196,7 @@ TriMesh extrude_linear(Ring ring, const LinearExtrude& e) {
   // OpenSCAD's add_slice: the diagonal runs from the lower "prev" to the upper "curr" vertex
   // when sin((rot1 - rot2)) > 0, i.e. for a negative twist; holes use the mirrored rule, which
   // is the same diagonal once the hole is traversed counter-clockwise as here.
-  const bool split_first = std::sin(rad(-e.twist / slices)) > 0;
+  const bool split_first = std::sin(rad(e.twist / slices)) > 0;
   for (int j = 0; j < slices; ++j)
     for (size_t i = 0; i < n; ++i) {
       const size_t k = (i + 1) % n;
