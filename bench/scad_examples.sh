@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# `pic eval` against OpenSCAD 2021's own renderer on every example Debian's openscad ships.
+#   bench/scad_examples.sh [OUTDIR] [DEPTH]     (default: /tmp/pic_scad_examples, depth 12)
+# For each /usr/share/openscad/examples/*/*.scad: export the .csg; render the reference
+# with `openscad -o ref.stl x.scad` (timeout 300 s); run `pic eval x.scad -o pic.stl` (same
+# timeout); compare volume and two-sided Hausdorff distance in finest cells (`pic compare`);
+# evaluate the same .csg with Manifold (/work/shared/tools/manifold/scad.mjs) as a second
+# reference. Every timed run holds the CPU lock (/work/notes/cpu.lock) when it exists, one
+# at a time. Prints a Markdown table and totals; raw JSON per example in OUTDIR.
+set -uo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+out=${1:-/tmp/pic_scad_examples}
+depth=${2:-12}
+pic=${PIC:-$here/build/pic}
+manifold=${MANIFOLD_SCAD:-/work/shared/tools/manifold/scad.mjs}
+lock=/work/notes/cpu.lock
+mkdir -p "$out"
+locked() { if [[ -e $lock ]]; then flock "$lock" "$@"; else "$@"; fi; }
+now() { date +%s.%N; }
+
+for scad in /usr/share/openscad/examples/*/*.scad; do
+  name=$(basename "$scad" .scad)
+  d="$out/$name"
+  mkdir -p "$d"
+  # OpenSCAD resolves relative -o paths against the input's folder: use absolute paths.
+  timeout 60 openscad -o "$d/x.csg" "$scad" >"$d/export.log" 2>&1
+  t0=$(now)
+  locked timeout 300 openscad -o "$d/ref.stl" "$scad" >"$d/openscad.log" 2>&1
+  echo "$? $(echo "$(now) - $t0" | bc)" >"$d/openscad.rc"
+  t0=$(now)
+  locked timeout 300 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
+  echo "$? $(echo "$(now) - $t0" | bc)" >"$d/pic.rc"
+  if [[ -s $d/x.csg && -e $manifold ]]; then
+    locked timeout 300 node "$manifold" "$d/x.csg" "$d/manifold.obj" --json >"$d/manifold.json" 2>"$d/manifold.err"
+  fi
+  rm -f "$d/cmp_ref.json" "$d/cmp_manifold.json"
+  if [[ -s $d/pic.stl ]]; then
+    cell=$(python3 -c "import json; j=json.load(open('$d/pic.json')); print(j['cube']['size']/2**$depth)")
+    [[ -s $d/ref.stl ]] && locked "$pic" compare "$d/pic.stl" "$d/ref.stl" --unit "$cell" --json >"$d/cmp_ref.json" 2>/dev/null
+    [[ -s $d/manifold.obj ]] && locked "$pic" compare "$d/pic.stl" "$d/manifold.obj" --unit "$cell" --json >"$d/cmp_manifold.json" 2>/dev/null
+  fi
+  echo "$name done" >&2
+done
+
+python3 - "$out" <<'PY'
+import json, os, sys, statistics
+out = sys.argv[1]
+def load(p):
+    try:
+        with open(p) as f: return json.load(f)
+    except Exception: return None
+rows, speed, ok_n, total_ref, total_pic = [], [], 0, 0.0, 0.0
+for name in sorted(os.listdir(out)):
+    d = os.path.join(out, name)
+    if not os.path.isdir(d): continue
+    orc, osec = open(f"{d}/openscad.rc").read().split()
+    prc, psec = open(f"{d}/pic.rc").read().split()
+    osec, psec = float(osec), float(psec)
+    ref_ok = orc == "0" and os.path.getsize(f"{d}/ref.stl") > 0 if os.path.exists(f"{d}/ref.stl") else False
+    pj = load(f"{d}/pic.json")
+    mj = load(f"{d}/manifold.json")
+    if prc != "0" or not pj:
+        err = open(f"{d}/pic.err").read().strip().splitlines()
+        why = err[-1].replace("pic: error: ", "") if err else f"exit {prc}"
+        why = why.split(": ", 1)[-1] if ".scad: " in why else why
+        if not ref_ok: why += "; OpenSCAD: no 3D result"
+        rows.append(f"| {name} | no | {why} | {osec:.2f} | | | | | |")
+        continue
+    ok_n += 1
+    cr, cm = load(f"{d}/cmp_ref.json"), load(f"{d}/cmp_manifold.json")
+    topo = pj.get("topology", {})
+    man = "yes" if topo.get("manifold") else ("closed" if topo.get("closed") else "no")
+    sp = ""
+    if ref_ok:
+        s = osec / psec
+        speed.append(s); total_ref += osec; total_pic += psec
+        sp = f"{s:.1f}x"
+    vol = f"{100*cr['volume_rel_diff']:+.3f} %" if cr else "–"
+    hd = f"{cr['hausdorff']:.2f}" if cr else "–"
+    hm = f"{cm['hausdorff']:.2f}" if cm else "–"
+    mt = f"{mj['ms_total']/1000:.2f}" if mj and mj.get("ok") else "–"
+    rows.append(f"| {name} | yes | {pj['leaves']} leaves, {pj['booleans']} Booleans, {man} | "
+                f"{osec:.2f}{'' if ref_ok else ' (failed)'} | {psec:.2f} | {sp} | {vol} | {hd} | {mt} / {hm} |")
+print("| example | evaluated | PIC result | OpenSCAD s | PIC s | speed-up | volume vs OpenSCAD | Hausdorff vs OpenSCAD (cells) | Manifold s / Hausdorff (cells) |")
+print("|---|---|---|---|---|---|---|---|---|")
+print("\n".join(rows))
+if speed:
+    print(f"\nEvaluated {ok_n} of {len(rows)}; median speed-up {statistics.median(speed):.1f}x, "
+          f"total {total_ref:.1f} s (OpenSCAD) vs {total_pic:.1f} s (PIC) = {total_ref/total_pic:.1f}x "
+          f"over the {len(speed)} with an OpenSCAD result.")
+PY
