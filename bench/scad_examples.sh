@@ -65,7 +65,7 @@ def load(p):
 rows, speed, ok_n, total_ref, total_pic = [], [], 0, 0.0, 0.0
 for name in sorted(os.listdir(out)):
     d = os.path.join(out, name)
-    if not os.path.isdir(d): continue
+    if not os.path.isdir(d) or not os.path.exists(f"{d}/pic.rc"): continue
     prc, psec = open(f"{d}/pic.rc").read().split()
     orc, osec = open(f"{d}/openscad.rc").read().split() if os.path.exists(f"{d}/openscad.rc") else ("-", "nan")
     osec, psec = float(osec), float(psec)
