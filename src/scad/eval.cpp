@@ -375,7 +375,9 @@ class Lowering {
       Ring h = convex_hull_2d(pts);
       if (h.size() < 3) return {};
       s.rings.push_back(std::move(h));
-    } else if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" || k == "import" ||
+    } else if (k == "import") {
+      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node 'import' of a 2D file (DXF, SVG)");
+    } else if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" ||
                k == "linear_extrude" || k == "rotate_extrude") {
       fail(n, "a 3D object inside a 2D subtree");
     } else {
@@ -421,10 +423,29 @@ class Lowering {
       for (const P2& p : r) f(p);
     for (const Shape& c : s.children) for_each_point(c, f);
   }
+  // x-range of the shape, conservatively: a difference spans its first child, an
+  // intersection the overlap of its children.
   static void bounds2(const Shape& s, double& lo, double& hi) {
+    double l = 1e300, h = -1e300;
+    range2(s, l, h);
+    if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
+  }
+  static void range2(const Shape& s, double& lo, double& hi) {
     for (const Ring& r : s.rings)
       for (const P2& p : r) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
-    for (const Shape& c : s.children) bounds2(c, lo, hi);
+    if (s.kind == Shape::Kind::Union) {
+      for (const Shape& c : s.children) range2(c, lo, hi);
+    } else if (s.kind == Shape::Kind::Difference && !s.children.empty()) {
+      range2(s.children[0], lo, hi);
+    } else if (s.kind == Shape::Kind::Intersect) {
+      double l = -1e300, h = 1e300;
+      for (const Shape& c : s.children) {
+        double cl = 1e300, ch = -1e300;
+        range2(c, cl, ch);
+        l = std::max(l, cl), h = std::min(h, ch);
+      }
+      if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
+    }
   }
 
   // Even-odd rings -> Booleans of simple rings: each ring at even nesting depth minus the

@@ -219,7 +219,19 @@ TriMesh extrude_linear(Ring ring, const LinearExtrude& e) {
 
 TriMesh extrude_rotate(Ring ring, double angle, int fragments) {
   TriMesh m;
-  ring = cleaned(ring);
+  // Only the x >= 0 part revolves (a subtracted shape may reach across the axis): clip the
+  // ring to that half plane (Sutherland-Hodgman); pieces joined along the axis collapse there.
+  Ring clipped;
+  for (size_t i = 0, n = ring.size(); i < n; ++i) {
+    const P2& a = ring[i];
+    const P2& b = ring[(i + 1) % n];
+    if (a[0] >= 0) clipped.push_back(a);
+    if ((a[0] >= 0) != (b[0] >= 0)) {
+      const double t = a[0] / (a[0] - b[0]);
+      clipped.push_back({0, a[1] + t * (b[1] - a[1])});
+    }
+  }
+  ring = cleaned(clipped);
   if (ring.size() < 3 || signed_area(ring) == 0 || angle == 0) return m;
   if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
   angle = std::clamp(angle, -360.0, 360.0);
