@@ -348,7 +348,8 @@ class Lowering {
       s.rings.push_back(apply2(m, circle_ring(r, frags(n, r, stretch2(m) * stretch_3d_))));
     } else if (k == "polygon") {
       const Value* pv = arg(n, "points");
-      if (!pv || pv->kind != Value::Kind::Vector) fail(n, "needs points");
+      if (!pv || pv->kind == Value::Kind::Undef) return {};  // OpenSCAD: empty, with a warning
+      if (pv->kind != Value::Kind::Vector) fail(n, "points must be a vector");
       Ring pts;
       for (const Value& p : pv->items) {
         const auto xs = numbers(n, p, "points");
