@@ -2,8 +2,8 @@
 # `pic eval` against OpenSCAD 2021's own renderer on every example Debian's openscad ships.
 #   bench/scad_examples.sh [OUTDIR] [DEPTH]     (default: /tmp/pic_scad_examples, depth 12)
 # For each /usr/share/openscad/examples/*/*.scad: export the .csg; run
-# `pic eval x.scad -o pic.stl` (timeout 120 s); render the reference with
-# `openscad -o ref.stl x.scad` (timeout 150 s); compare volume and two-sided Hausdorff distance in finest cells (`pic compare`);
+# `pic eval x.scad -o pic.stl` (timeout 60 s); render the reference with
+# `openscad -o ref.stl x.scad` (timeout 100 s); compare volume and two-sided Hausdorff distance in finest cells (`pic compare`);
 # evaluate the same .csg with Manifold (/work/shared/tools/manifold/scad.mjs) as a second
 # reference. Each example runs whole under the CPU lock (/work/notes/cpu.lock) when it
 # exists, one at a time. Prints a Markdown table and totals; raw JSON per example in OUTDIR.
@@ -27,9 +27,9 @@ one() {
     timeout "$lim" "$@"
     echo "$? $(echo "$(date +%s.%N) - $t0" | bc)" >"$rc"
   }
-  t "$d/pic.rc" 120 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
+  t "$d/pic.rc" 60 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
   [[ $(cut -d' ' -f1 "$d/pic.rc") == 2 ]] && return
-  t "$d/openscad.rc" 150 openscad -o "$d/ref.stl" "$scad" >"$d/openscad.log" 2>&1
+  t "$d/openscad.rc" 100 openscad -o "$d/ref.stl" "$scad" >"$d/openscad.log" 2>&1
   if [[ -s $d/x.csg && -e $manifold ]]; then
     timeout 60 node "$manifold" "$d/x.csg" "$d/manifold.obj" --json >"$d/manifold.json" 2>"$d/manifold.err"
   fi
@@ -44,16 +44,36 @@ one() {
 export -f one
 export pic depth manifold
 
-for scad in /usr/share/openscad/examples/*/*.scad; do
-  name=$(basename "$scad" .scad)
-  d="$out/$name"
-  rm -rf "$d"
-  mkdir -p "$d"
-  # OpenSCAD resolves relative -o paths against the input's folder: use absolute paths.
-  timeout 60 openscad -o "$d/x.csg" "$scad" >"$d/export.log" 2>&1
-  if [[ -e $lock ]]; then flock "$lock" bash -c 'one "$@"' _ "$scad" "$d"; else one "$scad" "$d"; fi
-  echo "$name: $(cat "$d/pic.rc") $(tail -1 "$d/pic.err" | cut -c1-120)" >&2
-done
+# An example is done once its pic.rc exists (and, when PIC evaluated it, openscad.rc): an
+# interrupted run resumes where it stopped. Batches of examples share one lock acquisition
+# while it has been held for under 150 s (with the timeouts, at most ~5 minutes).
+batch() {
+  local start=$SECONDS scad name d
+  for scad in "$@"; do
+    name=$(basename "$scad" .scad)
+    d="$out/$name"
+    if [[ -e $d/pic.rc ]] && { [[ $(cut -d' ' -f1 "$d/pic.rc") == 2 ]] || [[ -e $d/openscad.rc ]]; }; then continue; fi
+    ((SECONDS - start > 150)) && return 1
+    rm -rf "$d"
+    mkdir -p "$d"
+    # OpenSCAD resolves relative -o paths against the input's folder: use absolute paths.
+    timeout 60 openscad -o "$d/x.csg" "$scad" >"$d/export.log" 2>&1
+    one "$scad" "$d"
+    echo "$name: $(cat "$d/pic.rc") $(tail -1 "$d/pic.err" | cut -c1-120)" >&2
+  done
+  return 0
+}
+export -f batch
+export out
+# The classic examples (Old/) first: they are the CSG models.
+examples=(/usr/share/openscad/examples/Old/*.scad /usr/share/openscad/examples/Parametric/*.scad
+          /usr/share/openscad/examples/Functions/*.scad /usr/share/openscad/examples/Basics/*.scad
+          /usr/share/openscad/examples/Advanced/*.scad)
+if [[ -e $lock ]]; then
+  until flock "$lock" bash -c 'batch "$@"' _ "${examples[@]}"; do :; done
+else
+  batch "${examples[@]}"
+fi
 
 python3 - "$out" <<'PY'
 import json, os, sys, statistics
@@ -76,6 +96,7 @@ for name in sorted(os.listdir(out)):
         err = open(f"{d}/pic.err").read().strip().splitlines()
         why = err[-1].replace("pic: error: ", "") if err else f"exit {prc}"
         why = why.split(": ", 1)[-1] if ".scad: " in why else why
+        if prc == "124": why = "PIC timed out (60 s)"
         rows.append(f"| {name} | no | {why} | | | | | | |")
         continue
     ok_n += 1
