@@ -9,10 +9,12 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
+#include "pic/scad.h"
 #ifdef PIC_HAS_RENDER
 #include "pic/render.h"
 #endif
@@ -174,6 +176,14 @@ pic::Octree load_any(const std::string& path, int depth, pic::TriMesh* contour_o
   return t;
 }
 
+// True when `path` names a mesh format (written by contouring) rather than a .pic file.
+bool is_mesh_path(const std::string& path) {
+  const auto dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".obj" || ext == ".stl" || ext == ".ply" || ext == ".off" || ext == ".glb" || ext == ".gltf";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -221,13 +231,32 @@ int main(int argc, char** argv) {
   std::string c_out, c_mesh;
   bool c_json = false, c_no_split = false;
   double c_error = 1e-8;
-  cmd_csg->add_option("args", c_args, "A.pic OP B.pic [OP C.pic ...]")->required();
-  cmd_csg->add_option("-o,--output", c_out, "Output .pic file")->required();
+  int c_depth = 12;
+  cmd_csg->add_option("args", c_args, "A OP B [OP C ...]; operands are .pic files or meshes")->required();
+  cmd_csg->add_option("-o,--output", c_out, "Output .pic file, or a mesh (.obj, .stl, .ply, .off, .glb)")->required();
+  cmd_csg->add_option("--depth", c_depth, "Sampling depth for mesh operands (one shared cube around them)")
+      ->capture_default_str();
   cmd_csg->add_option("--mesh", c_mesh, "Also contour the result to this mesh file");
   cmd_csg->add_flag("--no-split", c_no_split,
                     "With --mesh: write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   cmd_csg->add_option("--error", c_error, "QEF residual threshold for new vertices")->capture_default_str();
   cmd_csg->add_flag("--json", c_json, "Print one JSON object on stdout");
+
+  // eval
+  auto* cmd_eval = app.add_subcommand("eval", "Evaluate an OpenSCAD model (.scad via openscad, or its .csg export)");
+  std::string e_in, e_out;
+  int e_depth = 12;
+  double e_error = 1e-8;
+  bool e_smooth = false, e_json = false, e_serial = false, e_no_split = false;
+  cmd_eval->add_option("input", e_in, "OpenSCAD .scad or .csg file")->required();
+  cmd_eval->add_option("-o,--output", e_out, "Output .pic, or a mesh (.stl, .obj, .ply, .off, .glb)")->required();
+  cmd_eval->add_option("--depth", e_depth, "Maximum octree level")->capture_default_str();
+  cmd_eval->add_option("--error", e_error, "QEF residual threshold (root-cube units squared)")->capture_default_str();
+  cmd_eval->add_flag("--smooth", e_smooth,
+                     "Tessellate spheres, cylinders and circles to 0.05 finest cells instead of by $fn/$fa/$fs");
+  cmd_eval->add_flag("--json", e_json, "Print one JSON object on stdout");
+  cmd_eval->add_flag("--serial", e_serial, "Do not use threads");
+  cmd_eval->add_flag("--no-split", e_no_split, "Mesh output: write the dual contouring mesh as is");
 
   // prim
   auto* cmd_prim = app.add_subcommand("prim", "Sample a primitive solid: box|sphere|cylinder|cone|torus");
@@ -385,14 +414,34 @@ int main(int argc, char** argv) {
       if (c_args.size() < 3 || c_args.size() % 2 == 0)
         throw pic::InvalidInput("csg needs A.pic OP B.pic [OP C.pic ...]");
       const auto t0 = Clock::now();
-      pic::Octree acc = pic::load(c_args[0]);
+      // Mesh operands are sampled into one cube around all of them, so the Booleans need no
+      // resampling; .pic operands keep their own cube.
+      std::vector<pic::TriMesh> meshes(c_args.size());
+      pic::TriMesh all;
+      for (size_t k = 0; k < c_args.size(); k += 2)
+        if (c_args[k].size() < 4 || c_args[k].substr(c_args[k].size() - 4) != ".pic") {
+          meshes[k] = pic::read_mesh(c_args[k]);
+          all.positions.insert(all.positions.end(), meshes[k].positions.begin(), meshes[k].positions.end());
+        }
+      std::optional<pic::Cube> shared;
+      if (!all.positions.empty()) shared = pic::bounding_cube(all);
+      auto operand = [&](size_t k) {
+        if (meshes[k].positions.empty()) return pic::load(c_args[k]);
+        pic::SampleOptions so;
+        so.depth = c_depth;
+        so.error = c_error;
+        so.cube = shared;
+        progress("sampling " + c_args[k]);
+        return pic::sample(meshes[k], so);
+      };
+      pic::Octree acc = operand(0);
       std::string ops = "[";
       pic::CsgOptions opt;
       opt.error = c_error;
       for (size_t k = 1; k + 1 < c_args.size(); k += 2) {
         const auto op = pic::parse_csg_op(c_args[k]);
         if (!op) throw pic::InvalidInput("unknown operation '" + c_args[k] + "' (union, intersect, subtract)");
-        const pic::Octree b = pic::load(c_args[k + 1]);
+        const pic::Octree b = operand(k + 1);
         pic::CsgStats st;
         progress(pic::to_string(*op) + " " + c_args[k + 1]);
         acc = pic::csg(acc, b, *op, opt, &st);
@@ -418,10 +467,18 @@ int main(int argc, char** argv) {
       }
       ops += "]";
       const double secs = since(t0);
-      pic::save(acc, c_out);
       Json j;
       const size_t pics = pic::analyze(acc).pics;
       j.add("pics", pics).add("seconds", secs).raw("ops", ops);
+      if (is_mesh_path(c_out)) {
+        pic::TriMesh mesh = pic::contour(acc);
+        const size_t split = c_no_split ? 0 : pic::split_nonmanifold(mesh);
+        pic::write_mesh(mesh, c_out);
+        j.add("triangles", mesh.triangles.size()).add("split_vertices", split).add("volume", pic::volume(mesh))
+            .raw("topology", topology_json(pic::analyze_topology(mesh)));
+      } else {
+        pic::save(acc, c_out);
+      }
       if (!c_mesh.empty()) {
         pic::TriMesh mesh = pic::contour(acc);
         const size_t split = c_no_split ? 0 : pic::split_nonmanifold(mesh);
@@ -431,6 +488,48 @@ int main(int argc, char** argv) {
       }
       if (c_json) std::cout << j.str() << "\n";
       else std::printf("%zu PICs -> %s\n", pics, c_out.c_str());
+    } else if (*cmd_eval) {
+      pic::EvalOptions eo;
+      eo.depth = e_depth;
+      eo.error = e_error;
+      eo.smooth = e_smooth;
+      eo.parallel = !e_serial;
+      eo.progress = [](const std::string& m) { std::cerr << "pic: " << m << "\n"; };
+      pic::EvalStats st;
+      const pic::Octree tree = pic::eval_scad(e_in, eo, &st);
+      Json j;
+      j.add("seconds", st.seconds)
+          .add("openscad_seconds", st.openscad_seconds)
+          .add("mesh_seconds", st.mesh_seconds)
+          .add("octree_seconds", st.octree_seconds)
+          .add("nodes", st.nodes)
+          .add("leaves", st.leaves)
+          .add("leaf_triangles", st.triangles)
+          .add("booleans", st.booleans)
+          .add("depth", e_depth)
+          .add("smooth", e_smooth)
+          .add("pics", pic::analyze(tree).pics)
+          .raw("cube", Json().raw("origin", vec_json(tree.cube.origin)).add("size", tree.cube.size).str());
+      std::string summary;
+      if (is_mesh_path(e_out)) {
+        const auto t1 = Clock::now();
+        pic::TriMesh mesh = pic::contour(tree);
+        const size_t split = e_no_split ? 0 : pic::split_nonmanifold(mesh);
+        const double csecs = since(t1);
+        pic::write_mesh(mesh, e_out);
+        const auto topo = pic::analyze_topology(mesh);
+        j.add("contour_seconds", csecs).add("triangles", mesh.triangles.size()).add("split_vertices", split)
+            .add("volume", pic::volume(mesh)).raw("topology", topology_json(topo));
+        summary = std::to_string(mesh.triangles.size()) + " triangles (" +
+                  (topo.manifold() ? "closed manifold" : topo.closed() ? "closed, NOT manifold" : "NOT closed") + ")";
+      } else {
+        pic::save(tree, e_out);
+        summary = std::to_string(pic::analyze(tree).pics) + " PICs";
+      }
+      if (e_json) std::cout << j.str() << "\n";
+      else
+        std::printf("%zu leaves, %zu Booleans in %.3f s: %s -> %s\n", st.leaves, st.booleans, st.seconds,
+                    summary.c_str(), e_out.c_str());
     } else if (*cmd_prim) {
       const auto c = parse_numbers(p_center, 3, "--center");
       const pic::Vec3 center{c[0], c[1], c[2]};

@@ -1,0 +1,56 @@
+// OpenSCAD models in: the CSG tree that `openscad -o x.csg` exports, evaluated on PIC octrees
+// (docs/openscad.md). Curved primitives are tessellated by OpenSCAD's own rules ($fn, $fa, $fs),
+// every leaf is sampled into one root cube around the whole model, and the Booleans run on the
+// octrees bottom-up.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "pic/pic.h"
+
+namespace pic {
+
+struct EvalOptions {
+  int depth = 12;          ///< maximum octree level, 1..kMaxLevel
+  double error = 1e-8;     ///< QEF residual threshold (as SampleOptions::error)
+  /// Tessellate spheres, cylinders, cones and circles so finely that the chord error is at most
+  /// `smooth_chord` finest cells, instead of by $fn/$fa/$fs. The sampler takes meshes only, so
+  /// this is a very fine tessellation, not an exact curved surface.
+  bool smooth = false;
+  double smooth_chord = 0.05;
+  bool parallel = true;    ///< independent subtrees and sampling with TBB
+  /// Directory that `import(file = ...)` paths are relative to; default: the .csg file's own.
+  std::filesystem::path base_dir;
+  /// Called now and then with a one-line progress message (may be empty: silent).
+  std::function<void(const std::string&)> progress;
+};
+
+struct EvalStats {
+  size_t nodes = 0;        ///< nodes in the .csg tree
+  size_t leaves = 0;       ///< closed meshes sampled
+  size_t triangles = 0;    ///< triangles of all leaves
+  size_t booleans = 0;     ///< octree Booleans
+  double openscad_seconds = 0;  ///< `openscad -o x.csg` (for .scad input)
+  double mesh_seconds = 0;      ///< parse, tessellate, extrude, hull
+  double octree_seconds = 0;    ///< sampling plus Booleans (wall clock)
+  double seconds = 0;           ///< total wall clock
+  Cube cube;
+};
+
+/// Evaluates OpenSCAD CSG-tree text (the .csg format). `source` names it in error messages.
+/// \throws InvalidInput for a syntax error or an unsupported node (the message names the node
+///         and its line), or an empty model; IoError for an unreadable import.
+Octree eval_csg(const std::string& text, const EvalOptions& options = {}, EvalStats* stats = nullptr,
+                const std::string& source = "input");
+/// Reads and evaluates a .csg file. \throws as eval_csg, IoError when unreadable.
+Octree eval_csg_file(const std::filesystem::path& path, const EvalOptions& options = {},
+                     EvalStats* stats = nullptr);
+/// A .scad file is exported to .csg by the `openscad` program (a temporary file), then evaluated
+/// with imports relative to the .scad file; a .csg file is evaluated directly.
+/// \throws InvalidInput when `openscad` is missing or rejects the file; as eval_csg_file.
+Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options = {},
+                 EvalStats* stats = nullptr);
+
+}  // namespace pic

@@ -1,0 +1,873 @@
+// Evaluates an OpenSCAD CSG tree on PIC octrees. Two passes:
+//  1. lower: the parsed .csg tree becomes a tree of Booleans over closed meshes in world
+//     coordinates (transforms pushed into the leaves; 2D subtrees under an extrusion become
+//     extruded leaves combined with the same Booleans, since extrusion commutes with them);
+//  2. evaluate: one root cube around every leaf, each leaf sampled into it, the Booleans run on
+//     the octrees bottom-up -- n-ary unions balanced, independent subtrees in parallel (TBB).
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <unistd.h>
+
+#include "pic/primitives.h"
+#include "pic/scad.h"
+#include "scad/scad_detail.h"
+
+namespace pic {
+namespace {
+
+using namespace detail::scad;
+using Node = detail::scad::Node;  // not pic::Node (an octree cell)
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// The lowered tree: Booleans over closed meshes (3D) ...
+struct Solid {
+  enum class Kind { Empty, Mesh, Union, Intersect, Difference, Hull };
+  Kind kind = Kind::Empty;
+  TriMesh mesh;
+  std::vector<Solid> children;
+};
+/// ... and over even-odd filled rings (2D, below an extrusion).
+struct Shape {
+  enum class Kind { Empty, Rings, Union, Intersect, Difference };
+  Kind kind = Kind::Empty;
+  std::vector<Ring> rings;
+  std::vector<Shape> children;
+};
+
+// Row-major 3x4 affine map.
+using Affine = std::array<double, 12>;
+constexpr Affine kIdentity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+// 2D affine map [a b tx; c d ty].
+using Affine2 = std::array<double, 6>;
+constexpr Affine2 kIdentity2{1, 0, 0, 0, 1, 0};
+
+Affine compose(const Affine& a, const Affine& b) {  // a * b
+  Affine r{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double s = j == 3 ? a[i * 4 + 3] : 0;
+      for (int k = 0; k < 3; ++k) s += a[i * 4 + k] * b[k * 4 + j];
+      r[i * 4 + j] = s;
+    }
+  return r;
+}
+Affine2 compose2(const Affine2& a, const Affine2& b) {
+  return {a[0] * b[0] + a[1] * b[3], a[0] * b[1] + a[1] * b[4], a[0] * b[2] + a[1] * b[5] + a[2],
+          a[3] * b[0] + a[4] * b[3], a[3] * b[1] + a[4] * b[4], a[3] * b[2] + a[4] * b[5] + a[5]};
+}
+double det3(const Affine& m) {
+  return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+         m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+// Largest stretch of the linear part (max column norm; enough to size tessellations).
+double stretch(const Affine& m) {
+  double s = 0;
+  for (int j = 0; j < 3; ++j)
+    s = std::max(s, std::sqrt(m[j] * m[j] + m[4 + j] * m[4 + j] + m[8 + j] * m[8 + j]));
+  return s;
+}
+double stretch2(const Affine2& m) {
+  return std::max(std::hypot(m[0], m[3]), std::hypot(m[1], m[4]));
+}
+
+void apply(const Affine& m, TriMesh& mesh) {
+  for (Vec3& p : mesh.positions) {
+    const Vec3 q = p;
+    for (int i = 0; i < 3; ++i) p[i] = m[i * 4] * q[0] + m[i * 4 + 1] * q[1] + m[i * 4 + 2] * q[2] + m[i * 4 + 3];
+  }
+  if (det3(m) < 0)
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+}
+Ring apply2(const Affine2& m, const Ring& r) {
+  Ring out;
+  out.reserve(r.size());
+  for (const P2& p : r) out.push_back({m[0] * p[0] + m[1] * p[1] + m[2], m[3] * p[0] + m[4] * p[1] + m[5]});
+  return out;
+}
+
+[[noreturn]] void fail(const Node& n, const std::string& what) {
+  throw InvalidInput("line " + std::to_string(n.line) + ": " + n.name + ": " + what);
+}
+
+const Value* arg(const Node& n, const std::string& key) {
+  const auto it = n.args.find(key);
+  return it == n.args.end() ? nullptr : &it->second;
+}
+double number(const Node& n, const std::string& key, double fallback) {
+  const Value* v = arg(n, key);
+  if (!v || v->kind == Value::Kind::Undef) return fallback;
+  if (v->kind == Value::Kind::Bool) return v->boolean ? 1 : 0;
+  if (v->kind != Value::Kind::Number) fail(n, "'" + key + "' must be a number");
+  return v->number;
+}
+bool flag(const Node& n, const std::string& key, bool fallback) {
+  const Value* v = arg(n, key);
+  if (!v || v->kind == Value::Kind::Undef) return fallback;
+  if (v->kind == Value::Kind::Bool) return v->boolean;
+  if (v->kind == Value::Kind::Number) return v->number != 0;
+  return fallback;
+}
+std::vector<double> numbers(const Node& n, const Value& v, const std::string& key) {
+  std::vector<double> out;
+  if (v.kind == Value::Kind::Number) return {v.number};
+  if (v.kind != Value::Kind::Vector) fail(n, "'" + key + "' must be a vector of numbers");
+  for (const Value& x : v.items) {
+    if (x.kind != Value::Kind::Number) fail(n, "'" + key + "' must be a vector of numbers");
+    out.push_back(x.number);
+  }
+  return out;
+}
+void check_finite(const Node& n, std::initializer_list<double> xs) {
+  for (double x : xs)
+    if (!std::isfinite(x)) fail(n, "non-finite parameter");
+}
+
+bool is_2d_node(const std::string& s) { return s == "square" || s == "circle" || s == "polygon"; }
+bool is_group(const std::string& s) {
+  return s == "group" || s == "union" || s == "color" || s == "render";
+}
+
+class Lowering {
+ public:
+  Lowering(const EvalOptions& o, double finest_cell) : opt_(o), cell_(finest_cell) {}
+  size_t nodes = 0;
+
+  Solid solid(const Node& n, const Affine& m) {
+    ++nodes;
+    const std::string& k = n.name;
+    if (is_group(k)) return combine(Solid::Kind::Union, children3(n, m));
+    if (k == "difference") return combine(Solid::Kind::Difference, children3(n, m));
+    if (k == "intersection") return combine(Solid::Kind::Intersect, children3(n, m));
+    if (k == "multmatrix") return combine(Solid::Kind::Union, children3(n, compose(m, matrix(n))));
+    if (k == "hull") {
+      Solid s;
+      s.kind = Solid::Kind::Hull;
+      s.children = children3(n, m);
+      std::erase_if(s.children, [](const Solid& c) { return c.kind == Solid::Kind::Empty; });
+      if (s.children.empty()) s.kind = Solid::Kind::Empty;
+      return s;
+    }
+    if (k == "cube") return leaf(cube(n), m);
+    if (k == "sphere") {
+      const double r = radius(n, "r", "d", 1);
+      if (!(r > 0)) return {};
+      return leaf(sphere_mesh(r, frags(n, r, stretch(m))), m);
+    }
+    if (k == "cylinder") return leaf(cylinder(n, stretch(m)), m);
+    if (k == "polyhedron") return leaf(polyhedron(n), m);
+    if (k == "import") return leaf(import(n), m);
+    if (k == "linear_extrude") return linear_extrude(n, m);
+    if (k == "rotate_extrude") return rotate_extrude(n, m);
+    if (is_2d_node(k)) fail(n, "a 2D object outside linear_extrude/rotate_extrude (the model must be 3D)");
+    throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
+  }
+
+ private:
+  const EvalOptions& opt_;
+  double cell_;  // finest cell, for --smooth
+
+  // Fragments for a circle of radius r (model units) drawn `st` times larger in the world:
+  // OpenSCAD's rule on r, or, with --smooth, enough that the chord's sagitta
+  // r st (1 - cos(pi / n)) stays below smooth_chord finest cells.
+  int frags(const Node& n, double r, double st) const {
+    const double world_r = r * st;
+    if (opt_.smooth && cell_ > 0 && world_r > 0) {
+      const double e = opt_.smooth_chord * cell_;
+      if (e >= world_r) return 8;
+      return std::clamp(static_cast<int>(std::ceil(std::numbers::pi / std::acos(1 - e / world_r))), 8, 4096);
+    }
+    return fragments_from_r(r, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12));
+  }
+
+  Affine matrix(const Node& n) const {
+    const Value* v = arg(n, "m");
+    if (!v) v = arg(n, "0");
+    if (!v || v->kind != Value::Kind::Vector || v->items.size() < 3) fail(n, "needs a 4x4 matrix");
+    Affine a{};
+    for (int i = 0; i < 3; ++i) {
+      const auto row = numbers(n, v->items[i], "m");
+      if (row.size() < 4) fail(n, "needs a 4x4 matrix");
+      for (int j = 0; j < 4; ++j) a[i * 4 + j] = row[j];
+    }
+    for (double x : a)
+      if (!std::isfinite(x)) fail(n, "non-finite matrix");
+    return a;
+  }
+
+  std::vector<Solid> children3(const Node& n, const Affine& m) {
+    std::vector<Solid> out;
+    for (const Node& c : n.children) out.push_back(solid(c, m));
+    return out;
+  }
+  static Solid combine(Solid::Kind kind, std::vector<Solid> kids) {
+    Solid s;
+    if (kind == Solid::Kind::Difference) {
+      if (kids.empty() || kids[0].kind == Solid::Kind::Empty) return s;
+      Solid first = std::move(kids[0]);
+      kids.erase(kids.begin());
+      std::erase_if(kids, [](const Solid& c) { return c.kind == Solid::Kind::Empty; });
+      if (kids.empty()) return first;
+      s.kind = kind;
+      s.children.push_back(std::move(first));
+      for (auto& c : kids) s.children.push_back(std::move(c));
+      return s;
+    }
+    if (kind == Solid::Kind::Intersect) {
+      for (const auto& c : kids)
+        if (c.kind == Solid::Kind::Empty) return s;
+    }
+    std::erase_if(kids, [](const Solid& c) { return c.kind == Solid::Kind::Empty; });
+    if (kids.empty()) return s;
+    if (kids.size() == 1) return std::move(kids[0]);
+    s.kind = kind;
+    s.children = std::move(kids);
+    return s;
+  }
+  static Solid leaf(TriMesh mesh, const Affine& m) {
+    Solid s;
+    if (mesh.triangles.empty() || !(std::abs(det3(m)) > 0)) return s;
+    apply(m, mesh);
+    s.kind = Solid::Kind::Mesh;
+    s.mesh = std::move(mesh);
+    return s;
+  }
+
+  double radius(const Node& n, const char* r, const char* d, double fallback) const {
+    if (const Value* v = arg(n, r); v && v->kind == Value::Kind::Number) return v->number;
+    if (const Value* v = arg(n, d); v && v->kind == Value::Kind::Number) return v->number / 2;
+    return fallback;
+  }
+
+  TriMesh cube(const Node& n) const {
+    Vec3 s{1, 1, 1};
+    if (const Value* v = arg(n, "size")) {
+      const auto xs = numbers(n, *v, "size");
+      if (xs.size() == 1) s = {xs[0], xs[0], xs[0]};
+      else if (xs.size() >= 3) s = {xs[0], xs[1], xs[2]};
+      else fail(n, "size must be a number or [x, y, z]");
+    }
+    check_finite(n, {s[0], s[1], s[2]});
+    if (!(s[0] > 0 && s[1] > 0 && s[2] > 0)) return {};
+    const bool c = flag(n, "center", false);
+    const Vec3 lo = c ? Vec3{-s[0] / 2, -s[1] / 2, -s[2] / 2} : Vec3{0, 0, 0};
+    return make_box(lo, {lo[0] + s[0], lo[1] + s[1], lo[2] + s[2]});
+  }
+
+  TriMesh cylinder(const Node& n, double st) {
+    const double h = number(n, "h", 1);
+    double r1 = number(n, "r1", 1), r2 = number(n, "r2", 1);
+    if (const Value* v = arg(n, "r"); v && v->kind == Value::Kind::Number) r1 = r2 = v->number;
+    check_finite(n, {h, r1, r2});
+    if (!(h > 0) || r1 < 0 || r2 < 0 || (r1 <= 0 && r2 <= 0)) return {};
+    const bool c = flag(n, "center", false);
+    const double z1 = c ? -h / 2 : 0;
+    return cylinder_mesh(r1, r2, z1, z1 + h, frags(n, std::max(r1, r2), st));
+  }
+
+  TriMesh polyhedron(const Node& n) const {
+    const Value* pv = arg(n, "points");
+    const Value* fv = arg(n, "faces");
+    if (!fv || fv->kind != Value::Kind::Vector) fv = arg(n, "triangles");
+    if (!pv || !fv || pv->kind != Value::Kind::Vector || fv->kind != Value::Kind::Vector)
+      fail(n, "needs points and faces");
+    TriMesh m;
+    for (const Value& p : pv->items) {
+      const auto xs = numbers(n, p, "points");
+      if (xs.size() < 3) fail(n, "points must be [x, y, z]");
+      check_finite(n, {xs[0], xs[1], xs[2]});
+      m.positions.push_back({xs[0], xs[1], xs[2]});
+    }
+    for (const Value& f : fv->items) {
+      const auto xs = numbers(n, f, "faces");
+      std::vector<uint32_t> ids;
+      for (double x : xs) {
+        if (!(x >= 0 && x < double(m.positions.size()))) fail(n, "face index out of range");
+        ids.push_back(static_cast<uint32_t>(x));
+      }
+      // OpenSCAD's faces are clockwise seen from outside: reverse while fanning.
+      for (size_t i = 1; i + 1 < ids.size(); ++i) m.triangles.push_back({ids[0], ids[i + 1], ids[i]});
+    }
+    if (volume(m) < 0)  // faces given counter-clockwise: OpenSCAD renders them anyway
+      for (auto& t : m.triangles) std::swap(t[1], t[2]);
+    return m;
+  }
+
+  TriMesh import(const Node& n) const {
+    const Value* f = arg(n, "file");
+    if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
+    std::filesystem::path p = f->text;
+    std::string ext = p.extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".dxf" || ext == ".svg")
+      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node 'import' of a 2D " + ext +
+                         " file (only STL, OFF, OBJ, PLY meshes)");
+    if (p.is_relative()) p = opt_.base_dir / p;
+    return read_mesh(p);
+  }
+
+  // ---- 2D ----
+  Shape shape(const Node& n, const Affine2& m) {
+    ++nodes;
+    const std::string& k = n.name;
+    if (is_group(k)) return combine2(Shape::Kind::Union, children2(n, m));
+    if (k == "difference") return combine2(Shape::Kind::Difference, children2(n, m));
+    if (k == "intersection") return combine2(Shape::Kind::Intersect, children2(n, m));
+    if (k == "multmatrix") {
+      const Affine a = matrix(n);
+      return combine2(Shape::Kind::Union, children2(n, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]})));
+    }
+    Shape s;
+    s.kind = Shape::Kind::Rings;
+    if (k == "square") {
+      double sx = 1, sy = 1;
+      if (const Value* v = arg(n, "size")) {
+        const auto xs = numbers(n, *v, "size");
+        if (xs.size() == 1) sx = sy = xs[0];
+        else if (xs.size() >= 2) sx = xs[0], sy = xs[1];
+      }
+      check_finite(n, {sx, sy});
+      if (!(sx > 0 && sy > 0)) return {};
+      const bool c = flag(n, "center", false);
+      const double x0 = c ? -sx / 2 : 0, y0 = c ? -sy / 2 : 0;
+      s.rings.push_back(apply2(m, {{x0, y0}, {x0 + sx, y0}, {x0 + sx, y0 + sy}, {x0, y0 + sy}}));
+    } else if (k == "circle") {
+      const double r = radius(n, "r", "d", 1);
+      check_finite(n, {r});
+      if (!(r > 0)) return {};
+      s.rings.push_back(apply2(m, circle_ring(r, frags(n, r, stretch2(m) * stretch_3d_))));
+    } else if (k == "polygon") {
+      const Value* pv = arg(n, "points");
+      if (!pv || pv->kind == Value::Kind::Undef) return {};  // OpenSCAD: empty, with a warning
+      if (pv->kind != Value::Kind::Vector) fail(n, "points must be a vector");
+      Ring pts;
+      for (const Value& p : pv->items) {
+        const auto xs = numbers(n, p, "points");
+        if (xs.size() < 2) fail(n, "points must be [x, y]");
+        check_finite(n, {xs[0], xs[1]});
+        pts.push_back({xs[0], xs[1]});
+      }
+      const Value* paths = arg(n, "paths");
+      if (!paths || paths->kind != Value::Kind::Vector || paths->items.empty()) {
+        s.rings.push_back(apply2(m, pts));
+      } else {
+        for (const Value& path : paths->items) {
+          Ring r;
+          for (double x : numbers(n, path, "paths")) {
+            if (!(x >= 0 && x < double(pts.size()))) fail(n, "path index out of range");
+            r.push_back(pts[static_cast<size_t>(x)]);
+          }
+          s.rings.push_back(apply2(m, r));
+        }
+      }
+    } else if (k == "hull") {
+      std::vector<P2> pts;
+      for (const Shape& c : children2(n, m)) collect_points(n, c, pts);
+      Ring h = convex_hull_2d(pts);
+      if (h.size() < 3) return {};
+      s.rings.push_back(std::move(h));
+    } else if (k == "import") {
+      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node 'import' of a 2D file (DXF, SVG)");
+    } else if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" ||
+               k == "linear_extrude" || k == "rotate_extrude") {
+      fail(n, "a 3D object inside a 2D subtree");
+    } else {
+      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
+    }
+    return s;
+  }
+  static void collect_points(const Node& n, const Shape& s, std::vector<P2>& out) {
+    if (s.kind == Shape::Kind::Rings) {
+      for (const Ring& r : s.rings) out.insert(out.end(), r.begin(), r.end());
+    } else if (s.kind == Shape::Kind::Union) {
+      for (const Shape& c : s.children) collect_points(n, c, out);
+    } else if (s.kind != Shape::Kind::Empty) {
+      fail(n, "2D hull of a difference or intersection is not supported");
+    }
+  }
+  std::vector<Shape> children2(const Node& n, const Affine2& m) {
+    std::vector<Shape> out;
+    for (const Node& c : n.children) out.push_back(shape(c, m));
+    return out;
+  }
+  static Shape combine2(Shape::Kind kind, std::vector<Shape> kids) {
+    Shape s;
+    if (kind == Shape::Kind::Difference) {
+      if (kids.empty() || kids[0].kind == Shape::Kind::Empty) return s;
+    } else if (kind == Shape::Kind::Intersect) {
+      for (const auto& c : kids)
+        if (c.kind == Shape::Kind::Empty) return s;
+    }
+    std::vector<Shape> keep;
+    for (size_t i = 0; i < kids.size(); ++i)
+      if (kids[i].kind != Shape::Kind::Empty) keep.push_back(std::move(kids[i]));
+    if (keep.empty()) return s;
+    if (keep.size() == 1) return std::move(keep[0]);
+    s.kind = kind;
+    s.children = std::move(keep);
+    return s;
+  }
+
+  template <class F>
+  static void for_each_point(const Shape& s, const F& f) {
+    for (const Ring& r : s.rings)
+      for (const P2& p : r) f(p);
+    for (const Shape& c : s.children) for_each_point(c, f);
+  }
+  // x-range of the shape, conservatively: a difference spans its first child, an
+  // intersection the overlap of its children.
+  static void bounds2(const Shape& s, double& lo, double& hi) {
+    double l = 1e300, h = -1e300;
+    range2(s, l, h);
+    if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
+  }
+  static void range2(const Shape& s, double& lo, double& hi) {
+    for (const Ring& r : s.rings)
+      for (const P2& p : r) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+    if (s.kind == Shape::Kind::Union) {
+      for (const Shape& c : s.children) range2(c, lo, hi);
+    } else if (s.kind == Shape::Kind::Difference && !s.children.empty()) {
+      range2(s.children[0], lo, hi);
+    } else if (s.kind == Shape::Kind::Intersect) {
+      double l = -1e300, h = 1e300;
+      for (const Shape& c : s.children) {
+        double cl = 1e300, ch = -1e300;
+        range2(c, cl, ch);
+        l = std::max(l, cl), h = std::min(h, ch);
+      }
+      if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
+    }
+  }
+
+  // Even-odd rings -> Booleans of simple rings: each ring at even nesting depth minus the
+  // rings directly inside it (exact for rings that do not cross each other).
+  template <class Extrude>
+  Solid extrude(const Shape& s, const Extrude& ext) {
+    if (s.kind == Shape::Kind::Empty) return {};
+    if (s.kind != Shape::Kind::Rings) {
+      std::vector<Solid> kids;
+      for (const Shape& c : s.children) kids.push_back(extrude(c, ext));
+      return combine(s.kind == Shape::Kind::Union       ? Solid::Kind::Union
+                     : s.kind == Shape::Kind::Intersect ? Solid::Kind::Intersect
+                                                        : Solid::Kind::Difference,
+                     std::move(kids));
+    }
+    std::vector<Ring> rings;
+    for (const Ring& r : s.rings)
+      if (r.size() >= 3 && signed_area(r) != 0) rings.push_back(r);
+    const size_t n = rings.size();
+    auto inside = [](const P2& p, const Ring& r) {
+      bool in = false;
+      for (size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
+        if ((r[i][1] > p[1]) != (r[j][1] > p[1]) &&
+            p[0] < (r[j][0] - r[i][0]) * (p[1] - r[i][1]) / (r[j][1] - r[i][1]) + r[i][0])
+          in = !in;
+      return in;
+    };
+    std::vector<int> depth(n, 0), parent(n, -1);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j)
+        if (i != j && inside(rings[i][0], rings[j])) {
+          ++depth[i];
+          if (parent[i] < 0 || std::abs(signed_area(rings[j])) < std::abs(signed_area(rings[size_t(parent[i])])))
+            parent[i] = static_cast<int>(j);
+        }
+    std::vector<Solid> outers;
+    for (size_t i = 0; i < n; ++i) {
+      if (depth[i] % 2) continue;
+      std::vector<Solid> parts;
+      parts.push_back(leaf(ext(rings[i]), kIdentity));
+      for (size_t j = 0; j < n; ++j)
+        if (parent[j] == static_cast<int>(i) && depth[j] == depth[i] + 1) parts.push_back(leaf(ext(rings[j]), kIdentity));
+      outers.push_back(combine(Solid::Kind::Difference, std::move(parts)));
+    }
+    return combine(Solid::Kind::Union, std::move(outers));
+  }
+
+  Shape shape_children(const Node& n, double st) {
+    if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
+      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + n.name +
+                         "' of a DXF file");
+    stretch_3d_ = st;
+    std::vector<Shape> kids;
+    for (const Node& c : n.children) kids.push_back(shape(c, kIdentity2));
+    stretch_3d_ = 1;
+    return combine2(Shape::Kind::Union, std::move(kids));
+  }
+  double stretch_3d_ = 1;
+
+  Solid linear_extrude(const Node& n, const Affine& m) {
+    const Shape s = shape_children(n, stretch(m));
+    LinearExtrude e;
+    e.height = number(n, "height", 100);
+    e.center = flag(n, "center", false);
+    e.twist = number(n, "twist", 0);
+    if (const Value* v = arg(n, "scale")) {
+      const auto xs = numbers(n, *v, "scale");
+      if (xs.size() == 1) e.scale = {xs[0], xs[0]};
+      else if (xs.size() >= 2) e.scale = {xs[0], xs[1]};
+    }
+    e.scale = {std::max(0.0, e.scale[0]), std::max(0.0, e.scale[1])};
+    check_finite(n, {e.height, e.twist, e.scale[0], e.scale[1]});
+    // Slices when `slices` is not given, as OpenSCAD 2021.01 does (measured against its
+    // output; Calc::get_helix_slices / get_diagonal_slices): a twist takes the fewer of
+    // |twist| / $fa and (helix length of the outermost vertex) / $fs, at least one per 120
+    // degrees, or |twist| $fn / 360 when $fn is set; a non-uniform scale without twist takes
+    // (length of the longest vertex path) / $fs; otherwise one slice.
+    int slices = static_cast<int>(number(n, "slices", 0));
+    if (slices <= 0) {
+      const double fn = number(n, "$fn", 0), fs = number(n, "$fs", 2), fa = number(n, "$fa", 12);
+      double r2 = 0, d2 = 0;
+      for_each_point(s, [&](const P2& p) {
+        r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
+        const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
+        d2 = std::max(d2, dx * dx + dy * dy);
+      });
+      const double tw = std::abs(e.twist);
+      slices = 1;
+      if (tw > 0) {
+        const int min_slices = std::max(static_cast<int>(std::ceil(tw / 120.0)), 1);
+        if (fn > 0) {
+          slices = std::max(static_cast<int>(std::ceil(tw / 360.0 * fn)), min_slices);
+        } else if (std::sqrt(r2) >= 0.00000095367431640625) {
+          // Length of the outermost vertex's path: a conical helix when scaled (Simpson's rule).
+          const double r0 = std::sqrt(r2), th = tw * std::numbers::pi / 180;
+          const double sc = std::max(e.scale[0], e.scale[1]);
+          auto speed = [&](double t) {
+            const double r = r0 * (1 + (sc - 1) * t), dr = r0 * (sc - 1);
+            return std::sqrt(r * r * th * th + dr * dr + e.height * e.height);
+          };
+          constexpr int kSteps = 64;
+          double len = speed(0) + speed(1);
+          for (int i = 1; i < kSteps; ++i) len += (i % 2 ? 4 : 2) * speed(double(i) / kSteps);
+          len /= 3.0 * kSteps;
+          const int fa_slices = static_cast<int>(std::ceil(tw / fa));
+          const int fs_slices = static_cast<int>(std::ceil(len / fs));
+          slices = std::max(std::min(fa_slices, fs_slices), min_slices);
+        } else {
+          slices = min_slices;
+        }
+      } else if (e.scale[0] != e.scale[1]) {
+        slices = fn > 0 ? std::max(static_cast<int>(fn), 1)
+                        : std::max(static_cast<int>(std::ceil(std::sqrt(d2 + e.height * e.height) / fs)), 1);
+      }
+    }
+    if (opt_.smooth && e.twist != 0) {
+      // The walls follow helices: keep the chord of the largest radius below the tolerance.
+      double lo = 0, hi = 0;
+      bounds2(s, lo, hi);
+      const double r = std::max(std::abs(lo), std::abs(hi)) * stretch(m);
+      const int per_turn = frags(n, r, 1);
+      slices = std::max(slices, static_cast<int>(std::ceil(per_turn * std::abs(e.twist) / 360)));
+    }
+    e.slices = std::max(slices, 1);
+    if (!(e.height > 0)) return {};
+    Solid out = extrude(s, [&](const Ring& r) { return extrude_linear(r, e); });
+    transform(out, m);
+    return out;
+  }
+
+  Solid rotate_extrude(const Node& n, const Affine& m) {
+    const Shape s = shape_children(n, stretch(m));
+    double angle = number(n, "angle", 360);
+    check_finite(n, {angle});
+    if (angle == 0 || s.kind == Shape::Kind::Empty) return {};
+    double lo = 0, hi = 0;
+    bounds2(s, lo, hi);
+    if (lo < 0 && hi > 0) fail(n, "all points must have the same x coordinate sign");
+    // OpenSCAD 2021: fragments(max |x|) |angle| / 360, at least 1.
+    int f = static_cast<int>(std::fmax(
+        fragments_from_r(hi - lo, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12)) *
+            std::abs(std::min(angle, 360.0)) / 360,
+        1));
+    if (opt_.smooth) f = std::max(f, static_cast<int>(std::ceil(frags(n, hi - lo, stretch(m)) * std::min(std::abs(angle), 360.0) / 360)));
+    const bool mirrored = hi <= 0;  // profile left of the axis: revolve its mirror image
+    Solid out = extrude(s, [&](Ring r) {
+      if (mirrored)
+        for (P2& p : r) p[0] = -p[0];
+      return extrude_rotate(r, angle, f);
+    });
+    // OpenSCAD maps (x, y) at angle a to (x sin a, x cos a): a negative x lands half a turn on.
+    transform(out, mirrored ? Affine{-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0} : kIdentity);
+    transform(out, m);
+    return out;
+  }
+
+  static void transform(Solid& s, const Affine& m) {
+    if (s.kind == Solid::Kind::Mesh) apply(m, s.mesh);
+    for (Solid& c : s.children) transform(c, m);
+  }
+};
+
+void bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& tris) {
+  if (s.kind == Solid::Kind::Mesh) {
+    ++leaves;
+    tris += s.mesh.triangles.size();
+    for (const Vec3& p : s.mesh.positions)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  for (const Solid& c : s.children) bounds(c, lo, hi, leaves, tris);
+}
+
+// Hull input: the vertices of the leaves, when the subtree is only unions (and hulls) of them.
+bool hull_points(const Solid& s, std::vector<Vec3>& out) {
+  switch (s.kind) {
+    case Solid::Kind::Empty: return true;
+    case Solid::Kind::Mesh: out.insert(out.end(), s.mesh.positions.begin(), s.mesh.positions.end()); return true;
+    case Solid::Kind::Union:
+    case Solid::Kind::Hull:
+      for (const Solid& c : s.children)
+        if (!hull_points(c, out)) return false;
+      return true;
+    default: return false;
+  }
+}
+
+class Evaluator {
+ public:
+  Evaluator(const EvalOptions& o, const Cube& cube, size_t leaves) : opt_(o), cube_(cube), total_(leaves) {
+    t0_ = Clock::now();
+    last_ = t0_;
+  }
+  std::atomic<size_t> booleans{0};
+
+  std::optional<Octree> eval(const Solid& s) {
+    switch (s.kind) {
+      case Solid::Kind::Empty: return std::nullopt;
+      case Solid::Kind::Mesh: {
+        auto t = sample_leaf(s.mesh);
+        ++done_;
+        report();
+        return t;
+      }
+      case Solid::Kind::Union: return balanced(s.children, 0, s.children.size(), CsgOp::Union);
+      case Solid::Kind::Intersect: return balanced(s.children, 0, s.children.size(), CsgOp::Intersect);
+      case Solid::Kind::Difference: {
+        std::optional<Octree> a, b;
+        invoke([&] { a = eval(s.children[0]); },
+               [&] { b = balanced(s.children, 1, s.children.size(), CsgOp::Union); });
+        if (!a || !b) return a;
+        return boolean(std::move(*a), *b, CsgOp::Subtract);
+      }
+      case Solid::Kind::Hull: {
+        std::vector<Vec3> pts;
+        bool direct = true;
+        for (const Solid& c : s.children) direct = direct && hull_points(c, pts);
+        if (!direct) {
+          // A difference or intersection below the hull: take the vertices of its contour
+          // (within a finest cell of the exact result).
+          pts.clear();
+          auto u = balanced(s.children, 0, s.children.size(), CsgOp::Union);
+          if (!u) return std::nullopt;
+          pts = contour(*u).positions;
+        }
+        TriMesh h = detail::scad::convex_hull(pts);
+        if (h.triangles.empty()) return std::nullopt;
+        return sample_leaf(h);
+      }
+    }
+    return std::nullopt;
+  }
+
+ private:
+  const EvalOptions& opt_;
+  Cube cube_;
+  size_t total_;
+  std::atomic<size_t> done_{0};
+  Clock::time_point t0_, last_;
+  std::mutex mu_;
+
+  template <class A, class B>
+  void invoke(const A& a, const B& b) {
+    if (opt_.parallel) tbb::parallel_invoke(a, b);
+    else a(), b();
+  }
+  Octree sample_leaf(const TriMesh& m) {
+    SampleOptions so;
+    so.depth = opt_.depth;
+    so.error = opt_.error;
+    so.cube = cube_;
+    so.parallel = opt_.parallel;
+    return sample(m, so);
+  }
+  Octree boolean(Octree a, const Octree& b, CsgOp op) {
+    CsgOptions co;
+    co.error = opt_.error;
+    co.parallel = opt_.parallel;
+    csg_inplace(a, b, op, co);
+    ++booleans;
+    report();
+    return a;
+  }
+  // n-ary union/intersection in a balanced order: halves evaluated in parallel, then combined.
+  std::optional<Octree> balanced(const std::vector<Solid>& kids, size_t b, size_t e, CsgOp op) {
+    if (b >= e) return std::nullopt;
+    if (e - b == 1) return eval(kids[b]);
+    const size_t mid = b + (e - b) / 2;
+    std::optional<Octree> x, y;
+    invoke([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
+    if (op == CsgOp::Intersect && (!x || !y)) return std::nullopt;
+    if (!x) return y;
+    if (!y) return x;
+    return boolean(std::move(*x), *y, op);
+  }
+  void report() {
+    if (!opt_.progress) return;
+    std::lock_guard lock(mu_);
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < 1.0) return;
+    last_ = now;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%zu/%zu leaves sampled, %zu Booleans, %.1f s", done_.load(), total_,
+                  booleans.load(), since(t0_));
+    opt_.progress(buf);
+  }
+};
+
+}  // namespace
+
+Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* stats, const std::string& source) {
+  const auto t0 = Clock::now();
+  if (options.depth < 1 || options.depth > kMaxLevel)
+    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
+  std::vector<detail::scad::Node> top;
+  try {
+    top = parse(text);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(source + ": " + e.what());
+  }
+  detail::scad::Node root;
+  root.name = "group";
+  root.children = std::move(top);
+  auto lower = [&](double cell, size_t* nodes) {
+    Lowering l(options, cell);
+    try {
+      Solid s = l.solid(root, kIdentity);
+      if (nodes) *nodes = l.nodes - 1;
+      return s;
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(source + ": " + e.what());
+    }
+  };
+  EvalStats st;
+  EvalOptions first = options;
+  if (options.smooth) first.smooth = false;
+  Solid model = lower(0, &st.nodes);
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  bounds(model, lo, hi, st.leaves, st.triangles);
+  if (model.kind == Solid::Kind::Empty || st.leaves == 0) throw InvalidInput(source + ": the model is empty");
+  TriMesh corners;
+  corners.positions = {lo, hi};
+  st.cube = bounding_cube(corners);
+  if (options.smooth) {
+    // Second pass: tessellate against the finest cell of the cube found above.
+    model = lower(st.cube.size / double(int64_t{1} << options.depth), nullptr);
+    Vec3 lo2 = lo, hi2 = hi;
+    st.leaves = st.triangles = 0;
+    bounds(model, lo2, hi2, st.leaves, st.triangles);
+    corners.positions = {lo2, hi2};
+    st.cube = bounding_cube(corners);
+  }
+  st.mesh_seconds = since(t0);
+  if (options.progress)
+    options.progress("sampling " + std::to_string(st.leaves) + " leaves (" + std::to_string(st.triangles) +
+                     " triangles) at depth " + std::to_string(options.depth));
+  const auto t1 = Clock::now();
+  Evaluator ev(options, st.cube, st.leaves);
+  std::optional<Octree> out = ev.eval(model);
+  st.octree_seconds = since(t1);
+  st.booleans = ev.booleans.load();
+  st.seconds = since(t0);
+  if (!out || out->vertices.empty()) throw InvalidInput(source + ": the model is empty");
+  if (stats) *stats = st;
+  return std::move(*out);
+}
+
+Octree eval_csg_file(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot read " + path.string());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EvalOptions o = options;
+  if (o.base_dir.empty()) o.base_dir = path.parent_path();
+  return eval_csg(ss.str(), o, stats, path.string());
+}
+
+namespace {
+bool on_path(const std::string& prog) {
+  const char* p = std::getenv("PATH");
+  std::stringstream ss(p ? p : "");
+  std::string dir;
+  while (std::getline(ss, dir, ':'))
+    if (!dir.empty() && ::access((std::filesystem::path(dir) / prog).c_str(), X_OK) == 0) return true;
+  return false;
+}
+std::string shell_quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+}  // namespace
+
+Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
+  std::string ext = path.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".csg") return eval_csg_file(path, options, stats);
+  if (ext != ".scad") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
+  if (!std::filesystem::exists(path)) throw IoError("cannot read " + path.string());
+  if (!on_path("openscad"))
+    throw InvalidInput("the 'openscad' program is needed for .scad input: install it (Debian: apt-get install "
+                       "openscad, or scripts/setup.sh) or pass a .csg file exported by OpenSCAD");
+  const auto t0 = Clock::now();
+  // OpenSCAD resolves a relative output path against the input's directory: give it an
+  // absolute temporary path.
+  char tmpl[] = "/tmp/pic-scad-XXXXXX";
+  const char* dir = ::mkdtemp(tmpl);
+  if (!dir) throw IoError("cannot create a temporary directory");
+  const std::filesystem::path tmp_dir = dir, csg = tmp_dir / "model.csg", log = tmp_dir / "openscad.log";
+  const std::string cmd = "openscad -o " + shell_quote(csg.string()) + " " +
+                          shell_quote(std::filesystem::absolute(path).string()) + " >" +
+                          shell_quote(log.string()) + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  const double openscad_seconds = since(t0);
+  if (rc != 0 || !std::filesystem::exists(csg)) {
+    std::string msg;
+    std::ifstream l(log);
+    for (std::string line; std::getline(l, line);)
+      if (line.find("ERROR") != std::string::npos) {
+        msg = line;
+        break;
+      }
+    std::filesystem::remove_all(tmp_dir);
+    throw InvalidInput("openscad could not export " + path.string() + (msg.empty() ? "" : ": " + msg));
+  }
+  EvalOptions o = options;
+  if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
+  try {
+    std::ifstream in(csg, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::filesystem::remove_all(tmp_dir);
+    Octree t = eval_csg(ss.str(), o, stats, path.string());
+    if (stats) {
+      stats->openscad_seconds = openscad_seconds;
+      stats->seconds += openscad_seconds;
+    }
+    return t;
+  } catch (...) {
+    std::filesystem::remove_all(tmp_dir);
+    throw;
+  }
+}
+
+}  // namespace pic

@@ -1,0 +1,202 @@
+// `pic eval`: OpenSCAD CSG trees (tests/data/scad/*.csg, each with a known volume) evaluated on
+// octrees; the CLI's errors; `pic csg` with mesh operands; a .scad through `openscad`.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "pic/pic.h"
+#include "pic/primitives.h"
+#include "pic/scad.h"
+#include "scad/scad_detail.h"
+#include "support/mesh_checks.h"
+#include "support/temp_dir.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kData = PIC_SCAD_DATA_DIR;
+
+struct Result {
+  TriMesh mesh;
+  double volume = 0;
+  double cell = 0;  // finest cell
+};
+
+Result eval_file(const std::string& name, int depth = 8) {
+  EvalOptions o;
+  o.depth = depth;
+  const Octree t = eval_csg_file(kData / name, o);
+  Result r;
+  r.mesh = contour(t);
+  split_nonmanifold(r.mesh);
+  r.volume = volume(r.mesh);
+  r.cell = t.cube.size / double(1 << depth);
+  return r;
+}
+
+void expect_volume(const Result& r, double expected, double rel) {
+  EXPECT_NEAR(r.volume, expected, rel * expected) << "relative error " << (r.volume - expected) / expected;
+  EXPECT_TRUE(test::IsClosedManifold(r.mesh));
+}
+
+TEST(Eval, CubeMinusCube) { expect_volume(eval_file("cube_minus_cube.csg"), 840, 1e-3); }
+
+TEST(Eval, Fn6CylinderIsHexagonalPrism) {
+  const Result r = eval_file("hex_prism.csg");
+  expect_volume(r, 3 * std::sqrt(3.0), 1e-3);
+  // Vertices of the hexagon are at angles 60 i (OpenSCAD's circle placement): the point
+  // (1, 0, 1) is on the surface, (cos 30, 0, 1)... is inside; the apothem is sqrt(3)/2.
+  EXPECT_LT(test::point_mesh_distance(r.mesh, {1, 0, 1}), r.cell);
+  EXPECT_LT(test::point_mesh_distance(r.mesh, {0, std::sqrt(3.0) / 2, 1}), r.cell);
+}
+
+TEST(Eval, LinearExtrudeTwistAndScale) { expect_volume(eval_file("twist_scale.csg"), 280.0 / 3, 2e-3); }
+
+TEST(Eval, RotateExtrudeFn4) { expect_volume(eval_file("rotate_square.csg"), 6, 1e-3); }
+
+TEST(Eval, PolyhedronClockwiseFaces) { expect_volume(eval_file("polyhedron.csg"), 2000.0 / 3, 1e-3); }
+
+TEST(Eval, Extruded2DDifferenceAndPolygonHole) { expect_volume(eval_file("extruded_difference.csg"), 420, 1e-3); }
+
+TEST(Eval, HullOfTwoSpheres) {
+  // The $fn = 16 sphere polytope: 8 rings of 16 points at polar angles 180 (i + 0.5) / 8; its
+  // volume is the stack of frusta between rings (the caps are flat). The hull with its copy
+  // 3 higher adds 3 times the area of its projection (the widest ring's 16-gon).
+  const int n = 16, rings = 8;
+  auto ngon = [&](double r) { return n / 2.0 * r * r * std::sin(2 * std::numbers::pi / n); };
+  double v = 0, widest = 0;
+  for (int i = 0; i + 1 < rings; ++i) {
+    const double p1 = std::numbers::pi * (i + 0.5) / rings, p2 = std::numbers::pi * (i + 1.5) / rings;
+    const double a1 = ngon(std::sin(p1)), a2 = ngon(std::sin(p2));
+    v += (std::cos(p1) - std::cos(p2)) / 3 * (a1 + a2 + std::sqrt(a1 * a2));
+    widest = std::max({widest, a1, a2});
+  }
+  expect_volume(eval_file("hull_spheres.csg", 9), v + 3 * widest, 2e-3);
+}
+
+TEST(Eval, FragmentRule) {
+  using detail::scad::fragments_from_r;
+  EXPECT_EQ(fragments_from_r(10, 0, 2, 12), 30);  // 360 / $fa
+  EXPECT_EQ(fragments_from_r(1, 0, 2, 12), 5);    // at least 5
+  EXPECT_EQ(fragments_from_r(3, 0, 2, 12), 10);   // 2 pi r / $fs, rounded up
+  EXPECT_EQ(fragments_from_r(3, 6, 2, 12), 6);    // $fn wins
+  EXPECT_EQ(fragments_from_r(3, 2, 2, 12), 3);    // but at least 3
+}
+
+TEST(Eval, UnsupportedNodeNamesNodeAndLine) {
+  try {
+    eval_file("unsupported.csg");
+    FAIL() << "expected InvalidInput";
+  } catch (const InvalidInput& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("minkowski"), std::string::npos) << m;
+    EXPECT_NE(m.find("line 3"), std::string::npos) << m;
+  }
+}
+
+TEST(Eval, SyntaxErrorNamesLine) {
+  EXPECT_THROW(eval_csg("cube(size = [1, 1, 1]);\ncube(size = [1, 1 1]);\n"), InvalidInput);
+  try {
+    eval_csg("cube(size = 1);\n\nsphere(r = );\n");
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Eval, SmoothSphereIsCloserToTheTrueSphere) {
+  EvalOptions o;
+  o.depth = 7;
+  o.smooth = true;
+  const Octree t = eval_csg("sphere($fn = 0, $fa = 12, $fs = 2, r = 1);", o);
+  const double v = volume(contour(t)), exact = 4.0 / 3 * std::numbers::pi;
+  EXPECT_NEAR(v, exact, 0.01 * exact);  // the $fa/$fs sphere (5 fragments) is far smaller
+  o.smooth = false;
+  const double coarse = volume(contour(eval_csg("sphere($fn = 0, $fa = 12, $fs = 2, r = 1);", o)));
+  EXPECT_LT(coarse, 0.8 * exact);
+}
+
+// ---- the CLI ----
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+int run(const std::string& args, const fs::path& dir, std::string* err = nullptr) {
+  const fs::path e = dir / ".stderr";
+  const int status = std::system((quote(PIC_CLI) + " " + args + " > /dev/null 2> " + quote(e.string())).c_str());
+  if (err) {
+    std::ifstream in(e);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *err = ss.str();
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(EvalCli, WritesMeshAndPic) {
+  test::TempDir dir("pic_eval");
+  ASSERT_EQ(run("eval " + quote((kData / "cube_minus_cube.csg").string()) + " -o " + quote((dir / "a.stl").string()) +
+                    " --depth 7",
+                dir.path()),
+            0);
+  const TriMesh m = read_mesh(dir / "a.stl");
+  EXPECT_NEAR(volume(m), 840, 1);
+  ASSERT_EQ(run("eval " + quote((kData / "hex_prism.csg").string()) + " -o " + quote((dir / "a.pic").string()) +
+                    " --depth 7",
+                dir.path()),
+            0);
+  EXPECT_NEAR(volume(contour(load(dir / "a.pic"))), 3 * std::sqrt(3.0), 0.01);
+}
+
+TEST(EvalCli, UnsupportedNodeExits2WithOneLine) {
+  test::TempDir dir("pic_eval");
+  std::string err;
+  EXPECT_EQ(run("eval " + quote((kData / "unsupported.csg").string()) + " -o " + quote((dir / "a.stl").string()),
+                dir.path(), &err),
+            2);
+  EXPECT_NE(err.find("pic: error:"), std::string::npos) << err;
+  EXPECT_NE(err.find("'minkowski'"), std::string::npos) << err;
+  EXPECT_NE(err.find("line 3"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(dir / "a.stl"));
+}
+
+TEST(EvalCli, CsgWithMeshOperands) {
+  test::TempDir dir("pic_eval");
+  write_mesh(make_box({0, 0, 0}, {2, 2, 2}), dir / "part.stl");
+  write_mesh(make_box({0.5, 0.5, -1}, {1.5, 1.5, 3}), dir / "hole.stl");
+  ASSERT_EQ(run("csg " + quote((dir / "part.stl").string()) + " subtract " + quote((dir / "hole.stl").string()) +
+                    " -o " + quote((dir / "out.stl").string()) + " --depth 7",
+                dir.path()),
+            0);
+  const TriMesh m = read_mesh(dir / "out.stl");
+  EXPECT_NEAR(volume(m), 8 - 2, 0.01);
+  EXPECT_TRUE(test::IsClosedManifold(m));
+}
+
+TEST(EvalCli, ScadThroughOpenscad) {
+  if (std::system("command -v openscad > /dev/null 2>&1") != 0) GTEST_SKIP() << "openscad is not installed";
+  test::TempDir dir("pic_eval");
+  {
+    std::ofstream f(dir / "part.scad");
+    f << "difference() { cube(10); translate([5, 5, -1]) cylinder(r = 2, h = 12, $fn = 4); }\n";
+  }
+  EvalOptions o;
+  o.depth = 7;
+  const TriMesh m = contour(eval_scad(dir / "part.scad", o));
+  // A $fn = 4 cylinder of radius 2 is a square of diagonal 4: area 8.
+  EXPECT_NEAR(volume(m), 1000 - 8 * 10, 0.5);
+  EXPECT_FALSE(fs::exists(dir / "part.csg"));  // the export goes to a temporary directory
+}
+
+}  // namespace
+}  // namespace pic
