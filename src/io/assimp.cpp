@@ -281,8 +281,9 @@ RawGeometry read_with_assimp(Bytes bytes, const std::string& ext) {
   g.positions.resize(size_t(head[1]));
   g.triangles.resize(size_t(head[2]));
   const uint8_t* p = reply.data() + 25 + head[0];
-  std::memcpy(g.positions.data(), p, g.positions.size() * sizeof(Vec3));
-  std::memcpy(g.triangles.data(), p + g.positions.size() * sizeof(Vec3), g.triangles.size() * sizeof(g.triangles[0]));
+  if (!g.positions.empty()) std::memcpy(g.positions.data(), p, g.positions.size() * sizeof(Vec3));
+  if (!g.triangles.empty())  // memcpy from or to null is undefined even for 0 bytes
+    std::memcpy(g.triangles.data(), p + g.positions.size() * sizeof(Vec3), g.triangles.size() * sizeof(g.triangles[0]));
   for (const auto& t : g.triangles)
     for (uint32_t i : t)
       if (i >= g.positions.size()) throw InvalidInput("malformed file: the importer (assimp) failed on it");
