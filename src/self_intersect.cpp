@@ -1,0 +1,394 @@
+// Exact self-intersection test of a triangle mesh, with CGAL's rules
+// (Polygon_mesh_processing::self_intersections): two triangles sharing an edge intersect only
+// when they are coplanar and fold onto the same side of it; two sharing a vertex only when the
+// edge opposite that vertex in one meets the other; others when they meet at all (closed
+// triangles). Positions are compared bit for bit: vertices at exactly the same position are
+// one vertex (as /work/shared/tools meshcheck and a CGAL polygon-soup load see the file).
+// Zero-area (collinear) triangles are skipped and counted apart, as meshcheck does.
+//
+// Predicates: orientation determinants on the doubles as given, with Shewchuk's static error
+// bound as a filter (Shewchuk 1997, "Adaptive precision floating-point arithmetic and fast
+// robust geometric predicates", o3derrboundA / ccwerrboundA) and exact expansion arithmetic
+// (two-sum, fma two-product, grow- and scale-expansion from the same paper) when the filter
+// cannot decide. No snapping: the answer is exact for the double coordinates written.
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "pic/pic.h"
+#include "union_find.h"
+
+namespace pic {
+namespace {
+
+// ---------------------------------------------------------------- exact arithmetic
+using Expansion = std::vector<double>;  // nonoverlapping, increasing magnitude, no zeros
+
+inline void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double bv = x - a, av = x - bv;
+  y = (a - av) + (b - bv);
+}
+inline void two_prod(double a, double b, double& x, double& y) {
+  x = a * b;
+  y = std::fma(a, b, -x);
+}
+Expansion grow(const Expansion& e, double b) {
+  Expansion h;
+  h.reserve(e.size() + 1);
+  double q = b;
+  for (double ei : e) {
+    double hi;
+    two_sum(q, ei, q, hi);
+    if (hi != 0) h.push_back(hi);
+  }
+  if (q != 0) h.push_back(q);
+  return h;
+}
+Expansion add(Expansion e, const Expansion& f) {
+  for (double x : f) e = grow(e, x);
+  return e;
+}
+Expansion scale(const Expansion& e, double b) {
+  Expansion h;
+  if (e.empty() || b == 0) return h;
+  double q, lo;
+  two_prod(e[0], b, q, lo);
+  if (lo != 0) h.push_back(lo);
+  for (size_t i = 1; i < e.size(); ++i) {
+    double t_hi, t_lo, s;
+    two_prod(e[i], b, t_hi, t_lo);
+    two_sum(q, t_lo, q, s);
+    if (s != 0) h.push_back(s);
+    two_sum(t_hi, q, q, s);
+    if (s != 0) h.push_back(s);
+  }
+  if (q != 0) h.push_back(q);
+  return h;
+}
+Expansion mul(const Expansion& e, const Expansion& f) {
+  Expansion r;
+  for (double x : f) r = add(r, scale(e, x));
+  return r;
+}
+Expansion neg(Expansion e) {
+  for (double& x : e) x = -x;
+  return e;
+}
+Expansion diff(double a, double b) {
+  double x, y;
+  two_sum(a, -b, x, y);
+  Expansion e;
+  if (y != 0) e.push_back(y);
+  if (x != 0) e.push_back(x);
+  return e;
+}
+int sign_of(const Expansion& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
+
+// ---------------------------------------------------------------- predicates
+/// Sign of det[b-a, c-a, d-a] (CGAL::orientation(a, b, c, d)).
+int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+  const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
+  const double m1 = cy * dz - cz * dy, m2 = cz * dx - cx * dz, m3 = cx * dy - cy * dx;
+  const double det = bx * m1 + by * m2 + bz * m3;
+  const double perm = std::abs(bx) * (std::abs(cy * dz) + std::abs(cz * dy)) +
+                      std::abs(by) * (std::abs(cz * dx) + std::abs(cx * dz)) +
+                      std::abs(bz) * (std::abs(cx * dy) + std::abs(cy * dx));
+  // Shewchuk's o3derrboundA = (7 + 56 eps) eps, eps = 2^-53.
+  constexpr double kBound = 7.7715611723761027e-16;
+  if (det > kBound * perm) return 1;
+  if (-det > kBound * perm) return -1;
+  if (perm == 0) return 0;
+  const Expansion ebx = diff(b[0], a[0]), eby = diff(b[1], a[1]), ebz = diff(b[2], a[2]);
+  const Expansion ecx = diff(c[0], a[0]), ecy = diff(c[1], a[1]), ecz = diff(c[2], a[2]);
+  const Expansion edx = diff(d[0], a[0]), edy = diff(d[1], a[1]), edz = diff(d[2], a[2]);
+  const Expansion e1 = add(mul(ecy, edz), neg(mul(ecz, edy)));
+  const Expansion e2 = add(mul(ecz, edx), neg(mul(ecx, edz)));
+  const Expansion e3 = add(mul(ecx, edy), neg(mul(ecy, edx)));
+  return sign_of(add(add(mul(ebx, e1), mul(eby, e2)), mul(ebz, e3)));
+}
+
+/// Sign of the 2D orientation of (a, b, c) projected along axis `drop`.
+int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
+  const int i = drop == 0 ? 1 : 0, j = drop == 2 ? 1 : 2;
+  const double l = (a[i] - c[i]) * (b[j] - c[j]), r = (a[j] - c[j]) * (b[i] - c[i]);
+  const double det = l - r;
+  // Shewchuk's ccwerrboundA = (3 + 16 eps) eps.
+  constexpr double kBound = 3.3306690738754716e-16;
+  const double bound = kBound * (std::abs(l) + std::abs(r));
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  if (l == 0 && r == 0) return 0;
+  const Expansion d = add(mul(diff(a[i], c[i]), diff(b[j], c[j])), neg(mul(diff(a[j], c[j]), diff(b[i], c[i]))));
+  return sign_of(d);
+}
+
+/// An axis along which triangle abc projects to a non-degenerate triangle, or -1 when the
+/// triangle is collinear (its exact normal is zero; orient2d along axis k is its k-th component).
+int projection_axis(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const std::array<double, 3> n{std::abs(u[1] * v[2] - u[2] * v[1]), std::abs(u[2] * v[0] - u[0] * v[2]),
+                                std::abs(u[0] * v[1] - u[1] * v[0])};
+  std::array<int, 3> order{0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return n[x] > n[y]; });
+  for (int k : order)
+    if (orient2d(a, b, c, k) != 0) return k;
+  return -1;
+}
+
+/// Closed 2D point-on-segment for a point known to be collinear with the segment.
+bool within(const Vec3& p, const Vec3& a, const Vec3& b, int drop) {
+  for (int k = 0; k < 3; ++k) {
+    if (k == drop) continue;
+    if (p[k] < std::min(a[k], b[k]) || p[k] > std::max(a[k], b[k])) return false;
+  }
+  return true;
+}
+
+/// Closed segments pq and ab in the projection along `drop` (all four points coplanar).
+bool segments_meet_2d(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, int drop) {
+  const int o1 = orient2d(p, q, a, drop), o2 = orient2d(p, q, b, drop);
+  const int o3 = orient2d(a, b, p, drop), o4 = orient2d(a, b, q, drop);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  if (o1 == 0 && within(a, p, q, drop)) return true;
+  if (o2 == 0 && within(b, p, q, drop)) return true;
+  if (o3 == 0 && within(p, a, b, drop)) return true;
+  if (o4 == 0 && within(q, a, b, drop)) return true;
+  return false;
+}
+
+/// Closed point-in-triangle in the projection along `drop`.
+bool point_in_triangle_2d(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
+  const int s1 = orient2d(a, b, p, drop), s2 = orient2d(b, c, p, drop), s3 = orient2d(c, a, p, drop);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3 < 0, has_pos = s1 > 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+/// Whether the closed segment pq meets the closed, non-degenerate triangle abc (exact).
+bool segment_meets_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+  if (op != 0 && op == oq) return false;
+  if (op == 0 && oq == 0) {
+    const int drop = projection_axis(a, b, c);
+    if (drop < 0) return false;
+    if (point_in_triangle_2d(p, a, b, c, drop) || point_in_triangle_2d(q, a, b, c, drop)) return true;
+    return segments_meet_2d(p, q, a, b, drop) || segments_meet_2d(p, q, b, c, drop) ||
+           segments_meet_2d(p, q, c, a, drop);
+  }
+  // pq reaches the plane: the line through it passes through the triangle iff it lies on one
+  // side (or on) all three edges.
+  const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3 < 0, has_pos = s1 > 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+using Tri = std::array<uint32_t, 3>;
+
+/// CGAL's rule for a pair of non-degenerate triangles of one mesh.
+bool pair_intersects(const std::vector<Vec3>& x, const Tri& ta, const Tri& tb) {
+  int ia[3], ib[3], shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (ta[i] == tb[j]) {
+        ia[shared] = i;
+        ib[shared] = j;
+        ++shared;
+      }
+  if (shared == 3) return true;  // the same triangle twice
+  const Vec3 &a0 = x[ta[0]], &a1 = x[ta[1]], &a2 = x[ta[2]];
+  const Vec3 &b0 = x[tb[0]], &b1 = x[tb[1]], &b2 = x[tb[2]];
+  if (shared == 2) {
+    // Folded onto the same side of the shared edge uv, in one plane.
+    const Vec3 &u = x[ta[ia[0]]], &v = x[ta[ia[1]]];
+    const Vec3 &p = x[ta[3 - ia[0] - ia[1]]], &q = x[tb[3 - ib[0] - ib[1]]];
+    if (orient3d(u, v, p, q) != 0) return false;
+    const int drop = projection_axis(u, v, p);
+    return drop >= 0 && orient2d(u, v, p, drop) * orient2d(u, v, q, drop) > 0;
+  }
+  if (shared == 1) {
+    const int i = ia[0], j = ib[0];
+    return segment_meets_triangle(x[tb[(j + 1) % 3]], x[tb[(j + 2) % 3]], a0, a1, a2) ||
+           segment_meets_triangle(x[ta[(i + 1) % 3]], x[ta[(i + 2) % 3]], b0, b1, b2);
+  }
+  // Two closed triangles meet iff an edge of one meets the other: an extreme point of their
+  // (convex) intersection lies on the boundary of one of them.
+  return segment_meets_triangle(a0, a1, b0, b1, b2) || segment_meets_triangle(a1, a2, b0, b1, b2) ||
+         segment_meets_triangle(a2, a0, b0, b1, b2) || segment_meets_triangle(b0, b1, a0, a1, a2) ||
+         segment_meets_triangle(b1, b2, a0, a1, a2) || segment_meets_triangle(b2, b0, a0, a1, a2);
+}
+
+// ---------------------------------------------------------------- candidate pairs
+struct Box {
+  Vec3 lo, hi;
+};
+inline bool overlap(const Box& a, const Box& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+  return true;
+}
+
+/// A bounding-box hierarchy: median splits on the longest axis, leaves of up to 4 triangles.
+class BoxTree {
+ public:
+  explicit BoxTree(const std::vector<Box>& boxes) : boxes_(boxes) {
+    order_.resize(boxes.size());
+    std::iota(order_.begin(), order_.end(), 0u);
+    if (!boxes.empty()) build(0, uint32_t(boxes.size()));
+  }
+  /// Calls f(j) for every box j > i overlapping box i.
+  template <class F>
+  void pairs_of(uint32_t i, F&& f) const {
+    if (nodes_.empty()) return;
+    uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    const Box& q = boxes_[i];
+    while (top) {
+      const N& n = nodes_[stack[--top]];
+      if (!overlap(n.box, q)) continue;
+      if (n.count) {
+        for (uint32_t k = n.first; k < n.first + n.count; ++k)
+          if (order_[k] > i && overlap(boxes_[order_[k]], q)) f(order_[k]);
+      } else {
+        stack[top++] = n.first;
+        stack[top++] = n.right;
+      }
+    }
+  }
+
+ private:
+  struct N {
+    Box box;
+    uint32_t first, count, right;
+  };
+  uint32_t build(uint32_t begin, uint32_t end) {
+    const uint32_t id = uint32_t(nodes_.size());
+    nodes_.push_back({});
+    Box b = boxes_[order_[begin]];
+    for (uint32_t k = begin + 1; k < end; ++k)
+      for (int a = 0; a < 3; ++a) {
+        b.lo[a] = std::min(b.lo[a], boxes_[order_[k]].lo[a]);
+        b.hi[a] = std::max(b.hi[a], boxes_[order_[k]].hi[a]);
+      }
+    if (end - begin <= 4) {
+      nodes_[id] = {b, begin, end - begin, 0};
+      return id;
+    }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
+    const uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t x, uint32_t y) {
+      return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
+    });
+    const uint32_t left = build(begin, mid);
+    const uint32_t right = build(mid, end);
+    nodes_[id] = {b, left, 0, right};
+    return id;
+  }
+  const std::vector<Box>& boxes_;
+  std::vector<uint32_t> order_;
+  std::vector<N> nodes_;
+};
+
+/// The mesh with bit-identical positions merged (first occurrence kept, in position order).
+TriMesh merged(const TriMesh& m) {
+  std::vector<uint32_t> perm(m.positions.size());
+  std::iota(perm.begin(), perm.end(), 0u);
+  tbb::parallel_sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) {
+    return m.positions[a] < m.positions[b] || (m.positions[a] == m.positions[b] && a < b);
+  });
+  std::vector<uint32_t> remap(m.positions.size());
+  TriMesh out;
+  for (size_t i = 0; i < perm.size(); ++i) {
+    if (i == 0 || m.positions[perm[i]] != m.positions[perm[i - 1]]) out.positions.push_back(m.positions[perm[i]]);
+    remap[perm[i]] = uint32_t(out.positions.size() - 1);
+  }
+  out.triangles.reserve(m.triangles.size());
+  for (const auto& t : m.triangles) out.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+  return out;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> intersecting_pairs_merged(const TriMesh& m, size_t* collinear) {
+  const size_t n = m.triangles.size();
+  std::vector<Box> boxes(n);
+  std::vector<char> skip(n, 0);
+  tbb::parallel_for(size_t{0}, n, [&](size_t t) {
+    const auto& tri = m.triangles[t];
+    const Vec3 &a = m.positions[tri[0]], &b = m.positions[tri[1]], &c = m.positions[tri[2]];
+    for (int k = 0; k < 3; ++k) {
+      boxes[t].lo[k] = std::min({a[k], b[k], c[k]});
+      boxes[t].hi[k] = std::max({a[k], b[k], c[k]});
+    }
+    skip[t] = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || projection_axis(a, b, c) < 0;
+  });
+  if (collinear) *collinear = size_t(std::count(skip.begin(), skip.end(), char(1)));
+  const BoxTree tree(boxes);
+  tbb::enumerable_thread_specific<std::vector<std::pair<uint32_t, uint32_t>>> found;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+    auto& out = found.local();
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (skip[i]) continue;
+      tree.pairs_of(uint32_t(i), [&](uint32_t j) {
+        if (!skip[j] && pair_intersects(m.positions, m.triangles[i], m.triangles[j])) out.push_back({uint32_t(i), j});
+      });
+    }
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> all;
+  for (auto& v : found) all.insert(all.end(), v.begin(), v.end());
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+}  // namespace
+
+std::vector<std::pair<uint32_t, uint32_t>> self_intersecting_pairs(const TriMesh& mesh) {
+  return intersecting_pairs_merged(merged(mesh), nullptr);
+}
+
+size_t count_self_intersections(const TriMesh& mesh) { return self_intersecting_pairs(mesh).size(); }
+
+MeshValidity check_validity(const TriMesh& mesh, bool self_intersections) {
+  const TriMesh m = merged(mesh);
+  MeshValidity r;
+  const MeshTopology topo = analyze_topology(m);
+  r.nonmanifold_vertices = topo.nonmanifold_vertices;
+  r.nonmanifold_edges = topo.nonmanifold_edges;
+  r.boundary_edges = topo.boundary_edges;
+  r.degenerate_triangles = topo.degenerate_triangles;
+  // Components: triangles joined across shared edges (as meshcheck counts them).
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(m.triangles.size() * 3);
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = t[k], b = t[(k + 1) % 3];
+      edges.push_back({std::min(a, b) << 32 | std::max(a, b), f});
+    }
+  }
+  tbb::parallel_sort(edges.begin(), edges.end());
+  detail::UnionFind uf(m.triangles.size());
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i].first == edges[i - 1].first) uf.join(edges[i].second, edges[i - 1].second);
+  std::vector<char> used(m.triangles.size(), 0);
+  for (const auto& e : edges) used[e.second] = 1;
+  for (size_t f = 0; f < m.triangles.size(); ++f)
+    if (used[f] && uf.root(f) == f) ++r.components;
+  if (self_intersections) {
+    r.checked = true;
+    r.self_intersections = intersecting_pairs_merged(m, &r.collinear_triangles).size();
+  }
+  return r;
+}
+
+}  // namespace pic
