@@ -6,11 +6,8 @@
 // one vertex (as /work/shared/tools meshcheck and a CGAL polygon-soup load see the file).
 // Zero-area (collinear) triangles are skipped and counted apart, as meshcheck does.
 //
-// Predicates: orientation determinants on the doubles as given, with Shewchuk's static error
-// bound as a filter (Shewchuk 1997, "Adaptive precision floating-point arithmetic and fast
-// robust geometric predicates", o3derrboundA / ccwerrboundA) and exact expansion arithmetic
-// (two-sum, fma two-product, grow- and scale-expansion from the same paper) when the filter
-// cannot decide. No snapping: the answer is exact for the double coordinates written.
+// Predicates: src/predicates.h, exact on the doubles as given (no snapping): the answer holds
+// for the coordinates written.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -23,173 +20,16 @@
 #include <tbb/parallel_sort.h>
 
 #include "pic/pic.h"
+#include "predicates.h"
 #include "union_find.h"
 
 namespace pic {
 namespace {
 
-// ---------------------------------------------------------------- exact arithmetic
-using Expansion = std::vector<double>;  // nonoverlapping, increasing magnitude, no zeros
-
-inline void two_sum(double a, double b, double& x, double& y) {
-  x = a + b;
-  const double bv = x - a, av = x - bv;
-  y = (a - av) + (b - bv);
-}
-inline void two_prod(double a, double b, double& x, double& y) {
-  x = a * b;
-  y = std::fma(a, b, -x);
-}
-Expansion grow(const Expansion& e, double b) {
-  Expansion h;
-  h.reserve(e.size() + 1);
-  double q = b;
-  for (double ei : e) {
-    double hi;
-    two_sum(q, ei, q, hi);
-    if (hi != 0) h.push_back(hi);
-  }
-  if (q != 0) h.push_back(q);
-  return h;
-}
-Expansion add(Expansion e, const Expansion& f) {
-  for (double x : f) e = grow(e, x);
-  return e;
-}
-Expansion scale(const Expansion& e, double b) {
-  Expansion h;
-  if (e.empty() || b == 0) return h;
-  double q, lo;
-  two_prod(e[0], b, q, lo);
-  if (lo != 0) h.push_back(lo);
-  for (size_t i = 1; i < e.size(); ++i) {
-    double t_hi, t_lo, s;
-    two_prod(e[i], b, t_hi, t_lo);
-    two_sum(q, t_lo, q, s);
-    if (s != 0) h.push_back(s);
-    two_sum(t_hi, q, q, s);
-    if (s != 0) h.push_back(s);
-  }
-  if (q != 0) h.push_back(q);
-  return h;
-}
-Expansion mul(const Expansion& e, const Expansion& f) {
-  Expansion r;
-  for (double x : f) r = add(r, scale(e, x));
-  return r;
-}
-Expansion neg(Expansion e) {
-  for (double& x : e) x = -x;
-  return e;
-}
-Expansion diff(double a, double b) {
-  double x, y;
-  two_sum(a, -b, x, y);
-  Expansion e;
-  if (y != 0) e.push_back(y);
-  if (x != 0) e.push_back(x);
-  return e;
-}
-int sign_of(const Expansion& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
-
-// ---------------------------------------------------------------- predicates
-/// Sign of det[b-a, c-a, d-a] (CGAL::orientation(a, b, c, d)).
-int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
-  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
-  const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
-  const double m1 = cy * dz - cz * dy, m2 = cz * dx - cx * dz, m3 = cx * dy - cy * dx;
-  const double det = bx * m1 + by * m2 + bz * m3;
-  const double perm = std::abs(bx) * (std::abs(cy * dz) + std::abs(cz * dy)) +
-                      std::abs(by) * (std::abs(cz * dx) + std::abs(cx * dz)) +
-                      std::abs(bz) * (std::abs(cx * dy) + std::abs(cy * dx));
-  // Shewchuk's o3derrboundA = (7 + 56 eps) eps, eps = 2^-53.
-  constexpr double kBound = 7.7715611723761027e-16;
-  if (det > kBound * perm) return 1;
-  if (-det > kBound * perm) return -1;
-  if (perm == 0) return 0;
-  const Expansion ebx = diff(b[0], a[0]), eby = diff(b[1], a[1]), ebz = diff(b[2], a[2]);
-  const Expansion ecx = diff(c[0], a[0]), ecy = diff(c[1], a[1]), ecz = diff(c[2], a[2]);
-  const Expansion edx = diff(d[0], a[0]), edy = diff(d[1], a[1]), edz = diff(d[2], a[2]);
-  const Expansion e1 = add(mul(ecy, edz), neg(mul(ecz, edy)));
-  const Expansion e2 = add(mul(ecz, edx), neg(mul(ecx, edz)));
-  const Expansion e3 = add(mul(ecx, edy), neg(mul(ecy, edx)));
-  return sign_of(add(add(mul(ebx, e1), mul(eby, e2)), mul(ebz, e3)));
-}
-
-/// Sign of the 2D orientation of (a, b, c) projected along axis `drop`.
-int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
-  const int i = drop == 0 ? 1 : 0, j = drop == 2 ? 1 : 2;
-  const double l = (a[i] - c[i]) * (b[j] - c[j]), r = (a[j] - c[j]) * (b[i] - c[i]);
-  const double det = l - r;
-  // Shewchuk's ccwerrboundA = (3 + 16 eps) eps.
-  constexpr double kBound = 3.3306690738754716e-16;
-  const double bound = kBound * (std::abs(l) + std::abs(r));
-  if (det > bound) return 1;
-  if (-det > bound) return -1;
-  if (l == 0 && r == 0) return 0;
-  const Expansion d = add(mul(diff(a[i], c[i]), diff(b[j], c[j])), neg(mul(diff(a[j], c[j]), diff(b[i], c[i]))));
-  return sign_of(d);
-}
-
-/// An axis along which triangle abc projects to a non-degenerate triangle, or -1 when the
-/// triangle is collinear (its exact normal is zero; orient2d along axis k is its k-th component).
-int projection_axis(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const std::array<double, 3> n{std::abs(u[1] * v[2] - u[2] * v[1]), std::abs(u[2] * v[0] - u[0] * v[2]),
-                                std::abs(u[0] * v[1] - u[1] * v[0])};
-  std::array<int, 3> order{0, 1, 2};
-  std::sort(order.begin(), order.end(), [&](int x, int y) { return n[x] > n[y]; });
-  for (int k : order)
-    if (orient2d(a, b, c, k) != 0) return k;
-  return -1;
-}
-
-/// Closed 2D point-on-segment for a point known to be collinear with the segment.
-bool within(const Vec3& p, const Vec3& a, const Vec3& b, int drop) {
-  for (int k = 0; k < 3; ++k) {
-    if (k == drop) continue;
-    if (p[k] < std::min(a[k], b[k]) || p[k] > std::max(a[k], b[k])) return false;
-  }
-  return true;
-}
-
-/// Closed segments pq and ab in the projection along `drop` (all four points coplanar).
-bool segments_meet_2d(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, int drop) {
-  const int o1 = orient2d(p, q, a, drop), o2 = orient2d(p, q, b, drop);
-  const int o3 = orient2d(a, b, p, drop), o4 = orient2d(a, b, q, drop);
-  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
-  if (o1 == 0 && within(a, p, q, drop)) return true;
-  if (o2 == 0 && within(b, p, q, drop)) return true;
-  if (o3 == 0 && within(p, a, b, drop)) return true;
-  if (o4 == 0 && within(q, a, b, drop)) return true;
-  return false;
-}
-
-/// Closed point-in-triangle in the projection along `drop`.
-bool point_in_triangle_2d(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
-  const int s1 = orient2d(a, b, p, drop), s2 = orient2d(b, c, p, drop), s3 = orient2d(c, a, p, drop);
-  const bool has_neg = s1 < 0 || s2 < 0 || s3 < 0, has_pos = s1 > 0 || s2 > 0 || s3 > 0;
-  return !(has_neg && has_pos);
-}
-
-/// Whether the closed segment pq meets the closed, non-degenerate triangle abc (exact).
-bool segment_meets_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
-  if (op != 0 && op == oq) return false;
-  if (op == 0 && oq == 0) {
-    const int drop = projection_axis(a, b, c);
-    if (drop < 0) return false;
-    if (point_in_triangle_2d(p, a, b, c, drop) || point_in_triangle_2d(q, a, b, c, drop)) return true;
-    return segments_meet_2d(p, q, a, b, drop) || segments_meet_2d(p, q, b, c, drop) ||
-           segments_meet_2d(p, q, c, a, drop);
-  }
-  // pq reaches the plane: the line through it passes through the triangle iff it lies on one
-  // side (or on) all three edges.
-  const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
-  const bool has_neg = s1 < 0 || s2 < 0 || s3 < 0, has_pos = s1 > 0 || s2 > 0 || s3 > 0;
-  return !(has_neg && has_pos);
-}
+using detail::orient2d;
+using detail::orient3d;
+using detail::projection_axis;
+using detail::segment_meets_triangle;
 
 using Tri = std::array<uint32_t, 3>;
 
