@@ -5,7 +5,7 @@
 set -euo pipefail
 
 pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
-      libcli11-dev libgtest-dev chromium)
+      libcli11-dev libgtest-dev chromium libcgal-dev)
 if [[ "${1:-}" == "--bench" ]]; then
   pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3)
 fi

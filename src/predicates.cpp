@@ -184,4 +184,38 @@ bool segment_meets_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const V
   return !(has_neg && has_pos);
 }
 
+/// CGAL's rule for a pair of non-degenerate triangles of one mesh.
+bool triangles_intersect(const std::vector<Vec3>& x, const std::array<uint32_t, 3>& ta,
+                         const std::array<uint32_t, 3>& tb) {
+  int ia[3], ib[3], shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (ta[i] == tb[j]) {
+        ia[shared] = i;
+        ib[shared] = j;
+        ++shared;
+      }
+  if (shared == 3) return true;  // the same triangle twice
+  const Vec3 &a0 = x[ta[0]], &a1 = x[ta[1]], &a2 = x[ta[2]];
+  const Vec3 &b0 = x[tb[0]], &b1 = x[tb[1]], &b2 = x[tb[2]];
+  if (shared == 2) {
+    // Folded onto the same side of the shared edge uv, in one plane.
+    const Vec3 &u = x[ta[ia[0]]], &v = x[ta[ia[1]]];
+    const Vec3 &p = x[ta[3 - ia[0] - ia[1]]], &q = x[tb[3 - ib[0] - ib[1]]];
+    if (orient3d(u, v, p, q) != 0) return false;
+    const int drop = projection_axis(u, v, p);
+    return drop >= 0 && orient2d(u, v, p, drop) * orient2d(u, v, q, drop) > 0;
+  }
+  if (shared == 1) {
+    const int i = ia[0], j = ib[0];
+    return segment_meets_triangle(x[tb[(j + 1) % 3]], x[tb[(j + 2) % 3]], a0, a1, a2) ||
+           segment_meets_triangle(x[ta[(i + 1) % 3]], x[ta[(i + 2) % 3]], b0, b1, b2);
+  }
+  // Two closed triangles meet iff an edge of one meets the other: an extreme point of their
+  // (convex) intersection lies on the boundary of one of them.
+  return segment_meets_triangle(a0, a1, b0, b1, b2) || segment_meets_triangle(a1, a2, b0, b1, b2) ||
+         segment_meets_triangle(a2, a0, b0, b1, b2) || segment_meets_triangle(b0, b1, a0, a1, a2) ||
+         segment_meets_triangle(b1, b2, a0, a1, a2) || segment_meets_triangle(b2, b0, a0, a1, a2);
+}
+
 }  // namespace pic::detail

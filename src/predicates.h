@@ -1,6 +1,10 @@
 // Exact geometric predicates on double coordinates (filtered, exact fallback).
 #pragma once
 
+#include <array>
+#include <cstdint>
+#include <vector>
+
 #include "pic/pic.h"
 
 namespace pic::detail {
@@ -14,5 +18,12 @@ int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop);
 int projection_axis(const Vec3& a, const Vec3& b, const Vec3& c);
 /// Whether the closed segment pq meets the closed, non-degenerate triangle abc (exact).
 bool segment_meets_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// CGAL's self-intersection rule for two non-degenerate triangles of one mesh (vertex indices
+/// into `x`, equal positions already merged): sharing an edge, they intersect only when
+/// coplanar and folded onto the same side; sharing a vertex, when the edge opposite it in one
+/// meets the other; otherwise when the closed triangles meet. Exact.
+bool triangles_intersect(const std::vector<Vec3>& x, const std::array<uint32_t, 3>& ta,
+                         const std::array<uint32_t, 3>& tb);
 
 }  // namespace pic::detail

@@ -20,6 +20,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "pic/pic.h"
+#include "box_tree.h"
 #include "predicates.h"
 #include "union_find.h"
 
@@ -30,115 +31,8 @@ using detail::orient2d;
 using detail::orient3d;
 using detail::projection_axis;
 using detail::segment_meets_triangle;
-
-using Tri = std::array<uint32_t, 3>;
-
-/// CGAL's rule for a pair of non-degenerate triangles of one mesh.
-bool pair_intersects(const std::vector<Vec3>& x, const Tri& ta, const Tri& tb) {
-  int ia[3], ib[3], shared = 0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (ta[i] == tb[j]) {
-        ia[shared] = i;
-        ib[shared] = j;
-        ++shared;
-      }
-  if (shared == 3) return true;  // the same triangle twice
-  const Vec3 &a0 = x[ta[0]], &a1 = x[ta[1]], &a2 = x[ta[2]];
-  const Vec3 &b0 = x[tb[0]], &b1 = x[tb[1]], &b2 = x[tb[2]];
-  if (shared == 2) {
-    // Folded onto the same side of the shared edge uv, in one plane.
-    const Vec3 &u = x[ta[ia[0]]], &v = x[ta[ia[1]]];
-    const Vec3 &p = x[ta[3 - ia[0] - ia[1]]], &q = x[tb[3 - ib[0] - ib[1]]];
-    if (orient3d(u, v, p, q) != 0) return false;
-    const int drop = projection_axis(u, v, p);
-    return drop >= 0 && orient2d(u, v, p, drop) * orient2d(u, v, q, drop) > 0;
-  }
-  if (shared == 1) {
-    const int i = ia[0], j = ib[0];
-    return segment_meets_triangle(x[tb[(j + 1) % 3]], x[tb[(j + 2) % 3]], a0, a1, a2) ||
-           segment_meets_triangle(x[ta[(i + 1) % 3]], x[ta[(i + 2) % 3]], b0, b1, b2);
-  }
-  // Two closed triangles meet iff an edge of one meets the other: an extreme point of their
-  // (convex) intersection lies on the boundary of one of them.
-  return segment_meets_triangle(a0, a1, b0, b1, b2) || segment_meets_triangle(a1, a2, b0, b1, b2) ||
-         segment_meets_triangle(a2, a0, b0, b1, b2) || segment_meets_triangle(b0, b1, a0, a1, a2) ||
-         segment_meets_triangle(b1, b2, a0, a1, a2) || segment_meets_triangle(b2, b0, a0, a1, a2);
-}
-
-// ---------------------------------------------------------------- candidate pairs
-struct Box {
-  Vec3 lo, hi;
-};
-inline bool overlap(const Box& a, const Box& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-  return true;
-}
-
-/// A bounding-box hierarchy: median splits on the longest axis, leaves of up to 4 triangles.
-class BoxTree {
- public:
-  explicit BoxTree(const std::vector<Box>& boxes) : boxes_(boxes) {
-    order_.resize(boxes.size());
-    std::iota(order_.begin(), order_.end(), 0u);
-    if (!boxes.empty()) build(0, uint32_t(boxes.size()));
-  }
-  /// Calls f(j) for every box j > i overlapping box i.
-  template <class F>
-  void pairs_of(uint32_t i, F&& f) const {
-    if (nodes_.empty()) return;
-    uint32_t stack[64];
-    int top = 0;
-    stack[top++] = 0;
-    const Box& q = boxes_[i];
-    while (top) {
-      const N& n = nodes_[stack[--top]];
-      if (!overlap(n.box, q)) continue;
-      if (n.count) {
-        for (uint32_t k = n.first; k < n.first + n.count; ++k)
-          if (order_[k] > i && overlap(boxes_[order_[k]], q)) f(order_[k]);
-      } else {
-        stack[top++] = n.first;
-        stack[top++] = n.right;
-      }
-    }
-  }
-
- private:
-  struct N {
-    Box box;
-    uint32_t first, count, right;
-  };
-  uint32_t build(uint32_t begin, uint32_t end) {
-    const uint32_t id = uint32_t(nodes_.size());
-    nodes_.push_back({});
-    Box b = boxes_[order_[begin]];
-    for (uint32_t k = begin + 1; k < end; ++k)
-      for (int a = 0; a < 3; ++a) {
-        b.lo[a] = std::min(b.lo[a], boxes_[order_[k]].lo[a]);
-        b.hi[a] = std::max(b.hi[a], boxes_[order_[k]].hi[a]);
-      }
-    if (end - begin <= 4) {
-      nodes_[id] = {b, begin, end - begin, 0};
-      return id;
-    }
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
-    const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t x, uint32_t y) {
-      return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
-    });
-    const uint32_t left = build(begin, mid);
-    const uint32_t right = build(mid, end);
-    nodes_[id] = {b, left, 0, right};
-    return id;
-  }
-  const std::vector<Box>& boxes_;
-  std::vector<uint32_t> order_;
-  std::vector<N> nodes_;
-};
+using detail::BoxTree;
+using detail::Box;
 
 /// The mesh with bit-identical positions merged (first occurrence kept, in position order).
 TriMesh merged(const TriMesh& m) {
@@ -179,7 +73,7 @@ std::vector<std::pair<uint32_t, uint32_t>> intersecting_pairs_merged(const TriMe
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (skip[i]) continue;
       tree.pairs_of(uint32_t(i), [&](uint32_t j) {
-        if (!skip[j] && pair_intersects(m.positions, m.triangles[i], m.triangles[j])) out.push_back({uint32_t(i), j});
+        if (!skip[j] && detail::triangles_intersect(m.positions, m.triangles[i], m.triangles[j])) out.push_back({uint32_t(i), j});
       });
     }
   });

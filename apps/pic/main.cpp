@@ -207,13 +207,16 @@ int main(int argc, char** argv) {
   // mesh
   auto* cmd_mesh = app.add_subcommand("mesh", "Extract the surface of a PIC object");
   std::string m_in, m_out;
-  bool m_json = false, m_no_split = false, m_no_check = false;
+  bool m_json = false, m_no_split = false, m_no_check = false, m_fast = false;
   cmd_mesh->add_option("input", m_in, "Input .pic file")->required();
   cmd_mesh->add_option("-o,--output", m_out, "Output mesh (.obj, .stl, .ply, .off, .glb)")->required();
   cmd_mesh->add_flag("--json", m_json, "Print one JSON object on stdout");
   cmd_mesh->add_flag("--no-split", m_no_split,
                      "Write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   cmd_mesh->add_flag("--no-check", m_no_check, "With --json: skip the exact self-intersection test (huge meshes)");
+  cmd_mesh->add_flag("--fast", m_fast,
+                     "Plain dual contouring split: no exact re-triangulation, so a few triangles may cross "
+                     "(slivers folded over a neighbour, long triangles at sharp creases)");
 
   // info
   auto* cmd_info = app.add_subcommand("info", "Cells per level, PIC count, bytes, bounding box");
@@ -333,7 +336,10 @@ int main(int argc, char** argv) {
     } else if (*cmd_mesh) {
       const pic::Octree tree = pic::load(m_in);
       const auto t0 = Clock::now();
-      pic::TriMesh mesh = pic::contour(tree);
+      pic::ContourOptions copt;
+      copt.intersection_free = !m_fast;
+      pic::ContourStats cst;
+      pic::TriMesh mesh = pic::contour(tree, copt, &cst);
       const double secs = since(t0);
       const size_t split = m_no_split ? 0 : pic::split_nonmanifold(mesh);
       pic::write_mesh(mesh, m_out);
@@ -344,6 +350,8 @@ int main(int argc, char** argv) {
             .add("triangles", mesh.triangles.size())
             .add("seconds", secs)
             .add("split_vertices", split)
+            .add("fans", cst.fans)
+            .add("moved_vertices", cst.moved_vertices)
             .add("volume", pic::volume(mesh))
             .raw("topology", topology_json(topo));
         std::cout << add_validity(j, pic::check_validity(mesh, !m_no_check)).str() << "\n";
