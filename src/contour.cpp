@@ -299,12 +299,13 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   using namespace detail;
   const bool split = tree.nodes[0].kind == CellKind::Internal;
   // Each gray leaf's vertex in input coordinates, once (the walk meets it up to 12 times).
-  std::vector<Vec3> pos(tree.vertices.size()), center(tree.vertices.size());
+  std::vector<Vec3> pos(tree.vertices.size());
+  std::vector<VertexCell> cell_of(tree.vertices.size());
   auto place = [&](uint32_t node, const Cell& cell) {
     const Node& n = tree.nodes[node];
     if (n.kind != CellKind::Gray) return;
     pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, tree.vertices[n.index]));
-    center[n.index] = unit_to_world(tree.cube, vertex_unit(cell, {0.5f, 0.5f, 0.5f}));
+    cell_of[n.index] = {unit_to_world(tree.cube, vertex_unit(cell, {0.5f, 0.5f, 0.5f})), 0.5 * cell.size() * tree.cube.size};
   };
   if (split) {
     tbb::parallel_for(0, 8, [&](int c) { visit_leaves(tree, tree.nodes[0].index + c, Cell{}.child(c), place); });
@@ -338,18 +339,19 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   uint32_t used = 0;
   for (uint32_t& r : remap) used += r;
   out.positions.reserve(used);
-  std::vector<Vec3> centers;
-  centers.reserve(used);
+  std::vector<VertexCell> cells;
+  cells.reserve(used);
   for (size_t i = 0; i < remap.size(); ++i)
     if (remap[i]) {
       remap[i] = static_cast<uint32_t>(out.positions.size());
       out.positions.push_back(pos[i]);
-      centers.push_back(center[i]);
+      cells.push_back(cell_of[i]);
     }
   for (auto& p : polys)
     for (int k = 0; k < p.count; ++k) p.v[k] = remap[p.v[k]];
   TriangulationStats ts;
-  out.triangles = triangulate_polygons(out.positions, centers, polys, options.intersection_free, &ts);
+  out.triangles = triangulate_polygons(out.positions, cells, polys,
+                                       tree.cube.size / double(int64_t{1} << tree.max_depth), options.intersection_free, &ts);
   if (stats) {
     stats->fans = ts.fans;
     stats->other_diagonal = ts.other_diagonal;

@@ -56,10 +56,15 @@ struct TriangulationStats {
 /// Triangles of the dual polygons (vertex ids into `x`); with `intersection_free`, polygons
 /// near a crossing are re-triangulated until the exact test finds none (src/triangulate.cpp).
 /// Fan points are appended to `x`.
-/// `centers`: each vertex's cell centre (a moved vertex stays between it and where it was).
-std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, const std::vector<Vec3>& centers,
-                                                          const std::vector<MeshPolygon>& polys, bool intersection_free,
-                                                          TriangulationStats* stats);
+/// A vertex's cell: a moved vertex stays inside it.
+struct VertexCell {
+  Vec3 center;
+  double half;  // half the side
+};
+/// `cells`: each vertex's cell; `finest`: the side of a finest cell (moves are bounded by it).
+std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
+                                                          const std::vector<MeshPolygon>& polys, double finest,
+                                                          bool intersection_free, TriangulationStats* stats);
 
 /// Splits a quad along the diagonal that folds most (keeps sharp creases whose two vertices
 /// lie on the crease); returns the 2 triangles as index triples into `quad`.
