@@ -16,7 +16,22 @@ namespace pic::detail {
 namespace {
 
 // ---------------------------------------------------------------- exact arithmetic
-using Expansion = std::vector<double>;  // nonoverlapping, increasing magnitude, no zeros
+/// Nonoverlapping components, increasing magnitude, zeros dropped. Fixed capacity on the stack:
+/// the largest expansion orient3d builds has 192 components (3 x 2 x 2 x 16).
+struct Expansion {
+  std::array<double, 192> v;  // only v[0..n) is ever read or copied
+  int n = 0;
+  Expansion() = default;
+  Expansion(const Expansion& o) : n(o.n) { std::copy_n(o.v.begin(), n, v.begin()); }
+  Expansion& operator=(const Expansion& o) {
+    n = o.n;
+    std::copy_n(o.v.begin(), n, v.begin());
+    return *this;
+  }
+  void push(double x) {
+    if (x != 0) v[size_t(n++)] = x;
+  }
+};
 
 inline void two_sum(double a, double b, double& x, double& y) {
   x = a + b;
@@ -27,57 +42,57 @@ inline void two_prod(double a, double b, double& x, double& y) {
   x = a * b;
   y = std::fma(a, b, -x);
 }
-Expansion grow(const Expansion& e, double b) {
-  Expansion h;
-  h.reserve(e.size() + 1);
+/// e += b, in place (Shewchuk's Grow-Expansion: component i of the result needs only e[0..i]).
+void grow(Expansion& e, double b) {
   double q = b;
-  for (double ei : e) {
-    double hi;
-    two_sum(q, ei, q, hi);
-    if (hi != 0) h.push_back(hi);
+  int k = 0;
+  for (int i = 0; i < e.n; ++i) {
+    double h;
+    two_sum(q, e.v[size_t(i)], q, h);
+    if (h != 0) e.v[size_t(k++)] = h;
   }
-  if (q != 0) h.push_back(q);
-  return h;
+  if (q != 0) e.v[size_t(k++)] = q;
+  e.n = k;
 }
 Expansion add(Expansion e, const Expansion& f) {
-  for (double x : f) e = grow(e, x);
+  for (int i = 0; i < f.n; ++i) grow(e, f.v[size_t(i)]);
   return e;
 }
 Expansion scale(const Expansion& e, double b) {
   Expansion h;
-  if (e.empty() || b == 0) return h;
+  if (e.n == 0 || b == 0) return h;
   double q, lo;
-  two_prod(e[0], b, q, lo);
-  if (lo != 0) h.push_back(lo);
-  for (size_t i = 1; i < e.size(); ++i) {
+  two_prod(e.v[0], b, q, lo);
+  h.push(lo);
+  for (int i = 1; i < e.n; ++i) {
     double t_hi, t_lo, s;
-    two_prod(e[i], b, t_hi, t_lo);
+    two_prod(e.v[size_t(i)], b, t_hi, t_lo);
     two_sum(q, t_lo, q, s);
-    if (s != 0) h.push_back(s);
+    h.push(s);
     two_sum(t_hi, q, q, s);
-    if (s != 0) h.push_back(s);
+    h.push(s);
   }
-  if (q != 0) h.push_back(q);
+  h.push(q);
   return h;
 }
 Expansion mul(const Expansion& e, const Expansion& f) {
   Expansion r;
-  for (double x : f) r = add(r, scale(e, x));
+  for (int i = 0; i < f.n; ++i) r = add(r, scale(e, f.v[size_t(i)]));
   return r;
 }
 Expansion neg(Expansion e) {
-  for (double& x : e) x = -x;
+  for (int i = 0; i < e.n; ++i) e.v[size_t(i)] = -e.v[size_t(i)];
   return e;
 }
 Expansion diff(double a, double b) {
   double x, y;
   two_sum(a, -b, x, y);
   Expansion e;
-  if (y != 0) e.push_back(y);
-  if (x != 0) e.push_back(x);
+  e.push(y);
+  e.push(x);
   return e;
 }
-int sign_of(const Expansion& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
+int sign_of(const Expansion& e) { return e.n == 0 ? 0 : (e.v[size_t(e.n - 1)] > 0 ? 1 : -1); }
 
 }  // namespace
 

@@ -172,16 +172,14 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       size_t hits = 0;
       for (int a = 0; a < c; ++a)
         for (int b = a + 1; b < c; ++b) hits += triangles_intersect(xm, t[a], t[b]);
-      tree.query(boxes[i], [&](uint32_t j) {
-        if (j == i || j == except) return;
-        std::array<Tri, 4> u;
-        const int cu = merged_tris(j, opt[j], u);
-        for (int b = 0; b < cu; ++b) {
-          const Box ub = box_of(xm, u[b]);
-          for (int a = 0; a < c; ++a)
-            if (overlap(tb[a], ub)) hits += triangles_intersect(xm, t[a], u[b]);
-        }
-      });
+      for (int a = 0; a < c; ++a)
+        tree.query(tb[a], [&](uint32_t j) {
+          if (j == i || j == except) return;
+          std::array<Tri, 4> u;
+          const int cu = merged_tris(j, opt[j], u);
+          for (int b = 0; b < cu; ++b)
+            if (overlap(tb[a], box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
+        });
       return hits;
     };
     // The polygons around vertex v, counted together (a crossing between two of them twice).
