@@ -38,6 +38,8 @@ constexpr int kMaxRounds = 8;
 /// works is kept; measured on spot (1,117 crossings at depth 12), 1/4 of a cell leaves 48 and
 /// 1/2 leaves 8, one cell none. The vertex stays inside its own cell either way.
 constexpr double kMaxPull = 1.0;
+/// How far (in finest cells) the other diagonal or a fan may move the surface of a polygon.
+constexpr double kMaxDeviation = 0.25;
 
 enum Option : uint8_t { kPreferred = 0, kOtherDiagonal = 1, kFan = 2 };
 
@@ -222,9 +224,34 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         }
       std::sort(partners.begin(), partners.end());
       partners.erase(std::unique(partners.begin(), partners.end()), partners.end());
+      // Options that keep the surface where it is: the other diagonal only of a quad whose two
+      // splits lie within kMaxDeviation of each other (the distance between its diagonals'
+      // lines), the fan only when its point is that close to the current triangles' planes.
+      // A big non-planar quad folded the other way moves the surface by up to its bulge.
       auto options = [&](uint32_t i) {
-        return polys[i].count == 3 ? std::vector<uint8_t>{kPreferred, kFan}
-                                   : std::vector<uint8_t>{kPreferred, kOtherDiagonal, kFan};
+        std::vector<uint8_t> o{kPreferred};
+        const MeshPolygon& p = polys[i];
+        const double limit = kMaxDeviation * finest;
+        const Vec3& f = xm[mid[nv + i]];
+        auto plane_distance = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& q) {
+          const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+          const double l = norm3(n);
+          return l > 0 ? std::abs(dot3(n, sub3(q, a))) / l : 0.0;
+        };
+        std::array<Vec3, 4> q;
+        for (int k = 0; k < p.count; ++k) q[k] = xm[mid[p.v[k]]];
+        if (p.count == 3) {
+          if (plane_distance(q[0], q[1], q[2], f) <= limit) o.push_back(kFan);
+          return o;
+        }
+        const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
+        const double l = norm3(n);
+        const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
+        if (bulge <= limit) o.push_back(kOtherDiagonal);
+        if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
+            std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
+          o.push_back(kFan);
+        return o;
       };
       size_t changed = 0;
       for (uint32_t i : bad) {
