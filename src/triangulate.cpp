@@ -149,6 +149,29 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       boxes[i] = b;
     }
     const BoxTree tree(boxes);
+    // The other diagonal must not be an edge the mesh has (or may have) elsewhere: a polygon's
+    // side or another quad's diagonal would become an edge of four triangles.
+    std::vector<uint8_t> other_ok(n, 0);
+    {
+      auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
+      std::vector<uint64_t> pairs_used;
+      for (const auto& p : polys) {
+        for (int k = 0; k < p.count; ++k) pairs_used.push_back(key(p.v[k], p.v[(k + 1) % p.count]));
+        if (p.count == 4) {
+          pairs_used.push_back(key(p.v[0], p.v[2]));
+          pairs_used.push_back(key(p.v[1], p.v[3]));
+        }
+      }
+      std::sort(pairs_used.begin(), pairs_used.end());
+      auto uses = [&](uint64_t k) {
+        return std::upper_bound(pairs_used.begin(), pairs_used.end(), k) - std::lower_bound(pairs_used.begin(), pairs_used.end(), k);
+      };
+      for (size_t i = 0; i < n; ++i)
+        if (polys[i].count == 4) {
+          const auto& v = polys[i].v;
+          other_ok[i] = uses(key(v[0], v[2])) == 1 && uses(key(v[1], v[3])) == 1;
+        }
+    }
     // Polygons around each vertex.
     std::vector<uint32_t> first(size_t(nv) + 1, 0), around;
     for (const auto& p : polys)
@@ -247,7 +270,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
         const double l = norm3(n);
         const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
-        if (bulge <= limit) o.push_back(kOtherDiagonal);
+        if (bulge <= limit && other_ok[i]) o.push_back(kOtherDiagonal);
         if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
             std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
           o.push_back(kFan);
