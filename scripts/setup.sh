@@ -6,7 +6,7 @@
 set -euo pipefail
 
 pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
-      libcli11-dev libgtest-dev chromium)
+      libcli11-dev libgtest-dev chromium libcgal-dev)
 # `pic eval model.scad` runs OpenSCAD to export its CSG tree (tests skip the .scad case without it).
 pkgs+=(openscad)
 if [[ "${1:-}" == "--bench" ]]; then

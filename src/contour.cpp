@@ -1,4 +1,5 @@
 #include "contour.h"
+#include "predicates.h"
 #include "vec3.h"
 
 #include <tbb/parallel_for.h>
@@ -10,20 +11,13 @@
 namespace pic::detail {
 namespace {
 
-// What the walk carries for a node: the lean walk of a whole contour needs only the level
-// (vertex positions are computed once per leaf beforehand); partial contours and the crack
-// search need the cell itself.
-struct LevelRef {
-  uint32_t node;
-  int level;
-};
+// What the walk carries for a node: the node and its cell (the whole contour needs the
+// minimal edge's corners for the intersection-free triangulation).
 struct CellRef {
   uint32_t node;
   Cell cell;
 };
-inline int level_of(const LevelRef& r) { return r.level; }
 inline int level_of(const CellRef& r) { return r.cell.level; }
-inline LevelRef child_ref(const LevelRef& r, uint32_t first, int c) { return {first + uint32_t(c), r.level + 1}; }
 inline CellRef child_ref(const CellRef& r, uint32_t first, int c) { return {first + uint32_t(c), r.cell.child(c)}; }
 
 /// The recursion of Ju et al. over node references. `V` supplies `active(node)` (is the node
@@ -168,7 +162,7 @@ class DualWalker {
       poly[count++] = r;
     }
     if (count > 1 && poly[count - 1].node == poly[0].node) --count;
-    if (count >= 3) v_.polygon(poly, count);
+    if (count >= 3) v_.polygon(poly, count, n[deepest], c0, c1);
   }
 
  private:
@@ -192,7 +186,7 @@ struct CallbackVisitor {
     const auto a = deepest.cell.corner(c0), b = deepest.cell.corner(c1);
     stats->crack_points.push_back({a[0] + b[0], a[1] + b[1], a[2] + b[2]});
   }
-  void polygon(const std::array<CellRef, 4>& refs, int count) {
+  void polygon(const std::array<CellRef, 4>& refs, int count, const CellRef&, int, int) {
     DualPolygon poly{};
     poly.count = count;
     for (int k = 0; k < count; ++k) {
@@ -204,25 +198,27 @@ struct CallbackVisitor {
 };
 
 
-/// Whole-contour visitor: triangles as triples of the tree's vertex indices, positions
-/// looked up from a per-vertex table.
+/// Whole-contour visitor: records each dual polygon (tree vertex indices) with its minimal
+/// edge; triangulated afterwards (src/contour.cpp contour()).
 struct MeshVisitor {
-  using Tri = std::array<uint32_t, 3>;
   static constexpr bool kCracks = false;
   const Node* nodes;
-  const Vec3* pos;
-  std::vector<Tri>& tris;
+  const Cube& cube;
+  std::vector<MeshPolygon>& polys;
 
   static bool active(uint32_t) { return true; }
-  void polygon(const std::array<LevelRef, 4>& r, int count) {
-    std::array<uint32_t, 4> v;
-    for (int k = 0; k < count; ++k) v[k] = nodes[r[k].node].index;
-    if (count == 3) {
-      tris.push_back({v[0], v[1], v[2]});
-      return;
-    }
-    for (const auto& tri : split_quad({pos[v[0]], pos[v[1]], pos[v[2]], pos[v[3]]}))
-      tris.push_back({v[tri[0]], v[tri[1]], v[tri[2]]});
+  void polygon(const std::array<CellRef, 4>& r, int count, const CellRef& deepest, int c0, int c1) {
+    MeshPolygon m;
+    m.count = count;
+    for (int k = 0; k < count; ++k) m.v[k] = nodes[r[k].node].index;
+    const auto corner = [&](int c) {
+      const auto l = deepest.cell.corner(c);
+      constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
+      return unit_to_world(cube, Vec3{double(l[0]) * k, double(l[1]) * k, double(l[2]) * k});
+    };
+    m.e0 = corner(c0);
+    m.e1 = corner(c1);
+    polys.push_back(m);
   }
 };
 
@@ -272,56 +268,98 @@ std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
   return {{{0, 1, 3}, {1, 2, 3}}};
 }
 
+Vec3 fan_point(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Vec3& e1) {
+  // Where the polygon's mean plane (centroid, vector-area normal) crosses the edge: on a
+  // smooth surface, near where the surface does. Kept off the edge's ends.
+  Vec3 c{0, 0, 0}, n{0, 0, 0};
+  for (int k = 0; k < count; ++k) {
+    for (int a = 0; a < 3; ++a) c[a] += p[k][a] / count;
+    const Vec3 x = cross3(p[k], p[(k + 1) % count]);
+    for (int a = 0; a < 3; ++a) n[a] += x[a];
+  }
+  const Vec3 d = sub3(e1, e0);
+  const double den = dot3(n, d);
+  double t = 0.5;
+  if (den != 0) t = dot3(n, sub3(c, e0)) / den;
+  if (!(t >= kFanEdgeMargin)) t = kFanEdgeMargin;  // also NaN
+  if (t > 1 - kFanEdgeMargin) t = 1 - kFanEdgeMargin;
+  Vec3 x = e0;
+  for (int a = 0; a < 3; ++a)
+    if (e0[a] != e1[a]) x[a] = e0[a] + t * d[a];  // the other two coordinates stay exact
+  return x;
+}
+
 }  // namespace pic::detail
 
 namespace pic {
 
-TriMesh contour(const Octree& tree) {
+TriMesh contour(const Octree& tree) { return contour(tree, ContourOptions{}); }
+
+TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats* stats) {
   using namespace detail;
-  using Tri = MeshVisitor::Tri;
   const bool split = tree.nodes[0].kind == CellKind::Internal;
   // Each gray leaf's vertex in input coordinates, once (the walk meets it up to 12 times).
   std::vector<Vec3> pos(tree.vertices.size());
+  std::vector<VertexCell> cell_of(tree.vertices.size());
   auto place = [&](uint32_t node, const Cell& cell) {
     const Node& n = tree.nodes[node];
-    if (n.kind == CellKind::Gray) pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, tree.vertices[n.index]));
+    if (n.kind != CellKind::Gray) return;
+    pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, tree.vertices[n.index]));
+    cell_of[n.index] = {unit_to_world(tree.cube, vertex_unit(cell, {0.5f, 0.5f, 0.5f})), 0.5 * cell.size() * tree.cube.size};
   };
   if (split) {
     tbb::parallel_for(0, 8, [&](int c) { visit_leaves(tree, tree.nodes[0].index + c, Cell{}.child(c), place); });
   } else {
     visit_leaves(tree, 0, Cell{}, place);
   }
-  // Triangles made by 9 tasks — the 8 root children and the faces and edges between them —
+  // Polygons found by 9 tasks — the 8 root children and the faces and edges between them —
   // each into its own list; concatenated in that fixed order they are exactly what a serial
-  // walk makes.
-  std::array<std::vector<Tri>, 9> parts;
+  // walk finds.
+  std::array<std::vector<MeshPolygon>, 9> parts;
   tbb::parallel_for(0, split ? 9 : 1, [&](int task) {
-    MeshVisitor v{tree.nodes.data(), pos.data(), parts[task]};
-    DualWalker<LevelRef, MeshVisitor> w(tree, v);
-    if (!split) w.cell_proc({0, 0});
-    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), 1});
-    else w.root_faces_and_edges({0, 0});
+    MeshVisitor v{tree.nodes.data(), tree.cube, parts[task]};
+    DualWalker<CellRef, MeshVisitor> w(tree, v);
+    if (!split) w.cell_proc({0, Cell{}});
+    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), Cell{}.child(task)});
+    else w.root_faces_and_edges({0, Cell{}});
   });
-  // Vertices numbered in the tree's vertex order, keeping those the triangles use.
-  std::vector<uint32_t> remap(tree.vertices.size(), 0);
+  std::vector<MeshPolygon> polys;
   size_t total = 0;
-  for (const auto& part : parts) {
-    total += part.size();
-    for (const Tri& t : part) remap[t[0]] = remap[t[1]] = remap[t[2]] = 1;
+  for (const auto& part : parts) total += part.size();
+  polys.reserve(total);
+  for (auto& part : parts) {
+    polys.insert(polys.end(), part.begin(), part.end());
+    std::vector<MeshPolygon>().swap(part);
   }
+  // Vertices numbered in the tree's vertex order, keeping those the polygons use.
+  std::vector<uint32_t> remap(tree.vertices.size(), 0);
+  for (const auto& p : polys)
+    for (int k = 0; k < p.count; ++k) remap[p.v[k]] = 1;
   TriMesh out;
   uint32_t used = 0;
   for (uint32_t& r : remap) used += r;
   out.positions.reserve(used);
+  std::vector<VertexCell> cells;
+  cells.reserve(used);
   for (size_t i = 0; i < remap.size(); ++i)
     if (remap[i]) {
       remap[i] = static_cast<uint32_t>(out.positions.size());
       out.positions.push_back(pos[i]);
+      cells.push_back(cell_of[i]);
     }
-  out.triangles.resize(total);
-  size_t k = 0;
-  for (const auto& part : parts)
-    for (const Tri& t : part) out.triangles[k++] = {remap[t[0]], remap[t[1]], remap[t[2]]};
+  for (auto& p : polys)
+    for (int k = 0; k < p.count; ++k) p.v[k] = remap[p.v[k]];
+  TriangulationStats ts;
+  out.triangles = triangulate_polygons(out.positions, cells, polys,
+                                       tree.cube.size / double(int64_t{1} << tree.max_depth), options.intersection_free, &ts);
+  if (stats) {
+    stats->fans = ts.fans;
+    stats->other_diagonal = ts.other_diagonal;
+    stats->moved_vertices = ts.moved_vertices;
+    stats->initial_intersections = ts.initial_intersections;
+    stats->remaining_intersections = ts.remaining_intersections;
+    stats->rounds = ts.rounds;
+  }
   return out;
 }
 

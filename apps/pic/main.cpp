@@ -107,6 +107,16 @@ std::string topology_json(const pic::MeshTopology& t) {
       .str();
 }
 
+// Validity of a written mesh (issue 10): exact self-intersections (null with --no-check),
+// non-manifold vertices and edges, components; equal positions merged as a reader sees them.
+Json& add_validity(Json& j, const pic::MeshValidity& v) {
+  if (v.checked) j.add("self_intersections", v.self_intersections);
+  else j.raw("self_intersections", "null");
+  return j.add("nonmanifold_vertices", v.nonmanifold_vertices)
+      .add("nonmanifold_edges", v.nonmanifold_edges)
+      .add("components", v.components);
+}
+
 std::string info_json(const pic::Octree& tree, size_t file_bytes) {
   const auto s = pic::analyze(tree);
   std::string levels = "[";
@@ -211,25 +221,30 @@ int main(int argc, char** argv) {
   // mesh
   auto* cmd_mesh = app.add_subcommand("mesh", "Extract the surface of a PIC object");
   std::string m_in, m_out;
-  bool m_json = false, m_no_split = false;
+  bool m_json = false, m_no_split = false, m_no_check = false, m_fast = false;
   cmd_mesh->add_option("input", m_in, "Input .pic file")->required();
   cmd_mesh->add_option("-o,--output", m_out, "Output mesh (.obj, .stl, .ply, .off, .glb)")->required();
   cmd_mesh->add_flag("--json", m_json, "Print one JSON object on stdout");
   cmd_mesh->add_flag("--no-split", m_no_split,
                      "Write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
+  cmd_mesh->add_flag("--no-check", m_no_check, "With --json: skip the exact self-intersection test (huge meshes)");
+  cmd_mesh->add_flag("--fast", m_fast,
+                     "Plain dual contouring split: no exact re-triangulation, so a few triangles may cross "
+                     "(slivers folded over a neighbour, long triangles at sharp creases)");
 
   // info
   auto* cmd_info = app.add_subcommand("info", "Cells per level, PIC count, bytes, bounding box");
   std::string i_in;
-  bool i_json = false;
+  bool i_json = false, i_no_check = false;
   cmd_info->add_option("input", i_in, "Input .pic file")->required();
   cmd_info->add_flag("--json", i_json, "Print one JSON object on stdout");
+  cmd_info->add_flag("--no-check", i_no_check, "Skip the exact self-intersection test of the contour (huge meshes)");
 
   // csg
   auto* cmd_csg = app.add_subcommand("csg", "Booleans on PIC objects, left to right: A union|intersect|subtract B ...");
   std::vector<std::string> c_args;
   std::string c_out, c_mesh;
-  bool c_json = false, c_no_split = false;
+  bool c_json = false, c_no_split = false, c_no_check = false;
   double c_error = 1e-8;
   int c_depth = 12;
   cmd_csg->add_option("args", c_args, "A OP B [OP C ...]; operands are .pic files or meshes")->required();
@@ -241,6 +256,7 @@ int main(int argc, char** argv) {
                     "With --mesh: write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   cmd_csg->add_option("--error", c_error, "QEF residual threshold for new vertices")->capture_default_str();
   cmd_csg->add_flag("--json", c_json, "Print one JSON object on stdout");
+  cmd_csg->add_flag("--no-check", c_no_check, "With --mesh --json: skip the exact self-intersection test (huge meshes)");
 
   // eval
   auto* cmd_eval = app.add_subcommand("eval", "Evaluate an OpenSCAD model (.scad via openscad, or its .csg export)");
@@ -376,21 +392,25 @@ int main(int argc, char** argv) {
     } else if (*cmd_mesh) {
       const pic::Octree tree = pic::load(m_in);
       const auto t0 = Clock::now();
-      pic::TriMesh mesh = pic::contour(tree);
+      pic::ContourOptions copt;
+      copt.intersection_free = !m_fast;
+      pic::ContourStats cst;
+      pic::TriMesh mesh = pic::contour(tree, copt, &cst);
       const double secs = since(t0);
       const size_t split = m_no_split ? 0 : pic::split_nonmanifold(mesh);
       pic::write_mesh(mesh, m_out);
       const auto topo = pic::analyze_topology(mesh);
       if (m_json) {
-        std::cout << Json()
-                         .add("vertices", mesh.positions.size())
-                         .add("triangles", mesh.triangles.size())
-                         .add("seconds", secs)
-                         .add("split_vertices", split)
-                         .add("volume", pic::volume(mesh))
-                         .raw("topology", topology_json(topo))
-                         .str()
-                  << "\n";
+        Json j;
+        j.add("vertices", mesh.positions.size())
+            .add("triangles", mesh.triangles.size())
+            .add("seconds", secs)
+            .add("split_vertices", split)
+            .add("fans", cst.fans)
+            .add("moved_vertices", cst.moved_vertices)
+            .add("volume", pic::volume(mesh))
+            .raw("topology", topology_json(topo));
+        std::cout << add_validity(j, pic::check_validity(mesh, !m_no_check)).str() << "\n";
       } else {
         std::printf("%zu vertices, %zu triangles in %.4f s (%s) -> %s\n", mesh.positions.size(),
                     mesh.triangles.size(), secs, topo.manifold() ? "closed manifold" : topo.closed() ? "closed, NOT manifold" : "NOT closed", m_out.c_str());
@@ -400,8 +420,13 @@ int main(int argc, char** argv) {
       const size_t bytes = std::filesystem::file_size(i_in);
       if (i_json) {
         std::string j = info_json(tree, bytes);
-        const auto topo = pic::analyze_topology(pic::contour(tree));
+        const pic::TriMesh contour = pic::contour(tree);
+        const auto topo = pic::analyze_topology(contour);
         j.insert(j.size() - 1, ", \"contour\": " + topology_json(topo));
+        // The contour's validity, also at the top level (issue 10's contract).
+        Json v;
+        const std::string vs = add_validity(v, pic::check_validity(contour, !i_no_check)).str();
+        j.insert(j.size() - 1, ", " + vs.substr(1, vs.size() - 2));
         std::cout << j << "\n";
       } else {
         print_info_table(tree, bytes);
@@ -485,6 +510,7 @@ int main(int argc, char** argv) {
         pic::write_mesh(mesh, c_mesh);
         j.add("triangles", mesh.triangles.size()).add("split_vertices", split)
             .raw("topology", topology_json(pic::analyze_topology(mesh)));
+        if (c_json) add_validity(j, pic::check_validity(mesh, !c_no_check));
       }
       if (c_json) std::cout << j.str() << "\n";
       else std::printf("%zu PICs -> %s\n", pics, c_out.c_str());

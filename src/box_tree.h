@@ -1,0 +1,93 @@
+// A static bounding-box hierarchy for "which boxes overlap this one" (pairs of triangles that
+// may intersect; dual polygons near a polygon).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include "pic/pic.h"
+
+namespace pic::detail {
+
+struct Box {
+  Vec3 lo, hi;
+};
+inline bool overlap(const Box& a, const Box& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+  return true;
+}
+
+/// A bounding-box hierarchy: median splits on the longest axis, leaves of up to 4 triangles.
+class BoxTree {
+ public:
+  explicit BoxTree(const std::vector<Box>& boxes) : boxes_(boxes) {
+    order_.resize(boxes.size());
+    std::iota(order_.begin(), order_.end(), 0u);
+    if (!boxes.empty()) build(0, uint32_t(boxes.size()));
+  }
+  /// Calls f(j) for every box j > i overlapping box i.
+  template <class F>
+  void pairs_of(uint32_t i, F&& f) const {
+    query(boxes_[i], [&](uint32_t j) {
+      if (j > i) f(j);
+    });
+  }
+  /// Calls f(j) for every box j overlapping q (closed boxes).
+  template <class F>
+  void query(const Box& q, F&& f) const {
+    if (nodes_.empty()) return;
+    uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top) {
+      const N& n = nodes_[stack[--top]];
+      if (!overlap(n.box, q)) continue;
+      if (n.count) {
+        for (uint32_t k = n.first; k < n.first + n.count; ++k)
+          if (overlap(boxes_[order_[k]], q)) f(order_[k]);
+      } else {
+        stack[top++] = n.first;
+        stack[top++] = n.right;
+      }
+    }
+  }
+
+ private:
+  struct N {
+    Box box;
+    uint32_t first, count, right;
+  };
+  uint32_t build(uint32_t begin, uint32_t end) {
+    const uint32_t id = uint32_t(nodes_.size());
+    nodes_.push_back({});
+    Box b = boxes_[order_[begin]];
+    for (uint32_t k = begin + 1; k < end; ++k)
+      for (int a = 0; a < 3; ++a) {
+        b.lo[a] = std::min(b.lo[a], boxes_[order_[k]].lo[a]);
+        b.hi[a] = std::max(b.hi[a], boxes_[order_[k]].hi[a]);
+      }
+    if (end - begin <= 4) {
+      nodes_[id] = {b, begin, end - begin, 0};
+      return id;
+    }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
+    const uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t x, uint32_t y) {
+      return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
+    });
+    const uint32_t left = build(begin, mid);
+    const uint32_t right = build(mid, end);
+    nodes_[id] = {b, left, 0, right};
+    return id;
+  }
+  std::vector<Box> boxes_;
+  std::vector<uint32_t> order_;
+  std::vector<N> nodes_;
+};
+
+}  // namespace pic::detail
