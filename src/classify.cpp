@@ -24,24 +24,6 @@ constexpr i64 kGridMax = i64{1} << kGridBits;
 constexpr double kCapTolerance = 0.05;
 constexpr double kPointTolerance = 1e300;
 
-/// Segments carrying the child grid's values from the parent's corners (see sample.cpp).
-struct Segment {
-  int to, from, axis;
-};
-std::array<Segment, 19> make_segments() {
-  std::array<Segment, 19> out{};
-  int n = 0;
-  for (int ones = 1; ones <= 3; ++ones)
-    for (int g = 0; g < 27; ++g) {
-      const int a[3] = {g % 3, (g / 3) % 3, g / 9};
-      if ((a[0] == 1) + (a[1] == 1) + (a[2] == 1) != ones) continue;
-      const int axis = a[0] == 1 ? 0 : (a[1] == 1 ? 1 : 2);
-      out[n++] = {g, g - (axis == 0 ? 1 : axis == 1 ? 3 : 9), axis};
-    }
-  return out;
-}
-const std::array<Segment, 19> kSegments = make_segments();
-
 Vec3 unit_vec(const Vec3& v) {
   const double l = norm3(v);
   return l > 0 ? Vec3{v[0] / l, v[1] / l, v[2] / l} : Vec3{0, 0, 0};
@@ -92,16 +74,18 @@ void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_
                                      std::array<bool, 27>& g, Wind27* wind) const {
   // Crossing a triangle along +axis changes w by -sign(n_axis) (its normal points out).
   const i64 h = lattice_to_grid(cell.span() / 2);
+  const I3 base = lattice_to_grid(cell.lat);
   std::array<int32_t, 27> jump{};
   for (uint32_t k : idx) {
     const ITri& t = all_[k];
-    for (const Segment& s : kSegments) {
-      const I3 start = child_grid_point(cell, s.from);
-      if (crosses(t, start, s.axis, h)) jump[s.to] -= sgn(t.n[s.axis]);
+    const LineMask mask = line_mask(t, base, h, 3);
+    for (const GridSegment& s : kGridSegments) {
+      if (!mask.may_cross(s.axis, s.i, s.ci, s.j, s.cj)) continue;
+      if (crosses(t, child_grid_point(cell, s.from), s.axis, h)) jump[s.to] -= sgn(t.n[s.axis]);
     }
   }
   Wind27& w = *wind;
-  for (const Segment& s : kSegments) {
+  for (const GridSegment& s : kGridSegments) {
     w[s.to] = w[s.from] + jump[s.to];
     g[s.to] = inside(child_grid_point(cell, s.to), w[s.to]);
   }
@@ -302,7 +286,7 @@ bool PointSource::inside(const I3& p) const { return tree_.inside(to_unit(p), nu
 
 void PointSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g,
                                    Wind27*) const {
-  for (const Segment& s : kSegments) g[s.to] = inside(child_grid_point(cell, s.to));
+  for (const GridSegment& s : kGridSegments) g[s.to] = inside(child_grid_point(cell, s.to));
 }
 
 void PointSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8*, const std::vector<uint32_t>&,

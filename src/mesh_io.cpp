@@ -19,6 +19,7 @@
 #include <unordered_map>
 
 #include "file_util.h"
+#include "mesh_repair.h"
 #include "io/readers.h"
 #include "pic/pic.h"
 
@@ -31,37 +32,14 @@ std::string lower_ext(const std::filesystem::path& p) {
   return e;
 }
 
-struct PosHash {
-  size_t operator()(const Vec3& p) const {
-    size_t h = 0;
-    for (double x : p) {
-      uint64_t b;
-      x = x == 0 ? 0 : x;  // -0 and +0 weld
-      std::memcpy(&b, &x, 8);
-      h ^= std::hash<uint64_t>{}(b) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-    }
-    return h;
-  }
-};
-
 bool finite(const Vec3& p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
 
-// Exact welding of equal positions (-0 == +0); refuses NaN and inf.
+// Exact welding of equal positions (-0 == +0, mesh_repair's weld); refuses NaN and inf.
 TriMesh weld(const detail::RawGeometry& g) {
-  TriMesh out;
-  std::unordered_map<Vec3, uint32_t, PosHash> seen;
-  std::vector<uint32_t> ids(g.positions.size());
-  for (size_t v = 0; v < g.positions.size(); ++v) {
-    Vec3 q = g.positions[v];
-    for (double& x : q) x = x == 0 ? 0 : x;
-    if (!finite(q)) throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
-    auto [it, fresh] = seen.try_emplace(q, static_cast<uint32_t>(out.positions.size()));
-    if (fresh) out.positions.push_back(q);
-    ids[v] = it->second;
-  }
-  out.triangles.reserve(g.triangles.size());
-  for (const auto& t : g.triangles) out.triangles.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
-  return out;
+  for (const Vec3& p : g.positions)
+    if (!finite(p))
+      throw InvalidInput("mesh has non-finite (NaN or inf) vertex coordinates");
+  return detail::weld(TriMesh{g.positions, g.triangles});
 }
 
 detail::RawGeometry read_raw(const std::vector<uint8_t>& bytes, const std::string& ext, const std::string& name) {

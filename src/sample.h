@@ -13,6 +13,41 @@
 
 namespace pic::detail {
 
+/// Which axis-parallel grid lines a triangle's bounding box lets it cross: lines at
+/// base + b step (b < count) on each axis, for segments from base to base + step along it.
+struct LineMask {
+  std::array<unsigned, 3> on{};  // bit b of on[d]: coordinate base[d] + b step within [lo, hi)
+  std::array<bool, 3> spans{};   // segments along axis d overlap the box
+  /// A segment along `axis` at grid steps ci (axis i) and cj (axis j), i < j the other two.
+  bool may_cross(int axis, int i, int ci, int j, int cj) const {
+    return spans[axis] && ((on[i] >> ci) & 1) && ((on[j] >> cj) & 1);
+  }
+};
+/// The line mask of `t` for `count` grid lines per axis from `base`, `step` apart.
+LineMask line_mask(const ITri& t, const I3& base, i64 step, int count);
+
+/// The 19 segments that carry signs from a cell's corners to the rest of its child grid: grid
+/// point `to` is reached from `from` along `axis`; the segment's other two coordinates are
+/// grid steps `ci` (axis i) and `cj` (axis j), i < j. Ordered so that `from` is always known.
+struct GridSegment {
+  int to, from, axis, i, j, ci, cj;
+};
+constexpr std::array<GridSegment, 19> make_grid_segments() {
+  std::array<GridSegment, 19> out{};
+  int n = 0;
+  for (int ones = 1; ones <= 3; ++ones)
+    for (int g = 0; g < 27; ++g) {
+      const int a[3] = {g % 3, (g / 3) % 3, g / 9};
+      if ((a[0] == 1) + (a[1] == 1) + (a[2] == 1) != ones) continue;
+      const int axis = a[0] == 1 ? 0 : (a[1] == 1 ? 1 : 2);
+      const int i = axis == 0 ? 1 : 0, j = axis == 2 ? 1 : 2;
+      out[n++] = {g, g - (axis == 0 ? 1 : axis == 1 ? 3 : 9), axis, i, j, a[i], a[j]};
+    }
+  return out;
+}
+constexpr std::array<GridSegment, 19> kGridSegments = make_grid_segments();
+
+
 /// Integer winding numbers of the closed triangle set at a cell's corners / child grid.
 using Wind8 = std::array<int32_t, 8>;
 using Wind27 = std::array<int32_t, 27>;
