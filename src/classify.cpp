@@ -44,7 +44,31 @@ Vec3 bisect_edge(const Cell& cell, int c0, int axis, bool s0, F&& inside_at) {
   return to_unit(p);
 }
 
+struct CacheEntry {
+  I3 p;
+  uint32_t id = 0;  // 0: empty
+  bool inside = false;
+};
+constexpr size_t kCacheBits = 15;
+std::atomic<uint32_t> g_next_cache_id{1};
+
+CacheEntry& cache_slot(const I3& p) {
+  thread_local std::vector<CacheEntry> slots(size_t{1} << kCacheBits);
+  const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                     (uint64_t(p[2]) * 0x165667B19E3779F9ull);
+  return slots[(h ^ (h >> 29)) & ((size_t{1} << kCacheBits) - 1)];
+}
+
 }  // namespace
+
+DecisionCache::DecisionCache() : id_(g_next_cache_id++) {}
+
+int DecisionCache::find(const I3& p) const {
+  const CacheEntry& e = cache_slot(p);
+  return e.id == id_ && e.p == p ? int(e.inside) : -1;
+}
+
+void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, id_, inside}; }
 
 // ---- triangle soups -----------------------------------------------------------------------
 
@@ -67,7 +91,10 @@ int32_t WindingSource::ray_winding(const I3& p) const {
 
 bool WindingSource::inside(const I3& p, int32_t w) const {
   if (caps_.empty()) return w != 0;
-  return caps_.inside(to_unit(p), &p, w, kCapTolerance);
+  if (const int known = cache_.find(p); known >= 0) return known;
+  const bool in = caps_.inside(to_unit(p), &p, w, kCapTolerance);
+  cache_.store(p, in);
+  return in;
 }
 
 void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx,
@@ -282,7 +309,12 @@ PointSource::PointSource(const std::vector<Vec3>& pos, const std::vector<Vec3>& 
   tris_ = &prims_;
 }
 
-bool PointSource::inside(const I3& p) const { return tree_.inside(to_unit(p), nullptr, 0, kPointTolerance); }
+bool PointSource::inside(const I3& p) const {
+  if (const int known = cache_.find(p); known >= 0) return known;
+  const bool in = tree_.inside(to_unit(p), nullptr, 0, kPointTolerance);
+  cache_.store(p, in);
+  return in;
+}
 
 void PointSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g,
                                    Wind27*) const {

@@ -21,6 +21,20 @@
 
 namespace pic::detail {
 
+/// Remembers recent inside/outside decisions of one source per thread: a lattice point is
+/// asked for by up to 4 cells of a level (shared faces and edges) and by their children, and
+/// a decision near a hole costs hundreds of solid angles. Direct mapped, no locks.
+class DecisionCache {
+ public:
+  DecisionCache();
+  /// The cached decision at p (-1: none).
+  int find(const I3& p) const;
+  void store(const I3& p, bool inside) const;
+
+ private:
+  uint32_t id_;  // tells this source's entries from an earlier source's in the same thread
+};
+
 class WindingSource : public SurfaceSource {
  public:
   /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it.
@@ -50,6 +64,7 @@ class WindingSource : public SurfaceSource {
   TriangleBvh bvh_;
   DipoleTree caps_;
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
+  DecisionCache cache_;
 };
 
 class PointSource : public SurfaceSource {
@@ -65,6 +80,7 @@ class PointSource : public SurfaceSource {
  private:
   std::vector<ITri> prims_;  // per point: a splat (QEF) and a tiny marker (meets)
   DipoleTree tree_;
+  DecisionCache cache_;
 };
 
 }  // namespace pic::detail

@@ -13,6 +13,7 @@ namespace {
 
 constexpr double kInv4Pi = 1.0 / (4 * std::numbers::pi);
 constexpr double kBeta = 2.5;  // a node is far when its distance exceeds kBeta times its radius
+constexpr double kFirstBeta = 1.5;  // the first look: nearer nodes summarized too
 
 Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 Vec3 scale3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
@@ -44,12 +45,14 @@ double DipoleTree::far_field(const DNode& n, const Vec3& p) {
 }
 
 double DipoleTree::truncation_bound(const DNode& n, double d) {
-  // Each point of an element lies within `reach` of the expansion centre, and the dipole
-  // kernel's gradient is at most 2 / (4 pi r^3) at distance r >= d - radius: the sum of
-  // |area| * reach times that bounds what the single dipole gets wrong. (The first-order term
-  // far_field adds only makes the value better; the bound stays this conservative one.)
+  // far_field is the first-order Taylor expansion, at the centre c, of the exact sum
+  // sum_i int_Ti K(y) . n_i dA with K(y) = (y - p) / (4 pi |y - p|^3) = -grad(1/|y - p|) / (4 pi).
+  // Its remainder is at most 1/2 sup |grad^2 K| int |y - c|^2 |dA|, and the third derivatives
+  // of 1/r are at most 3! / r^4 (Legendre polynomials are bounded by 1), taken at the nearest
+  // point of any element, at least d - radius away: |error| <= 3 M2 / (4 pi (d - radius)^4),
+  // with M2 = sum_i |a_i| reach_i^2 (reach: an element's farthest point from c).
   const double r = d - n.radius;
-  return 2 * n.moment * kInv4Pi / (r * r * r);
+  return 3 * n.moment2 * kInv4Pi / (r * r * r * r);
 }
 
 double triangle_winding(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int side) {
@@ -144,7 +147,7 @@ uint32_t DipoleTree::build_range(uint32_t begin, uint32_t end, const std::functi
   for (uint32_t i = begin; i < end; ++i) {
     const double reach = norm3(sub3(elems_[i].centre, n.centre)) + elems_[i].radius;
     n.radius = std::max(n.radius, reach);
-    n.moment += elems_[i].abs_area * reach;
+    n.moment2 += elems_[i].abs_area * reach * reach;
     const Vec3 off = sub3(elems_[i].centre, n.centre);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) n.spread[3 * a + b] += off[a] * elems_[i].area[b];
@@ -193,7 +196,7 @@ DipoleTree::Value DipoleTree::evaluate(const Vec3& p, const I3* gp, double beta)
     const uint32_t id = stack[--top];
     const DNode& n = nodes_[id];
     const double d = norm3(sub3(n.centre, p));
-    if (beta > 0 && d > beta * n.radius && n.count == 0) {
+    if (beta > 0 && d > beta * n.radius && n.abs_area > 0) {
       v.w += far_field(n, p);
       v.bound += truncation_bound(n, d);
       continue;
@@ -208,18 +211,36 @@ DipoleTree::Value DipoleTree::evaluate(const Vec3& p, const I3* gp, double beta)
   return v;
 }
 
+void DipoleTree::add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum& angles, double& w) const {
+  for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+    const Element& e = elems_[i];
+    if (e.tri == UINT32_MAX) {
+      w += dipole(p, e.centre, e.area, e.radius);
+      continue;
+    }
+    const auto& t = tris_[e.tri];
+    angles.add(triangle_angle_terms(p, t[0], t[1], t[2], [&] { return gp ? -plane_side(itris_[e.tri], *gp) : 0; }));
+  }
+}
+
 bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double tolerance) const {
   if (nodes_.empty()) return std::abs(offset) >= 0.5;
   if (tolerance >= 1) return std::abs(offset - evaluate(p, gp).w) >= 0.5;  // no decision can move
-  // First the usual far-field sum; then, while the decision |offset - w| >= 1/2 is within the
-  // truncation bound, open the far node with the largest bound (its children replace it),
-  // down to exact sums if need be. Deterministic: the order depends on p only.
+  // Every node far enough is first summarized by its dipole, leaves included; a rigorous
+  // truncation bound says when that sum already decides |offset - w| >= 1/2 (most points).
+  // Otherwise the far leaves are summed exactly, then, while the decision is within the bound
+  // of the remaining (inner) far nodes, the one with the largest bound is opened, down to exact
+  // sums if need be, until that bound is below `tolerance`. Deterministic: it depends on p only.
   struct Far {
     uint32_t node;
     double w, bound;
   };
-  std::vector<Far> far;
-  double w = 0;
+  thread_local std::vector<Far> far;
+  far.clear();
+  AngleSum angles;
+  double w_far = 0, w_points = 0;
+  bool leaves_far = true;  // until the first refinement, far leaves are approximated too
+  double beta = kFirstBeta;
   auto visit = [&](uint32_t id) {
     // Opens `id`'s subtree down to nodes that are far enough (or exact leaves).
     uint32_t stack[128];
@@ -229,11 +250,11 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
       const uint32_t k = stack[--n];
       const DNode& nd = nodes_[k];
       const double d = norm3(sub3(nd.centre, p));
-      if (nd.count == 0 && d > kBeta * nd.radius) {
+      if (d > beta * nd.radius && nd.abs_area > 0 && (leaves_far || nd.count == 0)) {
         far.push_back({k, far_field(nd, p), truncation_bound(nd, d)});
-        w += far.back().w;
+        w_far += far.back().w;
       } else if (nd.count > 0) {
-        for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) w += exact(elems_[i], p, gp);
+        add_exact(nd, p, gp, angles, w_points);
       } else {
         stack[n++] = nd.right;
         stack[n++] = k + 1;
@@ -241,6 +262,19 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
     }
   };
   visit(0);
+  {
+    // The first look, with nearer nodes summarized too, decides most points; the others start
+    // again at the usual distance.
+    double bound = 0;
+    for (const Far& f : far) bound += f.bound;
+    const double w = w_far + w_points + angles.turns();
+    if (std::abs(std::abs(offset - w) - 0.5) > bound + 1e-9) return std::abs(offset - w) >= 0.5;
+    far.clear();
+    angles = AngleSum();
+    w_far = w_points = 0;
+    beta = kBeta;
+    visit(0);
+  }
   for (;;) {
     double bound = 0;
     size_t worst = 0;
@@ -248,13 +282,31 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
       bound += far[i].bound;
       if (far[i].bound > far[worst].bound) worst = i;
     }
+    const double w = w_far + w_points + angles.turns();
     const double margin = std::abs(std::abs(offset - w) - 0.5);
     // Rounding of the exact sums is far below 1e-9 for any mesh PIC can hold.
-    if (far.empty() || margin > bound + 1e-9 || bound < tolerance) return std::abs(offset - w) >= 0.5;
+    if (far.empty() || margin > bound + 1e-9) return std::abs(offset - w) >= 0.5;
+    if (leaves_far) {
+      // Leaves are summed exactly before any approximate decision is taken.
+      leaves_far = false;
+      size_t kept = 0;
+      for (const Far& f : far) {
+        const DNode& nd = nodes_[f.node];
+        if (nd.count > 0) {
+          w_far -= f.w;
+          add_exact(nd, p, gp, angles, w_points);
+        } else {
+          far[kept++] = f;
+        }
+      }
+      far.resize(kept);
+      continue;
+    }
+    if (bound < tolerance) return std::abs(offset - w) >= 0.5;
     const Far f = far[worst];
     far[worst] = far.back();
     far.pop_back();
-    w -= f.w;
+    w_far -= f.w;
     const DNode& nd = nodes_[f.node];
     visit(f.node + 1);
     visit(nd.right);

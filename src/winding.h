@@ -24,25 +24,67 @@ namespace pic::detail {
 /// `side` (+1 behind / -1 in front / 0 unknown) decides the sign when p lies (numerically) in
 /// the triangle's plane, so the jump agrees with the exact crossing predicates.
 double triangle_winding(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int side = 0);
-/// The same with the side asked for only when needed.
+/// The two terms of Van Oosterom and Strackee's formula for triangle (a, b, c) seen from p:
+/// tan(Omega / 2) = det / den, so the triangle's winding number is atan2(det, den) / (2 pi).
+/// `side()` (+1 behind / -1 in front / 0 unknown) is asked only when p lies (numerically) in
+/// the triangle's plane; det is then a signed zero, so the jump agrees with the exact predicates.
+struct AngleTerms {
+  double det = 0, den = 0;
+};
 template <class Side>
-double triangle_winding(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Side&& side) {
-  // Van Oosterom and Strackee 1983: tan(Omega / 2) = det / denominator.
+AngleTerms triangle_angle_terms(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Side&& side) {
   const Vec3 A{a[0] - p[0], a[1] - p[1], a[2] - p[2]}, B{b[0] - p[0], b[1] - p[1], b[2] - p[2]},
       C{c[0] - p[0], c[1] - p[1], c[2] - p[2]};
   const double la = std::sqrt(A[0] * A[0] + A[1] * A[1] + A[2] * A[2]);
   const double lb = std::sqrt(B[0] * B[0] + B[1] * B[1] + B[2] * B[2]);
   const double lc = std::sqrt(C[0] * C[0] + C[1] * C[1] + C[2] * C[2]);
-  double det = A[0] * (B[1] * C[2] - B[2] * C[1]) - A[1] * (B[0] * C[2] - B[2] * C[0]) + A[2] * (B[0] * C[1] - B[1] * C[0]);
-  const double den = la * lb * lc + (A[0] * B[0] + A[1] * B[1] + A[2] * B[2]) * lc +
-                     (B[0] * C[0] + B[1] * C[1] + B[2] * C[2]) * la + (C[0] * A[0] + C[1] * A[1] + C[2] * A[2]) * lb;
+  AngleTerms t;
+  t.det = A[0] * (B[1] * C[2] - B[2] * C[1]) - A[1] * (B[0] * C[2] - B[2] * C[0]) + A[2] * (B[0] * C[1] - B[1] * C[0]);
+  t.den = la * lb * lc + (A[0] * B[0] + A[1] * B[1] + A[2] * B[2]) * lc +
+          (B[0] * C[0] + B[1] * C[1] + B[2] * C[2]) * la + (C[0] * A[0] + C[1] * A[1] + C[2] * A[2]) * lb;
   // In the plane (relative to the terms' size) the sign of det is noise: use the side given.
-  if (std::abs(det) <= 1e-10 * la * lb * lc) {
+  if (std::abs(t.det) <= 1e-10 * la * lb * lc) {
     const int s = side();
-    if (s != 0) det = s > 0 ? 0.0 : -0.0;
+    if (s != 0) t.det = s > 0 ? 0.0 : -0.0;
   }
-  return std::atan2(det, den) * (0.5 / 3.14159265358979323846);
+  return t;
 }
+template <class Side>
+double triangle_winding(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Side&& side) {
+  const AngleTerms t = triangle_angle_terms(p, a, b, c, side);
+  return std::atan2(t.det, t.den) * (0.5 / 3.14159265358979323846);
+}
+
+/// A sum of angles atan2(det_i, den_i) with one atan2 at the end: the complex numbers
+/// den_i + i det_i are multiplied (the arguments add), and the half-turns the product's argument
+/// wraps past +-pi are counted, so the sum is exact to rounding, not only modulo 2 pi. Each
+/// wrap is read off the computed product itself, so rounding near +-pi cannot lose a turn.
+class AngleSum {
+ public:
+  void add(const AngleTerms& t) {
+    if (t.det == 0 && t.den == 0) return;  // p at a vertex: atan2(0, 0) = 0 contributes nothing
+    // Each factor is scaled to |den| + |det| = 1 off the dependency chain; the product then
+    // shrinks by at most 2^-1/2 per factor and is rescaled only when it gets small.
+    const double s = 1 / (std::abs(t.den) + std::abs(t.det)), den = t.den * s, det = t.det * s;
+    const bool lower_a = std::signbit(im_), lower_b = std::signbit(det);
+    const double re = re_ * den - im_ * det, im = re_ * det + im_ * den;
+    if (!lower_a && !lower_b && std::signbit(im)) ++turns_;  // the arguments' sum passed +pi
+    if (lower_a && lower_b && !std::signbit(im)) --turns_;   // ... or -pi
+    re_ = re;
+    im_ = im;
+    if (std::abs(re_) + std::abs(im_) < 1e-100) {
+      const double r = 1 / (std::abs(re_) + std::abs(im_));
+      re_ *= r;
+      im_ *= r;
+    }
+  }
+  /// The sum divided by 2 pi: the triangles' winding number.
+  double turns() const { return std::atan2(im_, re_) * (0.5 / 3.14159265358979323846) + turns_; }
+
+ private:
+  double re_ = 1, im_ = 0;
+  int turns_ = 0;
+};
 
 class DipoleTree {
  public:
@@ -74,7 +116,7 @@ class DipoleTree {
   struct DNode {
     Vec3 centre{}, area{};
     double abs_area = 0, radius = 0;
-    double moment = 0;  // sum of |area| * (distance of the element's farthest point from centre)
+    double moment2 = 0;  // sum of |area| * (distance of the element's farthest point from centre)^2
     std::array<double, 9> spread{};  // sum of (element centre - centre) (x) area: first-order term
     uint32_t first = 0, count = 0;  // leaf: elements [first, first + count)
     uint32_t right = 0;             // inner: left child is this + 1
@@ -86,6 +128,8 @@ class DipoleTree {
   static double truncation_bound(const DNode& n, double d);
   static double far_field(const DNode& n, const Vec3& p);
   double exact(const Element& e, const Vec3& p, const I3* gp) const;
+  /// Adds leaf `n`'s exact sum: triangles' angles to `angles`, points' discs to `w`.
+  void add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum& angles, double& w) const;
   void build();
 
   std::vector<Element> elems_;
