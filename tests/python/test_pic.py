@@ -401,3 +401,23 @@ def test_example_subtract_cylinder(tmp_path):
     v0, f0 = pic.read_mesh(DATA / "fandisk.obj")
     assert 0 < mesh_volume(v, f) < 0.99 * mesh_volume(v0, f0)
     assert pic.check_validity(v, f, self_intersections=False)["boundary_edges"] == 0
+
+
+# --- the type stubs ----------------------------------------------------------------------------
+
+
+def test_stubs_cover_the_module():
+    """Every public function and Octree member has a stub and a docstring, and no stub is stale."""
+    import ast
+
+    tree = ast.parse((Path(pic.__file__).parent / "__init__.pyi").read_text())
+    funcs = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+    octree = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Octree")
+    members = {n.name for n in octree.body if isinstance(n, ast.FunctionDef)}
+    public = {n for n in dir(pic) if not n.startswith("_") and callable(getattr(pic, n)) and n != "Octree"}
+    assert funcs == public
+    octree_public = {n for n in dir(pic.Octree) if not n.startswith("_")} | {
+        n for n in ("__or__", "__and__", "__sub__", "__ior__", "__iand__", "__isub__") if hasattr(pic.Octree, n)}
+    assert octree_public <= members
+    for name in public:
+        assert getattr(pic, name).__doc__, name
