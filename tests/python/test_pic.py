@@ -241,7 +241,7 @@ def test_wrong_shapes_refused(vertices, faces, message):
         pic.sample(vertices, faces)
 
 
-def test_point_cloud():
+def test_point_cloud(tmp_path):
     # Points on a sphere of radius 1 with outward normals (Fibonacci lattice).
     n = 4000
     i = np.arange(n) + 0.5
@@ -253,6 +253,11 @@ def test_point_cloud():
     assert t.stats["inside"] == "points" and t.stats["points_in"] == n
     v, f = t.contour()
     assert mesh_volume(v, f) == pytest.approx(4 / 3 * math.pi, rel=0.05)
+    # The same cloud from an .xyz file ("x y z nx ny nz" per line) gives the same octree.
+    xyz = tmp_path / "sphere.xyz"
+    p64 = p.astype(np.float64)
+    xyz.write_text("".join(f"{a!r} {b!r} {c!r} {a!r} {b!r} {c!r}\n" for a, b, c in p64.tolist()))
+    assert pic.sample(xyz, depth=6).serialize() == pic.sample((p64, p64), depth=6).serialize()
     with pytest.raises(ValueError, match="differ in length"):
         pic.sample((p, p[:-1]))
     with pytest.raises(ValueError, match=r"normals must be an \(n, 3\) array"):
