@@ -9,6 +9,8 @@ pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev li
       libcli11-dev libgtest-dev chromium libcgal-dev)
 # `pic eval model.scad` runs OpenSCAD to export its CSG tree (tests skip the .scad case without it).
 pkgs+=(openscad)
+# The `pic` Python module (pybind11) and its pytest suite; numpy arrays in and out.
+pkgs+=(pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest)
 if [[ "${1:-}" == "--bench" ]]; then
   pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3)
 fi

@@ -1,0 +1,345 @@
+// The module's free functions: one call into the library each, arguments converted in
+// convert.cpp, the GIL released around the library call.
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "convert.h"
+#include "octree.h"
+#include "pic/primitives.h"
+#include "pic/scad.h"
+
+namespace pic_python {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+bool is_path(py::handle obj) { return py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__"); }
+fs::path to_path(py::handle obj) { return fs::path(py::str(py::module_::import("os").attr("fspath")(obj)).cast<std::string>()); }
+
+pic::SampleOptions sample_options(int depth, double error, py::handle cube, const std::string& inside, bool parallel,
+                                  double margin) {
+  pic::SampleOptions o;
+  o.depth = depth;
+  o.error = error;
+  o.cube = to_cube(cube);
+  o.margin = margin;
+  o.parallel = parallel;
+  const auto mode = pic::parse_inside_mode(inside);
+  if (!mode) throw py::value_error("inside must be 'auto', 'parity' or 'winding', got '" + inside + "'");
+  o.inside = *mode;
+  return o;
+}
+
+std::unique_ptr<PyOctree> sample(py::object input, py::object faces, int depth, double error, py::object cube,
+                                 const std::string& inside, bool parallel, double margin) {
+  const pic::SampleOptions o = sample_options(depth, error, cube, inside, parallel, margin);
+  pic::SampleStats st;
+  size_t points_in = 0;
+  pic::Octree tree;
+  if (is_path(input)) {
+    if (!faces.is_none()) throw py::value_error("sample(path) takes no faces");
+    const fs::path path = to_path(input);
+    py::gil_scoped_release nogil;
+    const pic::Geometry geo = pic::read_geometry(path);
+    points_in = geo.points.positions.size();
+    tree = geo.is_point_cloud() ? pic::sample(geo.points, o, &st) : pic::sample(geo.mesh, o, &st);
+  } else if (faces.is_none() && py::isinstance<py::tuple>(input)) {
+    const auto t = input.cast<py::tuple>();
+    if (t.size() != 2) throw py::value_error("a point cloud is sample((points, normals))");
+    const pic::PointCloud cloud = to_cloud(t[0], t[1]);
+    points_in = cloud.positions.size();
+    py::gil_scoped_release nogil;
+    tree = pic::sample(cloud, o, &st);
+  } else {
+    if (faces.is_none())
+      throw py::value_error("faces is missing: a mesh is sample(vertices, faces), a point cloud sample((points, normals))");
+    const pic::TriMesh mesh = to_mesh(input, faces);
+    py::gil_scoped_release nogil;
+    tree = pic::sample(mesh, o, &st);
+  }
+  py::dict stats = sample_stats(st);
+  stats["points_in"] = points_in;
+  return wrap(std::move(tree), stats);
+}
+
+pic::CsgOptions csg_options(double error, bool parallel) {
+  pic::CsgOptions o;
+  o.error = error;
+  o.parallel = parallel;
+  return o;
+}
+
+std::unique_ptr<PyOctree> eval(bool is_text, const std::string& input, int depth, double error, bool smooth,
+                               bool parallel) {
+  pic::EvalOptions o;
+  o.depth = depth;
+  o.error = error;
+  o.smooth = smooth;
+  o.parallel = parallel;
+  pic::EvalStats st;
+  pic::Octree tree;
+  {
+    py::gil_scoped_release nogil;
+    tree = is_text ? pic::eval_csg(input, o, &st) : pic::eval_scad(input, o, &st);
+  }
+  py::dict d;
+  d["op"] = "eval";
+  d["seconds"] = st.seconds;
+  d["openscad_seconds"] = st.openscad_seconds;
+  d["mesh_seconds"] = st.mesh_seconds;
+  d["octree_seconds"] = st.octree_seconds;
+  d["nodes"] = st.nodes;
+  d["leaves"] = st.leaves;
+  d["leaf_triangles"] = st.triangles;
+  d["booleans"] = st.booleans;
+  return wrap(std::move(tree), d);
+}
+
+pic::Vec3 to_vec3(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
+
+// Primitives: a closed mesh as (vertices, faces), made without the GIL.
+template <class F>
+py::tuple primitive(F&& make) {
+  pic::TriMesh mesh;
+  {
+    py::gil_scoped_release nogil;
+    mesh = make();
+  }
+  return from_mesh(mesh);
+}
+
+}  // namespace
+
+void bind_functions(py::module_& m) {
+  m.attr("MAX_LEVEL") = pic::kMaxLevel;
+
+  m.def("sample", &sample, py::arg("input"), py::arg("faces") = py::none(), py::arg("depth") = 12,
+        py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("inside") = "auto", py::arg("parallel") = true,
+        py::arg("margin") = 1.0 / 16,
+        R"doc(Adaptively samples a solid into a PIC object (pic::sample).
+
+input: an (n, 3) real array of vertices with faces an (m, 3) integer array; or a path to a mesh
+(obj, stl, ply, off, gltf, glb) or point cloud (ply with normals, xyz); or a tuple
+(points, normals) of two (n, 3) arrays, an oriented point cloud.
+depth: maximum octree level (1..MAX_LEVEL). error: QEF residual threshold in root-cube units squared.
+cube: root cube (x, y, z, size), default the bounding cube plus `margin` of the extent on each side;
+share one cube between CSG operands. inside: 'auto', 'parity' or 'winding'.
+parallel: use all cores (same bytes as serial).
+Raises ValueError for bad input (empty, open with inside='parity', non-finite, wrong shape),
+OSError for an unreadable file. The result's .stats hold the sampling statistics.)doc");
+  m.def(
+      "bounding_cube",
+      [](py::object vertices, double margin) {
+        pic::TriMesh mesh;
+        mesh.positions = to_points(vertices, "vertices");
+        return from_cube(pic::bounding_cube(mesh, margin));
+      },
+      py::arg("vertices"), py::arg("margin") = 1.0 / 16,
+      "The automatic root cube (x, y, z, size) around points: their bounding cube enlarged by margin of the "
+      "extent on each side. Sample CSG operands into one cube around all of them.");
+
+  m.def(
+      "csg",
+      [](const PyOctree& a, const PyOctree& b, const std::string& op, double error, bool parallel) {
+        return csg(a, b, to_csg_op(op), csg_options(error, parallel));
+      },
+      py::arg("a"), py::arg("b"), py::arg("op"), py::arg("error") = 1e-8, py::arg("parallel") = true,
+      R"doc(Boolean of two PIC objects on their octrees, as a new object (pic::csg).
+
+op: 'union', 'intersect' ('intersection') or 'subtract' ('difference'). Operands should share a
+root cube; otherwise b is resampled into a's cube. The result's .stats hold the operation's
+statistics. Raises ValueError for an unknown op or an operand that cannot be resampled.)doc");
+  m.def(
+      "csg_inplace",
+      [](PyOctree& a, const PyOctree& b, const std::string& op, double error, bool parallel) {
+        csg_inplace(a, b, to_csg_op(op), csg_options(error, parallel));
+      },
+      py::arg("a"), py::arg("b"), py::arg("op"), py::arg("error") = 1e-8, py::arg("parallel") = true,
+      "a := a op b (pic::csg_inplace, the sculpting path: only the overlap is rebuilt). a.stats become the "
+      "operation's statistics.");
+  m.def("contour", &contour, py::arg("tree"), py::arg("intersection_free") = true, py::arg("split") = true,
+        py::arg("stats") = py::none(), "Same as tree.contour(...): (vertices, faces) of the closed surface.");
+
+  m.def(
+      "load",
+      [](const fs::path& path) {
+        pic::Octree tree;
+        {
+          py::gil_scoped_release nogil;
+          tree = pic::load(path);
+        }
+        return wrap(std::move(tree));
+      },
+      py::arg("path"), "Reads a .pic file. Raises OSError for a missing, truncated, corrupted or foreign file.");
+  m.def(
+      "save", [](const PyOctree& t, const fs::path& path) { without_gil([&] { return pic::save(t.tree, path), 0; }, t); },
+      py::arg("tree"), py::arg("path"), "Same as tree.save(path).");
+  m.def(
+      "deserialize",
+      [](const py::bytes& data) {
+        const std::string s = data;
+        const std::vector<uint8_t> bytes(s.begin(), s.end());
+        pic::Octree tree;
+        {
+          py::gil_scoped_release nogil;
+          tree = pic::deserialize(bytes);
+        }
+        return wrap(std::move(tree));
+      },
+      py::arg("data"), "A PIC object from .pic bytes (Octree.serialize()). Raises OSError for corrupted bytes.");
+
+  m.def(
+      "eval_scad",
+      [](const fs::path& path, int depth, double error, bool smooth, bool parallel) {
+        return eval(false, path.string(), depth, error, smooth, parallel);
+      },
+      py::arg("path"), py::arg("depth") = 12, py::arg("error") = 1e-8, py::arg("smooth") = false,
+      py::arg("parallel") = true,
+      R"doc(Evaluates an OpenSCAD model on octrees (pic::eval_scad): a .scad file through the `openscad`
+program, or its .csg export directly. smooth: tessellate curved primitives finely instead of by
+$fn/$fa/$fs. Raises ValueError for an unsupported node or a missing `openscad`, OSError for an
+unreadable file.)doc");
+  m.def(
+      "eval_csg",
+      [](const std::string& text, int depth, double error, bool smooth, bool parallel) {
+        return eval(true, text, depth, error, smooth, parallel);
+      },
+      py::arg("text"), py::arg("depth") = 12, py::arg("error") = 1e-8, py::arg("smooth") = false,
+      py::arg("parallel") = true, "Evaluates OpenSCAD CSG-tree text (the .csg format) on octrees.");
+
+  m.def(
+      "read_mesh",
+      [](const fs::path& path) {
+        pic::TriMesh mesh;
+        {
+          py::gil_scoped_release nogil;
+          mesh = pic::read_mesh(path);
+        }
+        return from_mesh(mesh);
+      },
+      py::arg("path"),
+      "Reads OBJ, STL, PLY, OFF, glTF/GLB with duplicate vertices welded: (vertices float64 (n, 3), faces "
+      "int64 (m, 3)). Raises OSError (missing, unreadable, unknown format) or ValueError (empty, non-finite).");
+  m.def(
+      "write_mesh",
+      [](py::object vertices, py::object faces, const fs::path& path) {
+        const pic::TriMesh mesh = to_mesh(vertices, faces);
+        py::gil_scoped_release nogil;
+        pic::write_mesh(mesh, path);
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("path"),
+      "Writes a mesh, the format from the extension (obj, stl, ply, off, glb), atomically. Raises OSError.");
+  m.def(
+      "volume",
+      [](py::object vertices, py::object faces) {
+        const pic::TriMesh mesh = to_mesh(vertices, faces);
+        return pic::volume(mesh);
+      },
+      py::arg("vertices"), py::arg("faces"), "Signed volume of a mesh (positive for outward orientation).");
+  m.def(
+      "check_validity",
+      [](py::object vertices, py::object faces, bool self_intersections) {
+        const pic::TriMesh mesh = to_mesh(vertices, faces);
+        pic::MeshValidity v;
+        {
+          py::gil_scoped_release nogil;
+          v = pic::check_validity(mesh, self_intersections);
+        }
+        py::dict d;
+        d["valid"] = v.valid();
+        d["self_intersections"] = v.checked ? py::object(py::int_(v.self_intersections)) : py::none();
+        d["collinear_triangles"] = v.collinear_triangles;
+        d["nonmanifold_vertices"] = v.nonmanifold_vertices;
+        d["nonmanifold_edges"] = v.nonmanifold_edges;
+        d["boundary_edges"] = v.boundary_edges;
+        d["degenerate_triangles"] = v.degenerate_triangles;
+        d["components"] = v.components;
+        return d;
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("self_intersections") = true,
+      "Validity of a mesh as a solid's boundary (pic::check_validity), equal positions merged: a dict with "
+      "'valid' and the counts.");
+
+  m.def(
+      "make_box", [](std::array<double, 3> lo, std::array<double, 3> hi) {
+        return primitive([&] { return pic::make_box(to_vec3(lo), to_vec3(hi)); });
+      },
+      py::arg("lo"), py::arg("hi"), "Closed mesh of the axis-aligned box [lo, hi]: (vertices, faces).");
+  m.def(
+      "make_sphere",
+      [](std::array<double, 3> c, double r, int segments) {
+        return primitive([&] { return pic::make_sphere(to_vec3(c), r, segments); });
+      },
+      py::arg("center"), py::arg("radius"), py::arg("segments") = 64, "Closed UV sphere mesh: (vertices, faces).");
+  m.def(
+      "make_cylinder",
+      [](std::array<double, 3> c, double r, double h, int axis, int segments) {
+        return primitive([&] { return pic::make_cylinder(to_vec3(c), r, h, axis, segments); });
+      },
+      py::arg("center"), py::arg("radius"), py::arg("height"), py::arg("axis") = 2, py::arg("segments") = 64,
+      "Closed cylinder mesh along axis 0, 1 or 2, centred at center, total height height: (vertices, faces).");
+  m.def(
+      "make_cone",
+      [](std::array<double, 3> c, double r, double h, int axis, int segments) {
+        return primitive([&] { return pic::make_cone(to_vec3(c), r, h, axis, segments); });
+      },
+      py::arg("center"), py::arg("radius"), py::arg("height"), py::arg("axis") = 2, py::arg("segments") = 64,
+      "Closed cone mesh: base disk at center - height/2, apex at center + height/2: (vertices, faces).");
+  m.def(
+      "make_torus",
+      [](std::array<double, 3> c, double major, double minor, int axis, int segments, int tube_segments) {
+        return primitive([&] { return pic::make_torus(to_vec3(c), major, minor, axis, segments, tube_segments); });
+      },
+      py::arg("center"), py::arg("major"), py::arg("minor"), py::arg("axis") = 2, py::arg("segments") = 64,
+      py::arg("tube_segments") = 32, "Closed torus mesh around axis: (vertices, faces).");
+
+#ifdef PIC_HAS_RENDER
+  m.def(
+      "render",
+      [](py::object obj, std::array<int, 2> size, bool octree, bool points, const std::string& view,
+         std::optional<std::array<double, 9>> camera, bool perspective, int supersample) {
+        pic::RenderOptions o;
+        o.width = size[0];
+        o.height = size[1];
+        o.octree = octree;
+        o.points = points;
+        o.view = view;
+        o.camera = camera;
+        o.perspective = perspective;
+        o.supersample = supersample;
+        pic::Image img;
+        if (py::isinstance<PyOctree>(obj)) {
+          const PyOctree& t = obj.cast<const PyOctree&>();
+          img = without_gil([&] { return pic::render(pic::contour(t.tree), &t.tree, o); }, t);
+        } else {
+          if (octree) throw py::value_error("render: octree=True needs a pic.Octree");
+          if (!py::isinstance<py::tuple>(obj) || py::len(obj) != 2)
+            throw py::value_error("render: obj must be a pic.Octree or a mesh (vertices, faces)");
+          const auto t = obj.cast<py::tuple>();
+          const pic::TriMesh mesh = to_mesh(t[0], t[1]);
+          py::gil_scoped_release nogil;
+          img = pic::render(mesh, nullptr, o);
+        }
+        return from_image(img);
+      },
+      py::arg("obj"), py::arg("size") = std::array<int, 2>{640, 480}, py::arg("octree") = false,
+      py::arg("points") = false, py::arg("view") = "iso", py::arg("camera") = py::none(),
+      py::arg("perspective") = false, py::arg("supersample") = 2,
+      R"doc(Renders a pic.Octree (its contour) or a mesh (vertices, faces) to an (h, w, 3) uint8 array.
+
+size: (width, height). octree: draw the gray leaves' cells; points: the representative vertices
+(a mesh's vertices). view: iso, front, back, left, right, top, bottom (+Z up); camera: eye xyz,
+target xyz, up xyz. Raises ValueError for a bad size, view or camera.)doc");
+  m.def(
+      "write_png",
+      [](py::object image, const fs::path& path) {
+        const pic::Image img = to_image(image);
+        py::gil_scoped_release nogil;
+        pic::write_png(img, path);
+      },
+      py::arg("image"), py::arg("path"), "Writes an (h, w, 3) uint8 array as a PNG, atomically. Raises OSError.");
+#endif
+}
+
+}  // namespace pic_python

@@ -1,0 +1,179 @@
+"""PIC: solids as points with implicit connectivity (type stubs for the `pic` module)."""
+import os
+from typing import Any, Optional, Sequence, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+MAX_LEVEL: int
+"""Deepest octree level any PIC object may reach."""
+
+PathLike = Union[str, "os.PathLike[str]"]
+Cube = Tuple[float, float, float, float]
+"""Root cube (x, y, z, size): minimum corner and side, in the input's coordinates."""
+Vertices = npt.NDArray[np.float64]
+"""(n, 3) float64 positions."""
+Faces = npt.NDArray[np.int64]
+"""(m, 3) int64 vertex indices, counter-clockwise seen from outside."""
+Mesh = Tuple[Vertices, Faces]
+ArrayLike = npt.ArrayLike
+"""Inputs: (n, 3) arrays of float32/float64 (vertices) or int32/int64 (faces), or nested lists."""
+
+class Octree:
+    """A PIC object: an adaptive octree whose gray leaves each hold one representative vertex
+    and the in/out signs of the cell's corners.
+
+    Made by sample, load, deserialize, eval_scad or CSG. ``a | b`` (union), ``a & b``
+    (intersect), ``a - b`` (subtract) return new objects; ``a |= b``, ``a &= b``, ``a -= b``
+    edit ``a`` in place (the library's sculpting path: only the overlap is rebuilt). Pickles
+    through its .pic bytes.
+    """
+
+    @property
+    def pics(self) -> int:
+        """Number of PICs (gray leaves, one representative vertex each)."""
+    @property
+    def nodes(self) -> int:
+        """Number of octree nodes."""
+    @property
+    def depth(self) -> int:
+        """Maximum octree level."""
+    @property
+    def cube(self) -> Cube:
+        """Root cube (x, y, z, size)."""
+    @property
+    def stats(self) -> dict[str, Any]:
+        """Statistics of the operation that made or last changed this object (sample, csg, eval);
+        empty after load."""
+    def contour(self, intersection_free: bool = True, split: bool = True,
+                stats: Optional[dict[str, Any]] = None) -> Mesh:
+        """The closed surface by dual contouring: (vertices (n, 3) float64, faces (m, 3) int64).
+
+        intersection_free: re-triangulate so no two triangles cross (False: `pic mesh --fast`).
+        split: give touching sheets their own vertex copies, as `pic mesh` writes.
+        stats: a dict to fill with the contour's counts and seconds.
+        """
+    def info(self, check: bool = True) -> dict[str, Any]:
+        """The dict `pic info --json` prints: cells per level, PICs, bytes, bounding box, and
+        the contour's topology and validity. check=False skips the exact self-intersection test."""
+    def save(self, path: PathLike) -> None:
+        """Writes the .pic file atomically. Raises OSError."""
+    def serialize(self) -> bytes:
+        """The .pic file's bytes."""
+    def copy(self) -> Octree:
+        """An independent copy."""
+    def __copy__(self) -> Octree: ...
+    def __deepcopy__(self, memo: Any) -> Octree: ...
+    def __or__(self, other: Octree) -> Octree:
+        """Union, a new object."""
+    def __and__(self, other: Octree) -> Octree:
+        """Intersection, a new object."""
+    def __sub__(self, other: Octree) -> Octree:
+        """Difference, a new object."""
+    def __ior__(self, other: Octree) -> Octree:
+        """Union in place (pic::csg_inplace)."""
+    def __iand__(self, other: Octree) -> Octree:
+        """Intersection in place (pic::csg_inplace)."""
+    def __isub__(self, other: Octree) -> Octree:
+        """Difference in place (pic::csg_inplace): the sculpting path."""
+    def __getstate__(self) -> tuple[bytes]: ...
+    def __setstate__(self, state: tuple[bytes]) -> None: ...
+
+@overload
+def sample(input: PathLike, *, depth: int = 12, error: float = 1e-8, cube: Optional[Sequence[float]] = None,
+           inside: str = "auto", parallel: bool = True, margin: float = 1 / 16) -> Octree: ...
+@overload
+def sample(input: Tuple[ArrayLike, ArrayLike], *, depth: int = 12, error: float = 1e-8,
+           cube: Optional[Sequence[float]] = None, inside: str = "auto", parallel: bool = True,
+           margin: float = 1 / 16) -> Octree: ...
+@overload
+def sample(input: ArrayLike, faces: ArrayLike, depth: int = 12, error: float = 1e-8,
+           cube: Optional[Sequence[float]] = None, inside: str = "auto", parallel: bool = True,
+           margin: float = 1 / 16) -> Octree: ...
+def sample(input: Any, faces: Any = None, depth: int = 12, error: float = 1e-8,
+           cube: Optional[Sequence[float]] = None, inside: str = "auto", parallel: bool = True,
+           margin: float = 1 / 16) -> Octree:
+    """Adaptively samples a solid into a PIC object (pic::sample).
+
+    input: (n, 3) vertices with faces (m, 3); or a path to a mesh (obj, stl, ply, off, gltf,
+    glb) or point cloud (ply with normals, xyz); or a tuple (points, normals), an oriented
+    point cloud. depth: maximum level (1..MAX_LEVEL). error: QEF residual threshold in
+    root-cube units squared. cube: (x, y, z, size), default the bounding cube plus `margin`
+    of the extent; share one between CSG operands. inside: 'auto', 'parity', 'winding'.
+    Raises ValueError for bad input, OSError for an unreadable file. The GIL is released.
+    """
+
+def bounding_cube(vertices: ArrayLike, margin: float = 1 / 16) -> Cube:
+    """The automatic root cube around points (bounding cube plus margin of the extent)."""
+
+def csg(a: Octree, b: Octree, op: str, error: float = 1e-8, parallel: bool = True) -> Octree:
+    """Boolean on the octrees as a new object (pic::csg). op: 'union', 'intersect'
+    ('intersection'), 'subtract' ('difference'). The result's .stats hold the statistics."""
+
+def csg_inplace(a: Octree, b: Octree, op: str, error: float = 1e-8, parallel: bool = True) -> None:
+    """a := a op b (pic::csg_inplace): only the overlap is rebuilt. a.stats become the operation's."""
+
+def contour(tree: Octree, intersection_free: bool = True, split: bool = True,
+            stats: Optional[dict[str, Any]] = None) -> Mesh:
+    """Same as tree.contour(...)."""
+
+def load(path: PathLike) -> Octree:
+    """Reads a .pic file. Raises OSError for a missing, truncated, corrupted or foreign file."""
+
+def save(tree: Octree, path: PathLike) -> None:
+    """Same as tree.save(path)."""
+
+def deserialize(data: bytes) -> Octree:
+    """A PIC object from .pic bytes (Octree.serialize()). Raises OSError for corrupted bytes."""
+
+def eval_scad(path: PathLike, depth: int = 12, error: float = 1e-8, smooth: bool = False,
+              parallel: bool = True) -> Octree:
+    """Evaluates an OpenSCAD model (.scad through `openscad`, or its .csg export) on octrees."""
+
+def eval_csg(text: str, depth: int = 12, error: float = 1e-8, smooth: bool = False,
+             parallel: bool = True) -> Octree:
+    """Evaluates OpenSCAD CSG-tree text (the .csg format) on octrees."""
+
+def read_mesh(path: PathLike) -> Mesh:
+    """Reads OBJ, STL, PLY, OFF, glTF/GLB, duplicate vertices welded. Raises OSError, ValueError."""
+
+def write_mesh(vertices: ArrayLike, faces: ArrayLike, path: PathLike) -> None:
+    """Writes a mesh; format from the extension (obj, stl, ply, off, glb); atomic. Raises OSError."""
+
+def volume(vertices: ArrayLike, faces: ArrayLike) -> float:
+    """Signed volume of a mesh (positive for outward orientation)."""
+
+def check_validity(vertices: ArrayLike, faces: ArrayLike, self_intersections: bool = True) -> dict[str, Any]:
+    """Validity as a solid's boundary (pic::check_validity): 'valid' and the counts."""
+
+def make_box(lo: Sequence[float], hi: Sequence[float]) -> Mesh:
+    """Closed mesh of the axis-aligned box [lo, hi]."""
+
+def make_sphere(center: Sequence[float], radius: float, segments: int = 64) -> Mesh:
+    """Closed UV sphere mesh."""
+
+def make_cylinder(center: Sequence[float], radius: float, height: float, axis: int = 2,
+                  segments: int = 64) -> Mesh:
+    """Closed cylinder mesh along axis 0, 1 or 2, centred at center."""
+
+def make_cone(center: Sequence[float], radius: float, height: float, axis: int = 2,
+              segments: int = 64) -> Mesh:
+    """Closed cone mesh: base at center - height/2, apex at center + height/2."""
+
+def make_torus(center: Sequence[float], major: float, minor: float, axis: int = 2, segments: int = 64,
+               tube_segments: int = 32) -> Mesh:
+    """Closed torus mesh around axis."""
+
+def render(obj: Union[Octree, Tuple[ArrayLike, ArrayLike]], size: Tuple[int, int] = (640, 480),
+           octree: bool = False, points: bool = False, view: str = "iso",
+           camera: Optional[Sequence[float]] = None, perspective: bool = False,
+           supersample: int = 2) -> npt.NDArray[np.uint8]:
+    """Renders an Octree (its contour) or a mesh (vertices, faces) to an (h, w, 3) uint8 array.
+
+    size: (width, height). octree: draw the gray leaves' cells; points: the representative
+    vertices. view: iso, front, back, left, right, top, bottom (+Z up). camera: eye xyz,
+    target xyz, up xyz (9 numbers)."""
+
+def write_png(image: npt.ArrayLike, path: PathLike) -> None:
+    """Writes an (h, w, 3) uint8 array as a PNG, atomically. Raises OSError."""

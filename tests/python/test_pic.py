@@ -1,0 +1,428 @@
+"""Tests of the `pic` Python module (issue 12), run by ctest as `python_tests`.
+
+Environment (set by tests/CMakeLists.txt): PYTHONPATH=build/python, PIC_DATA_DIR (data/),
+PIC_CLI (build/pic, for the round trips against the C++ results), PIC_EXAMPLES_DIR,
+PIC_SCAD_DATA_DIR.
+"""
+import copy
+import json
+import math
+import os
+import pickle
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pic
+
+HERE = Path(__file__).resolve().parent
+DATA = Path(os.environ.get("PIC_DATA_DIR", HERE.parents[1] / "data"))
+SCAD = Path(os.environ.get("PIC_SCAD_DATA_DIR", HERE.parent / "data" / "scad"))
+EXAMPLES = Path(os.environ.get("PIC_EXAMPLES_DIR", HERE.parents[1] / "examples"))
+CLI = os.environ.get("PIC_CLI")
+
+needs_cli = pytest.mark.skipif(not CLI, reason="PIC_CLI (the pic command) not given")
+
+CUBE = (-1.0, -1.0, -1.0, 3.0)  # shared root cube of the CSG operands below
+
+
+def cli(*args):
+    out = subprocess.run([CLI, *map(str, args)], check=True, capture_output=True, text=True)
+    return out.stdout
+
+
+def mesh_volume(v, f):
+    """Signed volume with numpy alone (independent of pic.volume)."""
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
+
+
+def edges_closed_manifold(f):
+    """Every undirected edge on exactly two triangles, traversed once each way."""
+    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    uniq, counts = np.unique(directed, axis=0, return_counts=True)
+    if (counts != 1).any():
+        return False
+    keys = {tuple(e) for e in uniq.tolist()}
+    return all((b, a) in keys for a, b in keys)
+
+
+@pytest.fixture(scope="module")
+def box():
+    return pic.sample(*pic.make_box((0, 0, 0), (1, 1, 1)), depth=8, cube=CUBE)
+
+
+@pytest.fixture(scope="module")
+def cylinder():
+    # Radius 0.25 along z through the box's centre, longer than the box.
+    return pic.sample(*pic.make_cylinder((0.5, 0.5, 0.5), 0.25, 1.6, segments=256), depth=8, cube=CUBE)
+
+
+BOX_V = 1.0
+CYL_IN_BOX = math.pi * 0.25**2 * 1.0
+CYL_V = math.pi * 0.25**2 * 1.6
+
+
+# --- round trips against the C++ results ------------------------------------------------------
+
+
+@needs_cli
+def test_sample_same_pics_and_bytes_as_cli(tmp_path):
+    out = tmp_path / "fandisk.pic"
+    stats = json.loads(cli("sample", DATA / "fandisk.obj", "-o", out, "--depth", 10, "--json"))
+    from_path = pic.sample(DATA / "fandisk.obj", depth=10)
+    v, f = pic.read_mesh(DATA / "fandisk.obj")
+    from_arrays = pic.sample(v, f, depth=10)
+    assert from_path.pics == stats["pics"] == from_arrays.pics
+    assert from_path.stats["pics"] == stats["pics"]
+    assert from_path.stats["inside"] == stats["inside"]
+    expected = out.read_bytes()
+    assert from_path.serialize() == expected
+    assert from_arrays.serialize() == expected
+    saved = tmp_path / "py.pic"
+    from_arrays.save(saved)
+    assert saved.read_bytes() == expected
+    assert pic.load(out).serialize() == expected
+
+
+@needs_cli
+def test_info_matches_cli_json(tmp_path):
+    out = tmp_path / "cad.pic"
+    cli("sample", DATA / "cad_part.obj", "-o", out, "--depth", 8)
+    expected = json.loads(cli("info", out, "--json"))
+    got = pic.load(out).info()
+    assert set(got) == set(expected)
+    for key, value in expected.items():
+        assert _approx_nested(got[key], value), key
+    assert got["self_intersections"] == 0
+    assert pic.load(out).info(check=False)["self_intersections"] is None
+
+
+def _approx_nested(a, b):
+    if isinstance(b, dict):
+        return all(_approx_nested(a[k], v) for k, v in b.items())
+    if isinstance(b, list):
+        return all(_approx_nested(x, y) for x, y in zip(a, b))
+    if isinstance(b, float):
+        return a == pytest.approx(b, rel=1e-8, abs=1e-12)  # the CLI prints %.9g
+    return a == b and type(a) is type(b)
+
+
+@needs_cli
+def test_contour_matches_cli_mesh(tmp_path):
+    out = tmp_path / "cad.pic"
+    cli("sample", DATA / "cad_part.obj", "-o", out, "--depth", 8)
+    expected = json.loads(cli("mesh", out, "-o", tmp_path / "cad.obj", "--json", "--no-check"))
+    stats = {}
+    v, f = pic.load(out).contour(stats=stats)
+    assert v.dtype == np.float64 and v.shape == (expected["vertices"], 3)
+    assert f.dtype == np.int64 and f.shape == (expected["triangles"], 3)
+    assert stats["triangles"] == expected["triangles"] and stats["fans"] == expected["fans"]
+    assert mesh_volume(v, f) == pytest.approx(expected["volume"], rel=1e-9)
+    assert edges_closed_manifold(f)
+
+
+@needs_cli
+def test_csg_same_bytes_as_cli(tmp_path, box, cylinder):
+    box.save(tmp_path / "a.pic")
+    cylinder.save(tmp_path / "b.pic")
+    cli("csg", tmp_path / "a.pic", "subtract", tmp_path / "b.pic", "-o", tmp_path / "r.pic")
+    expected = (tmp_path / "r.pic").read_bytes()
+    # The CLI's operands are the loaded files: .pic vertices are quantized (docs/pic-format.md),
+    # so the same Boolean on the unquantized sampled trees may differ in the last bits.
+    a, b = pic.load(tmp_path / "a.pic"), pic.load(tmp_path / "b.pic")
+    assert (a - b).serialize() == expected
+    assert pic.csg(a, b, "subtract").serialize() == expected
+    assert pic.csg(a, b, "difference", parallel=False).serialize() == expected
+    c = a.copy()
+    c -= b
+    assert c.pics == pic.load(tmp_path / "r.pic").pics
+
+
+# --- CSG ---------------------------------------------------------------------------------------
+
+
+def test_operators_known_volumes(box, cylinder):
+    cases = {
+        "union": (box | cylinder, BOX_V + CYL_V - CYL_IN_BOX),
+        "intersect": (box & cylinder, CYL_IN_BOX),
+        "subtract": (box - cylinder, BOX_V - CYL_IN_BOX),
+    }
+    for op, (result, expected) in cases.items():
+        assert isinstance(result, pic.Octree)
+        assert result.stats["op"] == op and result.stats["inplace"] is False
+        assert result.stats["seconds"] >= 0 and result.stats["cells_visited"] > 0
+        v, f = result.contour()
+        assert edges_closed_manifold(f), op
+        # Depth 8 in a cube of side 3: cells of 0.012; the 256-gon's area is 0.01 % under the circle's.
+        assert mesh_volume(v, f) == pytest.approx(expected, rel=2e-3), op
+        assert pic.volume(v, f) == pytest.approx(mesh_volume(v, f), rel=1e-12)
+    assert (box - cylinder).serialize() == pic.csg(box, cylinder, "subtract").serialize()
+
+
+def test_operands_unchanged_by_operators(box, cylinder):
+    a, b = box.serialize(), cylinder.serialize()
+    _ = box | cylinder, box & cylinder, box - cylinder
+    assert box.serialize() == a and cylinder.serialize() == b
+
+
+def test_inplace_is_the_sculpting_path(box, cylinder):
+    a = box.copy()
+    before = id(a)
+    b_bytes = cylinder.serialize()
+    a -= cylinder
+    assert id(a) == before
+    assert a.stats["op"] == "subtract" and a.stats["inplace"] is True
+    assert cylinder.serialize() == b_bytes
+    assert box.pics != a.pics  # the fixture (copied from) is untouched
+    v, f = a.contour()
+    assert mesh_volume(v, f) == pytest.approx(BOX_V - CYL_IN_BOX, rel=2e-3)
+    assert edges_closed_manifold(f)
+    # Same solid as the copying operator (node order may differ: untouched subtrees stay put).
+    assert mesh_volume(*(box - cylinder).contour()) == pytest.approx(mesh_volume(v, f), rel=1e-6)
+    # A sculpting stroke: a small sphere added then removed, in place.
+    ball = pic.sample(*pic.make_sphere((1.0, 1.0, 1.0), 0.2), depth=8, cube=CUBE)
+    a |= ball
+    grown = mesh_volume(*a.contour())
+    assert grown > mesh_volume(v, f) + 0.01
+    pic.csg_inplace(a, ball, "subtract")
+    assert mesh_volume(*a.contour()) < grown - 0.01
+    c = box.copy()
+    c &= cylinder
+    assert mesh_volume(*c.contour()) == pytest.approx(CYL_IN_BOX, rel=2e-3)
+
+
+def test_inplace_with_itself(box):
+    a = box.copy()
+    a -= a
+    assert a.pics == 0
+    b = box.copy()
+    b |= b
+    assert mesh_volume(*b.contour()) == pytest.approx(BOX_V, rel=1e-3)
+
+
+# --- numpy inputs ------------------------------------------------------------------------------
+
+
+def test_dtypes_accepted_same_result():
+    v, f = pic.make_box((0, 0, 0), (1, 1, 1))
+    reference = pic.sample(v, f, depth=6, cube=CUBE).serialize()
+    for vd in (np.float32, np.float64):
+        for fd in (np.int32, np.int64, np.uint32):
+            assert pic.sample(v.astype(vd), f.astype(fd), depth=6, cube=CUBE).serialize() == reference
+    # Nested lists and non-contiguous views too.
+    assert pic.sample(v.tolist(), f.tolist(), depth=6, cube=CUBE).serialize() == reference
+    wide = np.zeros((len(v), 6))
+    wide[:, ::2] = v
+    assert pic.sample(wide[:, ::2], np.asfortranarray(f), depth=6, cube=CUBE).serialize() == reference
+
+
+@pytest.mark.parametrize(
+    "vertices, faces, message",
+    [
+        (np.zeros((4, 2)), np.zeros((1, 3), int), r"vertices must be an \(n, 3\) array, got shape \(4, 2\)"),
+        (np.zeros(12), np.zeros((1, 3), int), r"vertices must be an \(n, 3\) array, got shape \(12,\)"),
+        (np.zeros((4, 3)), np.zeros((1, 4), int), r"faces must be an \(n, 3\) array, got shape \(1, 4\)"),
+        (np.zeros((4, 3)), np.zeros((1, 3)), r"faces must be .* integers, got dtype float64"),
+        (np.zeros((4, 3), complex), np.zeros((1, 3), int), r"vertices must be .* real numbers, got dtype complex128"),
+        (np.zeros((4, 3)), [[0, 1, 4]], r"faces\[0\] has vertex index 4, outside 0..3"),
+        (np.zeros((4, 3)), [[0, -1, 2]], r"faces\[0\] has vertex index -1"),
+        (np.zeros((4, 3)), None, r"faces is missing"),
+    ],
+)
+def test_wrong_shapes_refused(vertices, faces, message):
+    with pytest.raises(ValueError, match=message):
+        pic.sample(vertices, faces)
+
+
+def test_point_cloud(tmp_path):
+    # Points on a sphere of radius 1 with outward normals (Fibonacci lattice).
+    n = 4000
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    r = np.sqrt(1 - z * z)
+    phi = i * math.pi * (3 - math.sqrt(5))
+    p = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1).astype(np.float32)
+    t = pic.sample((p, p), depth=6)
+    assert t.stats["inside"] == "points" and t.stats["points_in"] == n
+    v, f = t.contour()
+    assert mesh_volume(v, f) == pytest.approx(4 / 3 * math.pi, rel=0.05)
+    # The same cloud from an .xyz file ("x y z nx ny nz" per line) gives the same octree.
+    xyz = tmp_path / "sphere.xyz"
+    p64 = p.astype(np.float64)
+    xyz.write_text("".join(f"{a!r} {b!r} {c!r} {a!r} {b!r} {c!r}\n" for a, b, c in p64.tolist()))
+    assert pic.sample(xyz, depth=6).serialize() == pic.sample((p64, p64), depth=6).serialize()
+    with pytest.raises(ValueError, match="differ in length"):
+        pic.sample((p, p[:-1]))
+    with pytest.raises(ValueError, match=r"normals must be an \(n, 3\) array"):
+        pic.sample((p, p[:, :2]))
+
+
+# --- errors ------------------------------------------------------------------------------------
+
+
+def test_errors_mapped(tmp_path, box, cylinder):
+    with pytest.raises(OSError, match="no such file"):
+        pic.load(tmp_path / "missing.pic")
+    with pytest.raises(OSError):
+        pic.read_mesh(tmp_path / "missing.obj")
+    (tmp_path / "junk.pic").write_bytes(b"not a pic file at all")
+    with pytest.raises(OSError):
+        pic.load(tmp_path / "junk.pic")
+    with pytest.raises(OSError):
+        pic.deserialize(box.serialize()[:40])
+    with pytest.raises(OSError):
+        box.save(tmp_path / "no" / "such" / "dir" / "x.pic")
+    v, f = pic.make_box((0, 0, 0), (1, 1, 1))
+    with pytest.raises(ValueError, match="depth must be between 1 and 20"):
+        pic.sample(v, f, depth=0)
+    with pytest.raises(ValueError, match="non-finite"):
+        pic.sample(np.where(v == 1, np.nan, v), f)
+    with pytest.raises(ValueError, match="does not fit"):
+        pic.sample(v, f, cube=(0.2, 0.2, 0.2, 0.5))
+    with pytest.raises(ValueError, match=r"cube must be \(x, y, z, size\)"):
+        pic.sample(v, f, cube=(0, 0, 1))
+    with pytest.raises(ValueError, match="not closed"):
+        pic.sample(v, f[:-1], inside="parity")
+    with pytest.raises(ValueError, match="inside must be"):
+        pic.sample(v, f, inside="sometimes")
+    with pytest.raises(ValueError, match="unknown operation 'xor'"):
+        pic.csg(box, cylinder, "xor")
+    with pytest.raises(ValueError):
+        pic.render(box, size=(0, 10))
+    with pytest.raises(ValueError, match="unknown view|view"):
+        pic.render(box, view="sideways")
+    with pytest.raises(TypeError):
+        _ = box - 3
+    with pytest.raises(ValueError, match="unsupported|unknown"):
+        pic.eval_csg("frobnicate();", depth=5)
+
+
+# --- serialization, copies ---------------------------------------------------------------------
+
+
+def test_pickle_and_copy(box, cylinder):
+    r = box - cylinder
+    data = r.serialize()
+    for clone in (pickle.loads(pickle.dumps(r)), copy.copy(r), copy.deepcopy(r), r.copy(), pic.deserialize(data)):
+        assert isinstance(clone, pic.Octree) and clone is not r
+        assert clone.serialize() == data
+    c = r.copy()
+    c -= box
+    assert c.pics == 0 and r.serialize() == data  # copies are independent
+    assert r.depth == 8 and r.cube == CUBE and r.nodes > 1
+    assert "PICs" in repr(r)
+
+
+# --- GIL ---------------------------------------------------------------------------------------
+
+
+def test_gil_released_during_sample():
+    """A second Python thread keeps ticking while sample runs (serial, so a core stays free)."""
+    v, f = pic.read_mesh(DATA / "suzanne.obj")
+    ticks = []
+    stop = threading.Event()
+
+    def ticker():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    thread = threading.Thread(target=ticker)
+    thread.start()
+    time.sleep(0.02)
+    t0 = time.perf_counter()
+    tree = pic.sample(v, f, depth=9, parallel=False)
+    t1 = time.perf_counter()
+    stop.set()
+    thread.join()
+    assert tree.pics > 0
+    during = [t for t in ticks if t0 < t < t1]
+    assert t1 - t0 > 0.1, "the sample was too short to tell"
+    # Holding the GIL, the ticker could not run at all between t0 and t1 (a tick or two at the
+    # edges); released, it ticks about every millisecond.
+    assert len(during) >= 20, f"{len(during)} ticks in {t1 - t0:.3f} s"
+
+
+# --- render, mesh I/O, OpenSCAD ------------------------------------------------------------------
+
+
+def test_render(tmp_path, box):
+    img = pic.render(box, size=(160, 120))
+    assert img.shape == (120, 160, 3) and img.dtype == np.uint8
+    assert (img[0, 0] == (250, 250, 252)).all()  # background
+    assert (img != img[0, 0]).any(axis=2).sum() > 1000  # the box covers many pixels
+    drawn = pic.render(box, size=(160, 120), octree=True, points=True)
+    assert (drawn != img).any()
+    mesh_img = pic.render(pic.make_box((0, 0, 0), (1, 1, 1)), size=(64, 64))
+    assert mesh_img.shape == (64, 64, 3)
+    pic.write_png(img, tmp_path / "box.png")
+    assert (tmp_path / "box.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError, match="uint8"):
+        pic.write_png(img.astype(np.float32), tmp_path / "bad.png")
+
+
+def test_mesh_io_round_trip(tmp_path):
+    v, f = pic.make_cylinder((0, 0, 0), 1.0, 2.0, segments=32)
+    for ext in ("stl", "obj", "ply", "off"):
+        path = tmp_path / f"c.{ext}"
+        pic.write_mesh(v.astype(np.float32), f, path)
+        v2, f2 = pic.read_mesh(str(path))
+        assert len(v2) == len(v) and len(f2) == len(f)
+        assert mesh_volume(v2, f2) == pytest.approx(mesh_volume(v, f), rel=1e-6)
+
+
+def test_eval_csg_text_and_file():
+    t = pic.eval_csg((SCAD / "cube_minus_cube.csg").read_text(), depth=7)
+    assert t.stats["op"] == "eval" and t.stats["booleans"] == 1
+    assert mesh_volume(*t.contour()) == pytest.approx(840, rel=1e-3)
+    assert pic.eval_scad(SCAD / "cube_minus_cube.csg", depth=7).serialize() == t.serialize()
+
+
+@pytest.mark.skipif(shutil.which("openscad") is None, reason="openscad is not installed")
+def test_eval_scad(tmp_path):
+    (tmp_path / "part.scad").write_text(
+        "difference() { cube(10); translate([5, 5, -1]) cylinder(r = 2, h = 12, $fn = 4); }\n")
+    t = pic.eval_scad(tmp_path / "part.scad", depth=7)
+    assert mesh_volume(*t.contour()) == pytest.approx(1000 - 8 * 10, abs=0.5)
+
+
+# --- the example -------------------------------------------------------------------------------
+
+
+def test_example_subtract_cylinder(tmp_path):
+    env = dict(os.environ)
+    subprocess.run([sys.executable, EXAMPLES / "subtract_cylinder.py", "--depth", "8", "--out", tmp_path],
+                   check=True, env=env, capture_output=True, text=True)
+    png, stl = tmp_path / "fandisk_drilled.png", tmp_path / "fandisk_drilled.stl"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    v, f = pic.read_mesh(stl)
+    v0, f0 = pic.read_mesh(DATA / "fandisk.obj")
+    assert 0 < mesh_volume(v, f) < 0.99 * mesh_volume(v0, f0)
+    assert pic.check_validity(v, f, self_intersections=False)["boundary_edges"] == 0
+
+
+# --- the type stubs ----------------------------------------------------------------------------
+
+
+def test_stubs_cover_the_module():
+    """Every public function and Octree member has a stub and a docstring, and no stub is stale."""
+    import ast
+
+    tree = ast.parse((Path(pic.__file__).parent / "__init__.pyi").read_text())
+    funcs = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+    octree = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Octree")
+    members = {n.name for n in octree.body if isinstance(n, ast.FunctionDef)}
+    public = {n for n in dir(pic) if not n.startswith("_") and callable(getattr(pic, n)) and n != "Octree"}
+    assert funcs == public
+    octree_public = {n for n in dir(pic.Octree) if not n.startswith("_")} | {
+        n for n in ("__or__", "__and__", "__sub__", "__ior__", "__iand__", "__isub__") if hasattr(pic.Octree, n)}
+    assert octree_public <= members
+    for name in public:
+        assert getattr(pic, name).__doc__, name
