@@ -278,6 +278,9 @@ ITri clamp_itri(I3 a, I3 b, I3 c) {
 PointSource::PointSource(const std::vector<Vec3>& pos, const std::vector<Vec3>& normals) {
   constexpr int kNeighbours = 8;
   const std::vector<double> r = kth_neighbour_distance(pos, kNeighbours);
+  std::vector<double> sorted = r;
+  std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+  spacing_ = sorted.empty() ? 0 : sorted[sorted.size() / 2];
   std::vector<double> area(pos.size());
   for (size_t i = 0; i < pos.size(); ++i) area[i] = std::numbers::pi * r[i] * r[i] / kNeighbours;
   tree_.build_points(pos, normals, area);

@@ -76,8 +76,12 @@ class PointSource : public SurfaceSource {
   void add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind, const std::vector<uint32_t>& idx,
                        Qef& q) const override;
   bool inside(const I3& p) const;
+  /// Median distance from a point to its 8th nearest neighbour (unit space): the scale below
+  /// which the cloud says nothing about the surface.
+  double spacing() const { return spacing_; }
 
  private:
+  double spacing_ = 0;
   std::vector<ITri> prims_;  // per point: a splat (QEF) and a tiny marker (meets)
   DipoleTree tree_;
   DecisionCache cache_;

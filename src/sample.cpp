@@ -470,6 +470,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     st.triangles_in = mesh.triangles.size();
     st.pics = tree.vertices.size();
     st.capped = capped;
+    st.depth = options.depth;
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     *stats = st;
   }
@@ -496,8 +497,13 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
   const PointSource src(unit, cloud.normals);
   uint8_t signs = 0;
   for (int c = 0; c < 8; ++c) signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)))) << c;
+  // Cells finer than the points' spacing would only resolve the noise between neighbouring
+  // tangent planes: the depth stops where a cell is about half the spacing.
+  SampleOptions opt = options;
+  const double spacing = src.spacing();
+  if (spacing > 0) opt.depth = std::clamp(int(std::ceil(std::log2(2 / spacing))), 1, options.depth);
   size_t capped = 0;
-  Octree tree = build_tree(src, options, cube, signs, nullptr, capped, true);
+  Octree tree = build_tree(src, opt, cube, signs, nullptr, capped, true);
   if (tree.vertices.empty())
     throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
   if (stats) {
@@ -506,6 +512,7 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
     stats->pics = tree.vertices.size();
     stats->capped = capped;
     stats->classifier = "points";
+    stats->depth = opt.depth;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return tree;

@@ -370,6 +370,7 @@ int main(int argc, char** argv) {
                          .add("triangles_in", st.triangles_in)
                          .add("capped", st.capped)
                          .add("points_in", geo.points.positions.size())
+                         .add("depth_used", st.depth)
                          .add("inside", st.classifier)
                          .raw("defects", Json()
                                              .add("boundary_edges", d.boundary_edges)

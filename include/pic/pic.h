@@ -127,6 +127,7 @@ struct SampleStats {
   MeshDefects defects;      ///< of the input mesh (meshes only)
   size_t interior_triangles = 0;  ///< winding: triangles with the solid on both sides (dropped)
   size_t boundary_loops = 0;      ///< winding: closed curves of the input's boundary, capped
+  int depth = 0;  ///< deepest level allowed: the option's, or for a point cloud its spacing's
 };
 
 /// Adaptively samples a triangle mesh into a PIC object. A clean closed mesh is classified by
@@ -138,7 +139,8 @@ struct SampleStats {
 ///         or a mesh that encloses no solid (its winding number never reaches 1/2).
 Octree sample(const TriMesh& mesh, const SampleOptions& options = {}, SampleStats* stats = nullptr);
 /// Samples an oriented point cloud: signs from the points' winding number (each point a small
-/// disc of the area its neighbours leave it), vertices from their tangent planes.
+/// disc of the area its neighbours leave it), vertices from their tangent planes. The depth
+/// stops where a cell is half the points' spacing (SampleStats::depth says where).
 /// \throws InvalidInput for an empty cloud, missing or zero normals, non-finite values.
 Octree sample(const PointCloud& cloud, const SampleOptions& options = {}, SampleStats* stats = nullptr);
 
