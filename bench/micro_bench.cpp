@@ -6,10 +6,16 @@
 //   BM_Contour/threads:T         dual contouring of the fandisk PIC object on T threads (triangles/s)
 //   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
 //                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
+//   BM_WindingQuery/near         inside/outside by the winding number of the open bunny (69k
+//                                triangles in a dipole tree) at random points: 0 = anywhere in
+//                                its box, 1 = within 1 % of its size from its surface (queries/s)
+//   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
+//                                punched (winding), 2 = the Stanford bunny (open base, winding)
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
 #include <array>
+#include <map>
 #include <cmath>
 #include <random>
 #include <string>
@@ -18,6 +24,8 @@
 #include "pic/pic.h"
 #include "pic/primitives.h"
 #include "qef.h"
+#include "octree_util.h"
+#include "winding.h"
 
 namespace {
 
@@ -141,5 +149,79 @@ void BM_CsgCadStep(benchmark::State& state) {
 BENCHMARK(BM_CsgCadStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+const pic::TriMesh& mesh_of(const char* name) {
+  static std::map<std::string, pic::TriMesh> meshes;
+  auto it = meshes.find(name);
+  if (it == meshes.end()) it = meshes.emplace(name, pic::read_mesh(kData + "/" + name)).first;
+  return it->second;
+}
+
+/// Spot with 6 holes: the triangles within 3 % of its size of 6 of its vertices removed.
+pic::TriMesh spot_with_holes() {
+  pic::TriMesh m = mesh_of("spot.obj");
+  const pic::Cube c = pic::bounding_cube(m);
+  std::vector<pic::Vec3> centres;
+  for (size_t k = 0; k < 6; ++k) centres.push_back(m.positions[(k * 7919) % m.positions.size()]);
+  std::erase_if(m.triangles, [&](const auto& t) {
+    for (const auto& x : centres) {
+      const pic::Vec3& p = m.positions[t[0]];
+      const double d = std::hypot(p[0] - x[0], p[1] - x[1], p[2] - x[2]);
+      if (d < 0.03 * c.size) return true;
+    }
+    return false;
+  });
+  return m;
+}
+
+void BM_WindingQuery(benchmark::State& state) {
+  const pic::TriMesh& m = mesh_of("stanford-bunny.obj");
+  const pic::Cube c = pic::bounding_cube(m);
+  static pic::detail::DipoleTree tree;
+  if (tree.empty()) {
+    std::vector<pic::detail::ITri> tris;
+    for (const auto& t : m.triangles) {
+      pic::detail::I3 g[3];
+      for (int k = 0; k < 3; ++k) g[k] = pic::detail::to_grid(pic::detail::world_to_unit(c, m.positions[t[k]]));
+      tris.push_back(pic::detail::make_itri(g[0], g[1], g[2]));
+    }
+    tree.build_triangles(std::move(tris));
+  }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1), off(-0.01, 0.01);
+  std::vector<pic::Vec3> pts(4096);
+  for (auto& p : pts) {
+    if (state.range(0) == 0) {
+      p = {u(rng), u(rng), u(rng)};
+    } else {
+      p = pic::detail::world_to_unit(c, m.positions[rng() % m.positions.size()]);
+      for (double& x : p) x += off(rng);
+    }
+  }
+  size_t inside = 0, i = 0;
+  for (auto _ : state) {
+    const pic::detail::I3 g = pic::detail::to_grid(pts[i++ % pts.size()]);
+    inside += tree.inside(pic::detail::to_unit(g), &g, 0, 0.05);
+  }
+  benchmark::DoNotOptimize(inside);
+  state.SetLabel(state.range(0) ? "bunny, near the surface" : "bunny, anywhere in its box");
+  state.counters["queries/s"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_WindingQuery)->ArgName("near")->Arg(0)->Arg(1);
+
+void BM_SampleAnyInput(benchmark::State& state) {
+  static const pic::TriMesh holes = spot_with_holes();
+  const int k = static_cast<int>(state.range(0));
+  const pic::TriMesh& m = k == 0 ? mesh_of("spot.obj") : k == 1 ? holes : mesh_of("stanford-bunny.obj");
+  pic::SampleStats st;
+  for (auto _ : state) {
+    auto t = pic::sample(m, pic::SampleOptions{}, &st);
+    benchmark::DoNotOptimize(t);
+  }
+  state.SetLabel(k == 0 ? "spot" : k == 1 ? "spot with holes" : "stanford bunny");
+  state.counters["PICs"] = static_cast<double>(st.pics);
+  state.counters["boundary_edges"] = static_cast<double>(st.defects.boundary_edges);
+}
+BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();
