@@ -20,68 +20,14 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
+#include "support/csg_cases.h"
 #include "support/exact_csg.h"
 
 namespace {
 
 using namespace pic;
 
-constexpr const char* kModels[] = {"cad_part", "fandisk", "spot", "suzanne", "teapot"};
-
-/// A small deterministic generator (the same numbers on every standard library).
-struct Rng {
-  uint64_t s;
-  uint64_t next() {
-    s += 0x9E3779B97F4A7C15ull;
-    uint64_t z = s;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform(double lo, double hi) { return lo + (hi - lo) * double(next() >> 11) * 0x1.0p-53; }
-  int below(int n) { return int(next() % uint64_t(n)); }
-};
-
 std::vector<TriMesh> g_models;  // data/ meshes normalized to the unit cube around the origin
-
-TriMesh normalized(TriMesh m) {
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (const auto& p : m.positions)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  const double ext = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  for (auto& p : m.positions)
-    for (int k = 0; k < 3; ++k) p[k] = (p[k] - (lo[k] + hi[k]) / 2) / ext;
-  return m;
-}
-
-/// One random operand, inside [0.1, 0.9]^3: a primitive or a data mesh, scaled (not
-/// uniformly), rotated about a random axis, moved.
-TriMesh random_operand(Rng& r, std::string& what) {
-  const int kind = r.below(6);
-  TriMesh m;
-  const Vec3 o{0, 0, 0};
-  switch (kind) {
-    case 0: m = make_box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}); what = "box"; break;
-    case 1: m = make_sphere(o, 0.5, 48); what = "sphere"; break;
-    case 2: m = make_cylinder(o, 0.5, 1, 2, 48); what = "cylinder"; break;
-    case 3: m = make_torus(o, 0.35, 0.15, 2, 48, 24); what = "torus"; break;
-    case 4: m = make_cone(o, 0.5, 1, 2, 48); what = "cone"; break;
-    default: {
-      const int k = r.below(int(g_models.size()));
-      m = g_models[k];
-      what = kModels[k];
-    }
-  }
-  const double size = r.uniform(0.3, 0.6);
-  const Vec3 scale{size * r.uniform(0.5, 1), size * r.uniform(0.5, 1), size * r.uniform(0.5, 1)};
-  for (auto& p : m.positions)
-    for (int k = 0; k < 3; ++k) p[k] *= scale[k];
-  Vec3 axis{r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1)};
-  const double n = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]) + 1e-12;
-  for (double& x : axis) x /= n;
-  const Vec3 at{r.uniform(0.35, 0.65), r.uniform(0.35, 0.65), r.uniform(0.35, 0.65)};
-  return transformed(std::move(m), rotation(axis, r.uniform(0, 2 * std::numbers::pi)), at);
-}
 
 TriMesh written(const Octree& t) {
   TriMesh m = contour(t);
@@ -102,26 +48,24 @@ struct CaseResult {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+void print_components(const TriMesh& pic_mesh, const TriMesh& exact, double cell) {
+  for (const auto& [name, mesh] : {std::pair<const char*, const TriMesh*>{"pic", &pic_mesh}, {"exact", &exact}})
+    for (const MeshComponent& c : mesh_components(*mesh))
+      std::printf("%s component: %zu triangles, %.1f cells across, at (%.4f %.4f %.4f)\n", name, c.triangles,
+                  c.extent() / cell, (c.lo[0] + c.hi[0]) / 2, (c.lo[1] + c.hi[1]) / 2, (c.lo[2] + c.hi[2]) / 2);
+}
+
 CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) {
-  Rng r{seed * 0x2545F4914F6CDD1Dull + 1};
   CaseResult res;
   res.seed = seed;
-  res.depth = fixed_depth > 0 ? fixed_depth : 7 + r.below(3);
-  const int operands = 2 + (r.below(3) == 0 ? 1 + r.below(2) : 0);  // a third of the cases chain 2-3 ops
+  const CsgCase k = make_case(seed, fixed_depth, g_models);
+  res.depth = k.depth;
+  res.text = k.text;
+  const std::vector<TriMesh>& inputs = k.inputs;
+  const std::vector<CsgOp>& ops = k.ops;
   SampleOptions so;
   so.depth = res.depth;
   so.cube = Cube{{0, 0, 0}, 1};
-  std::vector<TriMesh> inputs;
-  std::vector<CsgOp> ops;
-  for (int i = 0; i < operands; ++i) {
-    std::string what;
-    inputs.push_back(random_operand(r, what));
-    if (i > 0) {
-      ops.push_back(CsgOp(r.below(3)));
-      res.text += " " + to_string(ops.back()) + " ";
-    }
-    res.text += what;
-  }
   // PIC: sample each operand, combine left to right. Reference: the same on the operands' own
   // contours, exactly.
   auto t0 = Clock::now();
@@ -148,6 +92,7 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
     return res;
   }
   res.cmp = compare_to_exact(pic_mesh, *exact, 1.0 / double(1 << res.depth));
+  if (!out_dir.empty()) print_components(pic_mesh, *exact, 1.0 / double(1 << res.depth));
   return res;
 }
 
@@ -186,7 +131,9 @@ CaseResult run_pair(const std::string& pa, CsgOp op, const std::string& pb, int 
     res.why = "CGAL failed";
     return res;
   }
-  res.cmp = compare_to_exact(pic_mesh, *exact, so.cube->size / double(1 << res.depth), 200000);
+  const double cell = so.cube->size / double(1 << res.depth);
+  res.cmp = compare_to_exact(pic_mesh, *exact, cell, 200000);
+  print_components(pic_mesh, *exact, cell);
   return res;
 }
 
@@ -231,7 +178,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  for (const char* name : kModels) g_models.push_back(normalized(read_mesh(std::string(PIC_DATA_DIR) + "/" + name + ".obj")));
+  g_models = load_case_models(PIC_DATA_DIR);
   if (!pair.empty()) {
     const std::optional<CsgOp> op = parse_csg_op(pair[1]);
     if (!op) return 1;

@@ -816,6 +816,94 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   x.bvh.build(x.tris);
 }
 
+/// Turns the stamped gray leaves without a sign change back into uniform leaves. Such a leaf
+/// is a crack repair (repair_cracks): a uniform leaf given a vertex so that the contour closes
+/// over the sign changes its finer neighbours show on its faces. The island and face passes
+/// take every gray leaf for a cell whose faces must look like one cell's, so they "fixed" those
+/// neighbours' signs to the repair's uniform ones: where an operand's repair leaf was copied
+/// into the result, that carved a slit as deep as the leaf into a flat face of the operand
+/// (issue 10, the Thingi10K pair). repair_cracks after the passes gives the leaves back their
+/// vertices where they still border a sign change.
+void withdraw_crack_repairs(Octree& t, uint32_t node, const std::function<bool(uint32_t)>& active) {
+  if (!active(node)) return;
+  Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal) {
+    for (int c = 0; c < 8; ++c) withdraw_crack_repairs(t, n.index + c, active);
+  } else if (n.kind == CellKind::Gray && (n.signs == 0 || n.signs == 0xff)) {
+    n = Node{0, n.signs != 0 ? CellKind::Black : CellKind::White, 0, 0, 0};
+  }
+}
+
+/// The leaf whose cell contains the finest-level cell at lattice point q (descending from the
+/// root), with its cell.
+std::pair<uint32_t, Cell> leaf_containing(const Octree& t, const Lat& q) {
+  uint32_t node = 0;
+  Cell cell;
+  while (t.nodes[node].kind == CellKind::Internal) {
+    const int64_t h = cell.span() / 2;
+    int c = 0;
+    for (int k = 0; k < 3; ++k)
+      if (q[k] >= cell.lat[k] + h) c |= 1 << k;
+    node = t.nodes[node].index + c;
+    cell = cell.child(c);
+  }
+  return {node, cell};
+}
+
+/// Removes specks: a lattice point whose sign differs from every other corner of every leaf
+/// around it is a closed shell one cell across (12 triangles), or a void as small. The
+/// Boolean makes them where the two operands' surfaces pass within a fraction of a cell of
+/// each other (the lattice point falls between two contours that the exact result keeps
+/// together, or at the thin end of a wedge): a feature thinner than the finest cell, which
+/// the octree cannot hold. Such a point takes its neighbours' sign. Returns how many points.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active) {
+  std::vector<Lat> candidates;
+  std::vector<uint32_t> path;
+  std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
+    if (!active(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth &&
+               (std::popcount(n.signs) == 1 || std::popcount(n.signs) == 7)) {
+      const uint8_t odd = std::popcount(n.signs) == 1 ? n.signs : uint8_t(~n.signs);
+      candidates.push_back(cell.corner(std::countr_zero(odd)));
+    }
+  };
+  collect(0, Cell{});
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  size_t removed = 0;
+  for (const Lat& p : candidates) {
+    std::array<std::pair<uint32_t, Cell>, 8> around;
+    bool speck = true;
+    int inside = -1;
+    for (int c = 0; c < 8 && speck; ++c) {
+      Lat q;
+      for (int k = 0; k < 3; ++k) q[k] = p[k] - ((c >> k) & 1) * step;
+      for (int k = 0; k < 3; ++k) speck = speck && q[k] >= 0 && q[k] + step <= kLimit;
+      if (!speck) break;
+      around[c] = leaf_containing(t, q);
+      const auto& [node, cell] = around[c];
+      const Node& n = t.nodes[node];
+      const int k = cell.corner_index(p);
+      if (n.kind != CellKind::Gray || k < 0 || !active(node)) {
+        speck = false;
+        break;
+      }
+      const int s = (n.signs >> k) & 1;
+      if (inside < 0) inside = s;
+      speck = s == inside && n.signs == (s ? uint8_t(1u << k) : uint8_t(~(1u << k)));
+    }
+    if (!speck) continue;
+    for (const auto& [node, cell] : around) t.nodes[node] = Node{0, inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+    ++removed;
+  }
+  return removed;
+}
+
 /// Drops unreachable nodes and vertices (left behind by in-place replacement).
 void compact(Octree& t) {
   Octree c;
@@ -948,6 +1036,9 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   const auto tclean = Clock::now();
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
+  // Crack repairs of the operands are redone on the result: as gray leaves they would pass
+  // for coarse neighbours that finer sign changes contradict (issue 10's slit).
+  withdraw_crack_repairs(a, 0, stamped);
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
@@ -955,6 +1046,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
     if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
+  remove_specks(a, stamped);
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);

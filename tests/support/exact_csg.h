@@ -9,6 +9,8 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <cmath>
+#include <map>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -79,6 +81,47 @@ inline std::optional<TriMesh> exact_boolean(const TriMesh& a, const TriMesh& b, 
   }
   if (!ok) return std::nullopt;
   return from_cgal(out);
+}
+
+/// An edge-connected component of a mesh (equal positions merged).
+struct MeshComponent {
+  size_t triangles = 0;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  double extent() const { return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}); }
+};
+
+/// The mesh's components, smallest first.
+inline std::vector<MeshComponent> mesh_components(const TriMesh& m) {
+  std::map<Vec3, uint32_t> id;
+  std::vector<uint32_t> v(m.positions.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) v[i] = id.try_emplace(m.positions[i], uint32_t(id.size())).first->second;
+  std::vector<uint32_t> parent(m.triangles.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto root = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> edges;
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = v[m.triangles[f][k]], b = v[m.triangles[f][(k + 1) % 3]];
+      const auto [it, fresh] = edges.try_emplace({std::min(a, b), std::max(a, b)}, f);
+      if (!fresh) parent[root(f)] = root(it->second);
+    }
+  std::map<uint32_t, MeshComponent> comps;
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    MeshComponent& c = comps[root(f)];
+    ++c.triangles;
+    for (uint32_t i : m.triangles[f])
+      for (int k = 0; k < 3; ++k) {
+        c.lo[k] = std::min(c.lo[k], m.positions[i][k]);
+        c.hi[k] = std::max(c.hi[k], m.positions[i][k]);
+      }
+  }
+  std::vector<MeshComponent> out;
+  for (const auto& [r, c] : comps) out.push_back(c);
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.triangles < b.triangles; });
+  return out;
 }
 
 /// PIC's result against the exact one. Distances in finest cells of the octree.
