@@ -28,7 +28,9 @@ struct Kept {
 
 // Each failed before the fix named: a component the exact result does not have.
 constexpr Kept kKept[] = {
-    {87, 1.5, 2.5, "speck: one lattice point between two nearly touching surfaces"},
+    {8, 1.5, 3.0, "torus union torus subtract box subtract cone: 4 components, 2 exact (specks)"},
+    {30, 1.5, 3.5, "box intersect torus: 4 components, 1 exact (specks along a thin tube)"},
+    {87, 1.5, 2.5, "cone subtract box: 2 components, 1 exact (a speck between nearly touching surfaces)"},
 };
 
 class HarnessCase : public ::testing::TestWithParam<Kept> {};
