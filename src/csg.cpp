@@ -3,8 +3,11 @@
 // Stages, each a function or class below:
 //   tag / stamp_under_surface   stamp the overlap cells with this operation's timestamp
 //   partial_contour             dual-contour only around stamped cells, triangles in a BVH
-//   Combiner                    the paired recursion: trivial cases, GraycellCSG, forced
-//                               subdivision (resampling a leaf's partial contour)
+//   Operand, side_of/child_side an operand's signs, triangles and state over a cell
+//   Combiner                    the paired recursion: trivial cases, GraycellCSG (built from
+//                               edge_verdict, surfaces_meet, feature_is_local, ...), forced
+//                               subdivision (resampling a leaf's partial contour), writing
+//                               through a FragmentWriter
 //   topology.h                  islands, one component per leaf, crack repair
 //
 // Topology comes from signs alone: each operand's sign is a single-valued function of the
@@ -15,6 +18,7 @@
 #include <bit>
 #include <atomic>
 #include <chrono>
+#include <optional>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -309,22 +313,11 @@ struct CombineCounts {
   }
 };
 
-class Combiner {
+/// Builds nodes and vertices into one task's Fragment (new slots are fragment-local).
+class FragmentWriter {
  public:
-  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
-           int parallel_levels, bool parallel, CombineCounts& stats)
-      : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
-        parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
+  explicit FragmentWriter(Fragment& out) : out_(out) {}
 
-  /// The result's root node (its index may be fragment-local).
-  Node run() {
-    Side sa = side_of(a_, 0, Cell{});
-    Side sb = side_of(b_, 0, Cell{});
-    return combine(Cell{}, sa, sb);
-  }
-
- private:
-  // ---- output ---------------------------------------------------------------------------
   void set(uint32_t slot, const Node& n) {
     if (Fragment::is_local(slot)) out_.nodes[slot & ~Fragment::kLocal] = n;
     else out_.pending.push_back({slot, n});
@@ -360,6 +353,237 @@ class Combiner {
     return n;
   }
 
+  /// Appends a freshly sampled subtree; returns its root.
+  Node append(const Builder& sub) {
+    const size_t from = out_.nodes.size();
+    Node root = append_subtree(out_.nodes, out_.vertices, sub);
+    auto mark = [](Node& n) {
+      if (n.kind == CellKind::Internal || n.kind == CellKind::Gray) n.index |= Fragment::kLocal;
+    };
+    for (size_t k = from; k < out_.nodes.size(); ++k) mark(out_.nodes[k]);
+    mark(root);
+    return root;
+  }
+
+  /// Appends another task's fragment; returns its root relocated.
+  Node absorb(const Fragment& f, Node root) { return out_.absorb(f, root); }
+
+ private:
+  Fragment& out_;
+};
+
+// ---- operand states ---------------------------------------------------------------------
+
+Side side_of(Operand& x, uint32_t node, const Cell& cell) {
+  const Node& n = x.t.nodes[node];
+  Side s;
+  s.node = node;
+  if (n.kind == CellKind::Internal) {
+    s.kind = Side::Internal;
+  } else if (n.kind == CellKind::Gray) {
+    s.kind = Side::Gray;
+    s.real = true;
+    s.signs = n.signs;
+    s.leaf_cell = cell;
+    s.idx = x.triangles_in(node, cell);
+  } else {
+    s.inside = n.kind == CellKind::Black;
+  }
+  return s;
+}
+
+/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
+/// (signs from sign_X, the leaf's triangles that reach the child), or uniform when such a
+/// virtual cell has neither a sign change nor a triangle.
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
+  const Cell cc = cell.child(c);
+  if (s.kind == Side::Uniform) return s;
+  if (s.kind == Side::Internal) return side_of(x, x.t.nodes[s.node].index + c, cc);
+  Side v;
+  v.kind = Side::Gray;
+  v.node = s.node;
+  v.real = false;
+  v.leaf_cell = s.leaf_cell;
+  for (int k = 0; k < 8; ++k) {
+    const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
+    bool sign;
+    if (gx != 1 && gy != 1 && gz != 1) {
+      sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
+    } else {
+      sign = x.sign_in(cc.corner(k), s.node, s.leaf_cell);
+    }
+    v.signs |= uint8_t(sign) << k;
+  }
+  filter_tris(x.tris, s.idx, cc, v.idx);
+  if ((v.signs == 0 || v.signs == 0xff) && !meets_cell(x.tris, v.idx, cc)) {
+    Side u;
+    u.inside = v.signs != 0;
+    return u;
+  }
+  return v;
+}
+
+/// A virtual cell with no sign change that still holds surface: it must be refined until the
+/// surface shows in the signs.
+bool unresolved(const Side& s) { return !s.real && (s.signs == 0 || s.signs == 0xff); }
+
+// ---- GraycellCSG pieces -----------------------------------------------------------------
+
+struct EdgeCrossing {
+  bool change;
+  double t;
+  int count;
+};
+EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axis, i64 len, int c0, int c1) {
+  EdgeCrossing r{(((s.signs >> c0) ^ (s.signs >> c1)) & 1) != 0, 0.5, 0};
+  for (uint32_t k : s.idx) {
+    if (crosses(x.tris[k], a, axis, len)) {
+      if (r.count == 0) r.t = crossing_param(x.tris[k], a, axis, len);
+      ++r.count;
+    }
+  }
+  return r;
+}
+
+/// What the cell's edges say: whether either operand's surface is visible in the result
+/// there, and whether the cell must split.
+struct EdgeVerdict {
+  bool must_split = false;
+  bool vis_a = false, vis_b = false;
+};
+
+/// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
+/// Table 1): two result crossings on one edge force a subdivision, as do two crossings of one
+/// operand on an edge of a virtual cell.
+EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b,
+                         const Cell& cell) {
+  EdgeVerdict v;
+  const I3 lo = lattice_to_grid(cell.lat);
+  const i64 len = lattice_to_grid(cell.span());
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
+    const EdgeCrossing ea = edge_crossing(xa, a, p, axis, len, c0, c1);
+    const EdgeCrossing eb = edge_crossing(xb, b, p, axis, len, c0, c1);
+    if ((!a.real && ea.count >= 2) || (!b.real && eb.count >= 2)) {
+      v.must_split = true;
+      return v;
+    }
+    if (!ea.change && !eb.change) continue;
+    const bool a0 = (a.signs >> c0) & 1, b0 = (b.signs >> c0) & 1;
+    auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
+    auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
+    int n_r = 0;
+    if (ea.change && eb.change && ea.t == eb.t) {
+      n_r = apply(op, a0, b0) != apply(op, !a0, !b0);
+      v.vis_a = v.vis_b = v.vis_a || n_r;
+    } else {
+      if (ea.change) {
+        const bool vis = apply(op, a0, in_b(ea.t)) != apply(op, !a0, in_b(ea.t));
+        n_r += vis;
+        v.vis_a = v.vis_a || vis;
+      }
+      if (eb.change) {
+        const bool vis = apply(op, in_a(eb.t), b0) != apply(op, in_a(eb.t), !b0);
+        n_r += vis;
+        v.vis_b = v.vis_b || vis;
+      }
+    }
+    if (n_r >= 2) {
+      v.must_split = true;
+      return v;
+    }
+  }
+  return v;
+}
+
+/// Whether the two operands' partial contours meet inside the cell.
+bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
+  for (uint32_t i : a.idx)
+    for (uint32_t j : b.idx)
+      if (triangles_meet_in_box(xa.tris[i], xb.tris[j], cell.box())) return true;
+  return false;
+}
+
+/// The new feature (where the two surfaces meet) must also fit one point or line over the
+/// cell grown by half its size on every side: dual contouring joins this vertex to its
+/// neighbours' by straight edges, so a curved intersection (a hole's rim) is refined until
+/// those edges follow it. Not in the paper, whose per-cell test lets big cells sit on a
+/// curved rim and chords cut across it.
+bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, const Vec3& x, double error,
+                      std::vector<uint32_t>& scratch) {
+  IBox g = cell.box();
+  const i64 h = lattice_to_grid(cell.span()) / 2;
+  for (int k = 0; k < 3; ++k) {
+    g.lo[k] = std::max<i64>(0, g.lo[k] - h);
+    g.hi[k] = std::min<i64>(i64{1} << kGridBits, g.hi[k] + h);
+  }
+  const double face = 4 * cell.size() * cell.size();
+  Qef q;
+  scratch.clear();
+  xa.bvh.query(xa.tris, g.lo, g.hi, scratch);
+  box_qef(xa.tris, scratch, g, face, q);
+  scratch.clear();
+  xb.bvh.query(xb.tris, g.lo, g.hi, scratch);
+  box_qef(xb.tris, scratch, g, face, q);
+  return q.solve(x).error < error;
+}
+
+/// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a
+/// leaf here would meet finer neighbours showing a second sheet on its faces.
+bool refinement_is_simple(CsgOp op, Operand& xa, const Side& a, Operand& xb, const Side& b, const Cell& cell,
+                          uint8_t sr) {
+  std::array<bool, 27> g{};
+  for (int k = 0; k < 8; ++k) g[grid_index_of_corner(k)] = (sr >> k) & 1;
+  const int64_t h = cell.span() / 2;
+  for (int i = 0; i < 27; ++i) {
+    const int x = i % 3, y = (i / 3) % 3, z = i / 9;
+    if (x != 1 && y != 1 && z != 1) continue;
+    const Lat p{cell.lat[0] + x * h, cell.lat[1] + y * h, cell.lat[2] + z * h};
+    g[i] = apply(op, xa.sign_in(p, a.node, a.leaf_cell), xb.sign_in(p, b.node, b.leaf_cell));
+  }
+  return grid_is_simple(g);
+}
+
+/// The two operands' QEFs over the cell, and their sum.
+struct CellQefs {
+  Qef a, b, sum;
+};
+CellQefs cell_qefs(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
+  CellQefs q;
+  cell_qef(xa.tris, a.idx, cell, q.a);
+  cell_qef(xb.tris, b.idx, cell, q.b);
+  q.sum = q.a;
+  q.sum += q.b;
+  return q;
+}
+
+/// An operand's own vertex in the cell: the leaf's stored one, or the minimizer of its QEF in
+/// a virtual cell.
+Vec3 operand_vertex(const Operand& x, const Side& s, const Qef& q, const Cell& cell) {
+  if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
+  return cell_vertex(q, cell, s.signs).position;
+}
+
+/// The paired recursion over A's and B's cells (paper 5.2): trivial cases, GraycellCSG where
+/// both are gray, forced subdivision (resampling a leaf's partial contour) where one is finer.
+class Combiner {
+ public:
+  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
+           int parallel_levels, bool parallel, CombineCounts& stats)
+      : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
+        parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
+
+  /// The result's root node (its index may be fragment-local).
+  Node run() {
+    Side sa = side_of(a_, 0, Cell{});
+    Side sb = side_of(b_, 0, Cell{});
+    return combine(Cell{}, sa, sb);
+  }
+
+ private:
+  static Node uniform(bool inside) { return FragmentWriter::uniform(inside); }
+
   /// Resamples a (virtual) gray cell of operand x from its partial contour.
   Node resample(Operand& x, const Cell& cell, const Side& s, bool invert) {
     FanSource src(x);
@@ -372,77 +596,20 @@ class Combiner {
     size_t capped = 0;
     sample_cell(src, p, cell, s.signs, s.idx, sub, 0, capped);
     ++stats_.forced_subdivisions;
-    return append(sub);
-  }
-  Node append(const Builder& sub) {
-    const size_t from = out_.nodes.size();
-    Node root = append_subtree(out_.nodes, out_.vertices, sub);
-    auto mark = [](Node& n) {
-      if (n.kind == CellKind::Internal || n.kind == CellKind::Gray) n.index |= Fragment::kLocal;
-    };
-    for (size_t k = from; k < out_.nodes.size(); ++k) mark(out_.nodes[k]);
-    mark(root);
-    return root;
+    return out_.append(sub);
   }
 
-  // ---- operand states -------------------------------------------------------------------
-  Side side_of(Operand& x, uint32_t node, const Cell& cell) {
-    const Node& n = x.t.nodes[node];
-    Side s;
-    s.node = node;
-    if (n.kind == CellKind::Internal) {
-      s.kind = Side::Internal;
-    } else if (n.kind == CellKind::Gray) {
-      s.kind = Side::Gray;
-      s.real = true;
-      s.signs = n.signs;
-      s.leaf_cell = cell;
-      s.idx = x.triangles_in(node, cell);
-    } else {
-      s.inside = n.kind == CellKind::Black;
-    }
-    return s;
-  }
-
-  Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
-    const Cell cc = cell.child(c);
-    if (s.kind == Side::Uniform) return s;
-    if (s.kind == Side::Internal) return side_of(x, x.t.nodes[s.node].index + c, cc);
-    Side v;
-    v.kind = Side::Gray;
-    v.node = s.node;
-    v.real = false;
-    v.leaf_cell = s.leaf_cell;
-    for (int k = 0; k < 8; ++k) {
-      const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
-      bool sign;
-      if (gx != 1 && gy != 1 && gz != 1) {
-        sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
-      } else {
-        sign = x.sign_in(cc.corner(k), s.node, s.leaf_cell);
-      }
-      v.signs |= uint8_t(sign) << k;
-    }
-    filter_tris(x.tris, s.idx, cc, v.idx);
-    if ((v.signs == 0 || v.signs == 0xff) && !meets_cell(x.tris, v.idx, cc)) {
-      Side u;
-      u.inside = v.signs != 0;
-      return u;
-    }
-    return v;
-  }
-
-  // ---- the recursion ----------------------------------------------------------------------
+  /// An operand's cell as the result (complemented if `invert`): A's own nodes stay in place.
   Node copy_side(Operand& x, const Side& s, const Cell& cell, bool invert, bool is_a) {
     switch (s.kind) {
       case Side::Uniform: return uniform(s.inside != invert);
       case Side::Internal:
         if (is_a && !invert) return x.t.nodes[s.node];  // unchanged subtree of A, in place
-        return copy_subtree(x.t, s.node, invert);
+        return out_.copy_subtree(x.t, s.node, invert);
       case Side::Gray:
         if (s.real) {
           if (is_a && !invert) return x.t.nodes[s.node];
-          return copy_subtree(x.t, s.node, invert);
+          return out_.copy_subtree(x.t, s.node, invert);
         }
         return resample(x, cell, s, invert);
     }
@@ -473,33 +640,17 @@ class Combiner {
     if (a.kind == Side::Internal) {
       first = a_.t.nodes[a.node].index;
     } else {
-      first = alloc8();
+      first = out_.alloc8();
       if (a.kind == Side::Gray && a.real) ++stats_.forced_subdivisions;
     }
     if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
     std::array<Node, 8> kids;
-    if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) {
-      // Near the root, each child is a task with its own fragment and caches, merged in child
-      // order: the same bytes whether the tasks run in parallel or not.
-      std::array<Fragment, 8> frags;
-      std::array<CombineCounts, 8> sub_stats;
-      auto task = [&](int c) {
-        Operand ca(a_.t, a_.pc, stamp_), cb(b_.t, b_.pc, stamp_);
-        Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
-        kids[c] = sub.combine(cell.child(c), sub.child_side(ca, a, cell, c), sub.child_side(cb, b, cell, c));
-      };
-      if (parallel_) tbb::parallel_for(0, 8, task);
-      else for (int c = 0; c < 8; ++c) task(c);
-      for (int c = 0; c < 8; ++c) {
-        kids[c] = out_.absorb(frags[c], kids[c]);
-        stats_ += sub_stats[c];
-      }
-    } else {
+    if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) kids = split_in_tasks(cell, a, b);
+    else
       for (int c = 0; c < 8; ++c) kids[c] = combine(cell.child(c), child_side(a_, a, cell, c), child_side(b_, b, cell, c));
-    }
     bool all_uniform = true;
     for (int c = 0; c < 8; ++c) {
-      set(first + c, kids[c]);
+      out_.set(first + c, kids[c]);
       all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
                     kids[c].kind == kids[0].kind;
     }
@@ -507,60 +658,28 @@ class Combiner {
     return Node{first, CellKind::Internal, 0, 0, 0};
   }
 
-  /// The new feature (where the two surfaces meet) must also fit one point or line over the
-  /// cell grown by half its size on every side: dual contouring joins this vertex to its
-  /// neighbours' by straight edges, so a curved intersection (a hole's rim) is refined until
-  /// those edges follow it. Not in the paper, whose per-cell test lets big cells sit on a
-  /// curved rim and chords cut across it.
-  bool feature_is_local(const Cell& cell, const Vec3& x) {
-    IBox g = cell.box();
-    const i64 h = lattice_to_grid(cell.span()) / 2;
-    for (int k = 0; k < 3; ++k) {
-      g.lo[k] = std::max<i64>(0, g.lo[k] - h);
-      g.hi[k] = std::min<i64>(i64{1} << kGridBits, g.hi[k] + h);
+  /// Near the root, each child is a task with its own fragment and caches, merged in child
+  /// order: the same bytes whether the tasks run in parallel or not.
+  std::array<Node, 8> split_in_tasks(const Cell& cell, const Side& a, const Side& b) {
+    std::array<Node, 8> kids;
+    std::array<Fragment, 8> frags;
+    std::array<CombineCounts, 8> sub_stats;
+    auto task = [&](int c) {
+      Operand ca(a_.t, a_.pc, stamp_), cb(b_.t, b_.pc, stamp_);
+      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
+      kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c), child_side(cb, b, cell, c));
+    };
+    if (parallel_) tbb::parallel_for(0, 8, task);
+    else for (int c = 0; c < 8; ++c) task(c);
+    for (int c = 0; c < 8; ++c) {
+      kids[c] = out_.absorb(frags[c], kids[c]);
+      stats_ += sub_stats[c];
     }
-    const double face = 4 * cell.size() * cell.size();
-    Qef q;
-    scratch_.clear();
-    a_.bvh.query(a_.tris, g.lo, g.hi, scratch_);
-    box_qef(a_.tris, scratch_, g, face, q);
-    scratch_.clear();
-    b_.bvh.query(b_.tris, g.lo, g.hi, scratch_);
-    box_qef(b_.tris, scratch_, g, face, q);
-    return q.solve(x).error < error_;
+    return kids;
   }
 
-  /// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a
-  /// leaf here would meet finer neighbours showing a second sheet on its faces.
-  bool refinement_is_simple(const Cell& cell, const Side& a, const Side& b, uint8_t sr) {
-    std::array<bool, 27> g{};
-    for (int k = 0; k < 8; ++k) g[grid_index_of_corner(k)] = (sr >> k) & 1;
-    const int64_t h = cell.span() / 2;
-    for (int i = 0; i < 27; ++i) {
-      const int x = i % 3, y = (i / 3) % 3, z = i / 9;
-      if (x != 1 && y != 1 && z != 1) continue;
-      const Lat p{cell.lat[0] + x * h, cell.lat[1] + y * h, cell.lat[2] + z * h};
-      g[i] = apply(op_, a_.sign_in(p, a.node, a.leaf_cell), b_.sign_in(p, b.node, b.leaf_cell));
-    }
-    return grid_is_simple(g);
-  }
-
-  struct EdgeCrossing {
-    bool change;
-    double t;
-    int count;
-  };
-  EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axis, i64 len, int c0, int c1) {
-    EdgeCrossing r{(((s.signs >> c0) ^ (s.signs >> c1)) & 1) != 0, 0.5, 0};
-    for (uint32_t k : s.idx) {
-      if (crosses(x.tris[k], a, axis, len)) {
-        if (r.count == 0) r.t = crossing_param(x.tris[k], a, axis, len);
-        ++r.count;
-      }
-    }
-    return r;
-  }
-
+  /// GraycellCSG: both operands gray over the cell. A leaf when the cell resolves (culled to
+  /// one operand or uniform, or a new vertex where the surfaces meet); else split.
   Node gray_cell(const Cell& cell, const Side& a, const Side& b) {
     ++stats_.gray_pairs;
     const uint8_t sr = apply_mask(op_, a.signs, b.signs);
@@ -571,100 +690,49 @@ class Combiner {
       return copy_side(a_, a, cell, false, true);
     }
     const bool at_cap = cell.level >= max_depth_;
-    const bool r_uniform = sr == 0 || sr == 0xff;
-    bool must_split = false;
-    // A virtual cell with no sign change still holds surface: refine until it resolves.
-    if ((!a.real && (a.signs == 0 || a.signs == 0xff)) || (!b.real && (b.signs == 0 || b.signs == 0xff)))
-      must_split = true;
-
-    // Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
-    // Table 1): two result crossings on one edge force a subdivision.
-    bool vis_a = false, vis_b = false;
-    const I3 lo = lattice_to_grid(cell.lat);
-    const i64 len = lattice_to_grid(cell.span());
-    for (int e = 0; e < 12 && !must_split; ++e) {
-      const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
-      const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
-      const EdgeCrossing ea = edge_crossing(a_, a, p, axis, len, c0, c1);
-      const EdgeCrossing eb = edge_crossing(b_, b, p, axis, len, c0, c1);
-      if ((!a.real && ea.count >= 2) || (!b.real && eb.count >= 2)) {
-        must_split = true;
-        break;
-      }
-      if (!ea.change && !eb.change) continue;
-      const bool a0 = (a.signs >> c0) & 1, b0 = (b.signs >> c0) & 1;
-      auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
-      auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
-      int n_r = 0;
-      if (ea.change && eb.change && ea.t == eb.t) {
-        n_r = apply(op_, a0, b0) != apply(op_, !a0, !b0);
-        vis_a = vis_b = vis_a || n_r;
-      } else {
-        if (ea.change) {
-          const bool vis = apply(op_, a0, in_b(ea.t)) != apply(op_, !a0, in_b(ea.t));
-          n_r += vis;
-          vis_a = vis_a || vis;
-        }
-        if (eb.change) {
-          const bool vis = apply(op_, in_a(eb.t), b0) != apply(op_, in_a(eb.t), !b0);
-          n_r += vis;
-          vis_b = vis_b || vis;
-        }
-      }
-      if (n_r >= 2) must_split = true;
-    }
-
-    // The QEFs are needed only when a vertex is made here (not when the cell splits).
-    Qef qa, qb, q;
-    bool have_q = false;
-    auto qefs = [&] {
-      if (have_q) return;
-      cell_qef(a_.tris, a.idx, cell, qa);
-      cell_qef(b_.tris, b.idx, cell, qb);
-      q = qa;
-      q += qb;
-      have_q = true;
-    };
-    auto vertex_of = [&](const Operand& x, const Side& s, const Qef& qs) {
-      if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
-      return cell_vertex(qs, cell, s.signs).position;
-    };
-    bool meets = false;
-    if (!must_split) {
-      for (size_t i = 0; i < a.idx.size() && !meets; ++i)
-        for (size_t j = 0; j < b.idx.size() && !meets; ++j)
-          meets = triangles_meet_in_box(a_.tris[a.idx[i]], b_.tris[b.idx[j]], cell.box());
-      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
-      const bool simple = at_cap || refinement_is_simple(cell, a, b, sr);
-      if (!meets && simple) {
-        // Triangle-fan culling: the surfaces do not meet here, so the result is one operand's
-        // cell, or uniform, when the signs agree.
-        if (!vis_a && !vis_b && r_uniform) return uniform(sr != 0);
-        if (vis_a && !vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
-        if (vis_b && !vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
-      } else if (meets && simple) {
-        // Q_sum = Q_A + Q_B minimized from the average of the two vertices (paper eq. 3).
-        qefs();
-        const Vec3 va = vertex_of(a_, a, qa), vb = vertex_of(b_, b, qb);
-        const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
-        const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
-        Qef::Solution sol = q.solve_in_box(seed, lo, hi);
-        if (!inside_cell(sol.position, cell)) sol = cell_vertex(q, cell, sr);
-        if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
-            feature_is_local(cell, sol.position))
-          return gray(cell, sr, sol.position, 0);
-      }
+    if (!unresolved(a) && !unresolved(b)) {
+      const EdgeVerdict ev = edge_verdict(op_, a_, a, b_, b, cell);
+      if (!ev.must_split)
+        if (const std::optional<Node> leaf = gray_leaf(cell, a, b, sr, ev, at_cap)) return *leaf;
     }
     if (at_cap) {
-      if (r_uniform) return uniform(sr != 0);
-      qefs();
-      const Vec3 seed = cell_vertex(q, cell, sr).position;
-      return gray(cell, sr, seed, kFlagCapped);
+      if (sr == 0 || sr == 0xff) return uniform(sr != 0);
+      const CellQefs q = cell_qefs(a_, a, b_, b, cell);
+      return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr).position, kFlagCapped);
     }
     return subdivide(cell, a, b);
   }
 
-  Fragment& out_;
+  /// The cell as one leaf, if it may be one: triangle-fan culling where the surfaces do not
+  /// meet, Q_sum's vertex where they do (paper eq. 3); nothing when the cell must split.
+  std::optional<Node> gray_leaf(const Cell& cell, const Side& a, const Side& b, uint8_t sr, const EdgeVerdict& ev,
+                                bool at_cap) {
+    const bool meets = surfaces_meet(a_, a, b_, b, cell);
+    const bool simple = at_cap || refinement_is_simple(op_, a_, a, b_, b, cell, sr);
+    if (!simple) return std::nullopt;
+    if (!meets) {
+      // The surfaces do not meet here, so the result is one operand's cell, or uniform, when
+      // the signs agree.
+      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
+      if (!ev.vis_a && !ev.vis_b && (sr == 0 || sr == 0xff)) return uniform(sr != 0);
+      if (ev.vis_a && !ev.vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
+      if (ev.vis_b && !ev.vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
+      return std::nullopt;
+    }
+    // Q_sum = Q_A + Q_B minimized from the average of the two vertices.
+    const CellQefs q = cell_qefs(a_, a, b_, b, cell);
+    const Vec3 va = operand_vertex(a_, a, q.a, cell), vb = operand_vertex(b_, b, q.b, cell);
+    const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
+    const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
+    Qef::Solution sol = q.sum.solve_in_box(seed, lo, hi);
+    if (!inside_cell(sol.position, cell)) sol = cell_vertex(q.sum, cell, sr);
+    if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
+        feature_is_local(a_, b_, cell, sol.position, error_, scratch_))
+      return out_.gray(cell, sr, sol.position, 0);
+    return std::nullopt;
+  }
+
+  FragmentWriter out_;
   Operand& a_;
   Operand& b_;
   CsgOp op_;
@@ -746,6 +814,94 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
+}
+
+/// Turns the stamped gray leaves without a sign change back into uniform leaves. Such a leaf
+/// is a crack repair (repair_cracks): a uniform leaf given a vertex so that the contour closes
+/// over the sign changes its finer neighbours show on its faces. The island and face passes
+/// take every gray leaf for a cell whose faces must look like one cell's, so they "fixed" those
+/// neighbours' signs to the repair's uniform ones: where an operand's repair leaf was copied
+/// into the result, that carved a slit as deep as the leaf into a flat face of the operand
+/// (issue 10, the Thingi10K pair). repair_cracks after the passes gives the leaves back their
+/// vertices where they still border a sign change.
+void withdraw_crack_repairs(Octree& t, uint32_t node, const std::function<bool(uint32_t)>& active) {
+  if (!active(node)) return;
+  Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal) {
+    for (int c = 0; c < 8; ++c) withdraw_crack_repairs(t, n.index + c, active);
+  } else if (n.kind == CellKind::Gray && (n.signs == 0 || n.signs == 0xff)) {
+    n = Node{0, n.signs != 0 ? CellKind::Black : CellKind::White, 0, 0, 0};
+  }
+}
+
+/// The leaf whose cell contains the finest-level cell at lattice point q (descending from the
+/// root), with its cell.
+std::pair<uint32_t, Cell> leaf_containing(const Octree& t, const Lat& q) {
+  uint32_t node = 0;
+  Cell cell;
+  while (t.nodes[node].kind == CellKind::Internal) {
+    const int64_t h = cell.span() / 2;
+    int c = 0;
+    for (int k = 0; k < 3; ++k)
+      if (q[k] >= cell.lat[k] + h) c |= 1 << k;
+    node = t.nodes[node].index + c;
+    cell = cell.child(c);
+  }
+  return {node, cell};
+}
+
+/// Removes specks: a lattice point whose sign differs from every other corner of every leaf
+/// around it is a closed shell one cell across (12 triangles), or a void as small. The
+/// Boolean makes them where the two operands' surfaces pass within a fraction of a cell of
+/// each other (the lattice point falls between two contours that the exact result keeps
+/// together, or at the thin end of a wedge): a feature thinner than the finest cell, which
+/// the octree cannot hold. Such a point takes its neighbours' sign. Returns how many points.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active) {
+  std::vector<Lat> candidates;
+  std::vector<uint32_t> path;
+  std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
+    if (!active(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth &&
+               (std::popcount(n.signs) == 1 || std::popcount(n.signs) == 7)) {
+      const uint8_t odd = std::popcount(n.signs) == 1 ? n.signs : uint8_t(~n.signs);
+      candidates.push_back(cell.corner(std::countr_zero(odd)));
+    }
+  };
+  collect(0, Cell{});
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  size_t removed = 0;
+  for (const Lat& p : candidates) {
+    std::array<std::pair<uint32_t, Cell>, 8> around;
+    bool speck = true;
+    int inside = -1;
+    for (int c = 0; c < 8 && speck; ++c) {
+      Lat q;
+      for (int k = 0; k < 3; ++k) q[k] = p[k] - ((c >> k) & 1) * step;
+      for (int k = 0; k < 3; ++k) speck = speck && q[k] >= 0 && q[k] + step <= kLimit;
+      if (!speck) break;
+      around[c] = leaf_containing(t, q);
+      const auto& [node, cell] = around[c];
+      const Node& n = t.nodes[node];
+      const int k = cell.corner_index(p);
+      if (n.kind != CellKind::Gray || k < 0 || !active(node)) {
+        speck = false;
+        break;
+      }
+      const int s = (n.signs >> k) & 1;
+      if (inside < 0) inside = s;
+      speck = s == inside && n.signs == (s ? uint8_t(1u << k) : uint8_t(~(1u << k)));
+    }
+    if (!speck) continue;
+    for (const auto& [node, cell] : around) t.nodes[node] = Node{0, inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+    ++removed;
+  }
+  return removed;
 }
 
 /// Drops unreachable nodes and vertices (left behind by in-place replacement).
@@ -880,6 +1036,9 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   const auto tclean = Clock::now();
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
+  // Crack repairs of the operands are redone on the result: as gray leaves they would pass
+  // for coarse neighbours that finer sign changes contradict (issue 10's slit).
+  withdraw_crack_repairs(a, 0, stamped);
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
@@ -887,6 +1046,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
     if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
+  remove_specks(a, stamped);
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);

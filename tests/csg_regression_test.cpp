@@ -1,0 +1,94 @@
+// CSG results against the exact Boolean of the operands' own contours (issue 10): the worst
+// cases the randomized harness (bench/csg_fuzz.cpp) found, kept by seed, and the Thingi10K
+// difference pair's slit and specks. The reference is CGAL's corefinement (test-only
+// dependency, tests/support/exact_csg.h).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "pic/pic.h"
+#include "support/csg_cases.h"
+#include "support/exact_csg.h"
+
+namespace pic {
+namespace {
+
+TriMesh written(const Octree& t) {
+  TriMesh m = contour(t);
+  split_nonmanifold(m);
+  return m;
+}
+
+struct Kept {
+  uint64_t seed;
+  double pic_to_exact, exact_to_pic;  // bounds, finest cells
+  const char* what;
+};
+
+// Each failed before the fix named: a component the exact result does not have.
+constexpr Kept kKept[] = {
+    {8, 1.5, 3.0, "torus union torus subtract box subtract cone: 4 components, 2 exact (specks)"},
+    {30, 1.5, 3.5, "box intersect torus: 4 components, 1 exact (specks along a thin tube)"},
+    {87, 1.5, 2.5, "cone subtract box: 2 components, 1 exact (a speck between nearly touching surfaces)"},
+};
+
+class HarnessCase : public ::testing::TestWithParam<Kept> {};
+
+TEST_P(HarnessCase, MatchesTheExactBoolean) {
+  static const std::vector<TriMesh> models = load_case_models(PIC_DATA_DIR);
+  const Kept kept = GetParam();
+  const CsgCase k = make_case(kept.seed, 0, models);
+  SampleOptions so;
+  so.depth = k.depth;
+  so.cube = Cube{{0, 0, 0}, 1};
+  std::vector<Octree> trees;
+  for (const TriMesh& m : k.inputs) trees.push_back(sample(m, so));
+  Octree acc = trees[0];
+  std::optional<TriMesh> exact = written(trees[0]);
+  for (size_t i = 1; i < trees.size(); ++i) {
+    acc = csg(acc, trees[i], k.ops[i - 1]);
+    exact = exact_boolean(*exact, written(trees[i]), k.ops[i - 1]);
+    ASSERT_TRUE(exact) << "CGAL refused case " << kept.seed;
+  }
+  const CsgComparison c = compare_to_exact(written(acc), *exact, 1.0 / double(1 << k.depth));
+  EXPECT_EQ(c.pic_components, c.exact_components) << k.text << " (" << kept.what << ")";
+  EXPECT_LE(c.pic_to_exact, kept.pic_to_exact) << k.text;
+  EXPECT_LE(c.exact_to_pic, kept.exact_to_pic) << k.text;
+}
+
+INSTANTIATE_TEST_SUITE_P(Kept, HarnessCase, ::testing::ValuesIn(kKept),
+                         [](const auto& info) { return "seed" + std::to_string(info.param.seed); });
+
+// The Thingi10K difference pair of issue 10 (1706459 − 1514499, sampled in one cube at depth
+// 12). Its meshes are not in this repository: the test runs where PIC_THINGI_DIR (or the
+// workplace's shared data folder) holds them. Without an exact reference (CGAL takes ~15 s
+// here): every point of the result's surface must lie near one operand's surface — the slit
+// (a crack repair of B taken for an island, 8 cells from both) did not — and the result has
+// as many components as the exact difference (4; the specks made 6).
+TEST(CsgRegression, ThingiPairHasNoSlitAndNoSpecks) {
+  const char* env = std::getenv("PIC_THINGI_DIR");
+  const std::filesystem::path dir = env ? env : "/work/shared/data";
+  const auto pa = dir / "thingi10k-1706459.obj", pb = dir / "thingi10k-1514499.obj";
+  if (!std::filesystem::exists(pa) || !std::filesystem::exists(pb)) GTEST_SKIP() << "no Thingi10K pair in " << dir;
+  const TriMesh a = read_mesh(pa), b = read_mesh(pb);
+  TriMesh both = a;
+  both.positions.insert(both.positions.end(), b.positions.begin(), b.positions.end());
+  SampleOptions so;
+  so.depth = 12;
+  so.cube = bounding_cube(both);
+  const Octree ta = sample(a, so), tb = sample(b, so);
+  const TriMesh r = written(csg(ta, tb, CsgOp::Subtract));
+  const double cell = so.cube->size / double(1 << so.depth);
+  const std::vector<Vec3> pts = sample_surface(r, 100000, 5);
+  const std::vector<double> da = distance_to_mesh(contour(ta), pts), db = distance_to_mesh(contour(tb), pts);
+  double worst = 0;
+  for (size_t i = 0; i < pts.size(); ++i) worst = std::max(worst, std::min(da[i], db[i]) / cell);
+  EXPECT_LT(worst, 3.0) << "a point of A − B's surface is " << worst << " cells from both operands";
+  EXPECT_EQ(check_validity(r, false).components, 4u);
+  std::printf("  [measure] Thingi A - B: %.2f cells from the operands at most, %zu components\n", worst,
+              check_validity(r, false).components);
+}
+
+}  // namespace
+}  // namespace pic
