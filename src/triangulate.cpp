@@ -133,6 +133,11 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
     // Every option of polygon i, with its vertices moved by up to kMaxPull finest cells (in one
     // round), stays inside the box of its vertices and its edge grown by that much. Rebuilt
     // after a round that moved vertices.
+    // How far a vertex may move in one round: a finest cell; in the last resort, 1/8 of its own
+    // cell's side when that is larger (the long triangles of a coarse cell's vertex cross a fine
+    // neighbour's folds by more than a finest cell).
+    bool last_resort = false;
+    auto reach = [&](uint32_t v) { return kMaxPull * (last_resort ? std::max(finest, cells[v].half / 4) : finest); };
     std::unique_ptr<BoxTree> tree;
     std::vector<Box> boxes(n);
     auto build_tree = [&](double room) {
@@ -147,9 +152,12 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         };
         grow(p.e1);
         for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
-        for (int a = 0; a < 3; ++a) {  // room for the vertex pulls below
-          b.lo[a] -= room;
-          b.hi[a] += room;
+        double r = 0;  // room for the vertex pulls below
+        if (room > 0)
+          for (int k = 0; k < p.count; ++k) r = std::max(r, reach(p.v[k]));
+        for (int a = 0; a < 3; ++a) {
+          b.lo[a] -= r;
+          b.hi[a] += r;
         }
         boxes[i] = b;
       });
@@ -423,7 +431,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
             const Vec3 d = sub3(target, was);
             const double len = norm3(d);
             if (!(len > 0)) continue;
-            const double f = std::min(1.0, step * finest / len);
+            const double f = std::min(1.0, step * reach(v) / len);
             Vec3 q;
             bool inside = true;
             for (int k = 0; k < 3; ++k) {
@@ -495,6 +503,16 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
           if (bi != oi0) dirty.push_back(i);
           if (bj != oj0) dirty.push_back(j);
         }
+      }
+      if (!changed && !last_resort) {
+        // What is left: let the vertices of coarse cells move further, and try everything once
+        // more (only the few polygons still crossing are tried).
+        last_resort = true;
+        moved = true;  // the tree needs the larger room
+        std::fill(settled.begin(), settled.end(), 0);
+        std::fill(joint_settled.begin(), joint_settled.end(), 0);
+        std::fill(vertex_settled.begin(), vertex_settled.end(), 0);
+        continue;
       }
       if (!changed) break;
     }
