@@ -225,6 +225,22 @@ bool triangles_intersect(const std::vector<Vec3>& x, const std::array<uint32_t, 
     const int drop = projection_axis(u, v, p);
     return drop >= 0 && orient2d(u, v, p, drop) * orient2d(u, v, q, drop) > 0;
   }
+  // Separating planes (exact): a triangle whose vertices other than the shared ones lie
+  // strictly on one side of the other's plane touches that plane at most in the shared vertex,
+  // so neither triangle's remaining edges can meet the other. Settles most pairs of a mesh in a
+  // few orientation tests.
+  auto one_side = [&](const std::array<uint32_t, 3>& t, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                      const std::array<uint32_t, 3>& other) {
+    int side = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (other[0] == t[k] || other[1] == t[k] || other[2] == t[k]) continue;
+      const int o = orient3d(p0, p1, p2, x[t[k]]);
+      if (o == 0 || (side != 0 && o != side)) return false;
+      side = o;
+    }
+    return true;
+  };
+  if (one_side(tb, a0, a1, a2, ta) || one_side(ta, b0, b1, b2, tb)) return false;
   if (shared == 1) {
     const int i = ia[0], j = ib[0];
     return segment_meets_triangle(x[tb[(j + 1) % 3]], x[tb[(j + 2) % 3]], a0, a1, a2) ||

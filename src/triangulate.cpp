@@ -21,6 +21,8 @@
 #include <numeric>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "box_tree.h"
 #include "contour.h"
 #include "predicates.h"
@@ -31,9 +33,9 @@ namespace {
 
 using Tri = std::array<uint32_t, 3>;
 
-/// Rounds of re-triangulation; each ends with one exact self-intersection pass over the mesh.
-/// Measured: fandisk, spot, CAD part and the CSG cases settle in 2-4 rounds.
-constexpr int kMaxRounds = 8;
+/// Rounds of re-triangulation; each starts by re-testing the polygons the previous one changed.
+/// A round changes options, or moves vertices, or changes pairs of polygons jointly.
+constexpr int kMaxRounds = 16;
 /// Largest vertex move, in finest cells. Moves are tried from 1/16 of it up and the least that
 /// works is kept; measured on spot (1,117 crossings at depth 12), 1/4 of a cell leaves 48 and
 /// 1/2 leaves 8, one cell none. The vertex stays inside its own cell either way.
@@ -128,27 +130,41 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         for (auto& v : t[k]) v = mid[v];
       return c;
     };
-    // Every option of polygon i, with its vertices moved by up to kMaxPull finest cells, stays
-    // inside the box of its vertices and its edge grown by that much.
+    // Every option of polygon i, with its vertices moved by up to kMaxPull finest cells (in one
+    // round), stays inside the box of its vertices and its edge grown by that much. Rebuilt
+    // after a round that moved vertices.
+    // How far a vertex may move in one round: a finest cell; in the last resort, 1/8 of its own
+    // cell's side when that is larger (the long triangles of a coarse cell's vertex cross a fine
+    // neighbour's folds by more than a finest cell).
+    bool last_resort = false;
+    auto reach = [&](uint32_t v) { return kMaxPull * (last_resort ? std::max(finest, cells[v].half / 4) : finest); };
+    std::unique_ptr<BoxTree> tree;
     std::vector<Box> boxes(n);
-    for (size_t i = 0; i < n; ++i) {
-      const MeshPolygon& p = polys[i];
-      Box b{p.e0, p.e0};
-      auto grow = [&](const Vec3& q) {
+    auto build_tree = [&](double room) {
+      tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+        const MeshPolygon& p = polys[i];
+        Box b{p.e0, p.e0};
+        auto grow = [&](const Vec3& q) {
+          for (int a = 0; a < 3; ++a) {
+            b.lo[a] = std::min(b.lo[a], q[a]);
+            b.hi[a] = std::max(b.hi[a], q[a]);
+          }
+        };
+        grow(p.e1);
+        for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
+        double r = 0;  // room for the vertex pulls below
+        if (room > 0)
+          for (int k = 0; k < p.count; ++k) r = std::max(r, reach(p.v[k]));
         for (int a = 0; a < 3; ++a) {
-          b.lo[a] = std::min(b.lo[a], q[a]);
-          b.hi[a] = std::max(b.hi[a], q[a]);
+          b.lo[a] -= r;
+          b.hi[a] += r;
         }
-      };
-      grow(p.e1);
-      for (int k = 0; k < p.count; ++k) grow(x[p.v[k]]);
-      for (int a = 0; a < 3; ++a) {  // room for the vertex pulls below
-        b.lo[a] -= kMaxPull * finest;
-        b.hi[a] += kMaxPull * finest;
-      }
-      boxes[i] = b;
-    }
-    const BoxTree tree(boxes);
+        boxes[i] = b;
+      });
+      tree = std::make_unique<BoxTree>(boxes);
+    };
+    // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
+    build_tree(0);
     // The other diagonal must not be an edge the mesh has (or may have) elsewhere: a polygon's
     // side or another quad's diagonal would become an edge of four triangles.
     std::vector<uint8_t> other_ok(n, 0);
@@ -198,7 +214,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       for (int a = 0; a < c; ++a)
         for (int b = a + 1; b < c; ++b) hits += triangles_intersect(xm, t[a], t[b]);
       for (int a = 0; a < c; ++a)
-        tree.query(tb[a], [&](uint32_t j) {
+        tree->query(tb[a], [&](uint32_t j) {
           if (j == i || j == except) return;
           std::array<Tri, 4> u;
           const int cu = merged_tris(j, opt[j], u);
@@ -207,46 +223,128 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         });
       return hits;
     };
+    // Crossings between polygon i under option oi and polygon j under option oj.
+    auto mutual = [&](uint32_t i, uint8_t oi, uint32_t j, uint8_t oj) {
+      std::array<Tri, 4> t, u;
+      const int c = merged_tris(i, oi, t), cu = merged_tris(j, oj, u);
+      size_t hits = 0;
+      for (int a = 0; a < c; ++a) {
+        const Box ta = box_of(xm, t[a]);
+        for (int b = 0; b < cu; ++b)
+          if (overlap(ta, box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
+      }
+      return hits;
+    };
     // The polygons around vertex v, counted together (a crossing between two of them twice).
     auto vertex_cost = [&](uint32_t v) {
       size_t c = 0;
       for (uint32_t k = first[v]; k < first[v + 1]; ++k) c += cost(around[k], uint32_t(-1));
       return c;
     };
-    std::vector<uint32_t> owner;
-    for (int round = 0;; ++round) {
-      TriMesh m;
-      m.positions = xm;
-      owner.clear();
-      for (size_t i = 0; i < n; ++i) {
-        std::array<Tri, 4> t;
-        const int c = merged_tris(i, opt[i], t);
-        for (int k = 0; k < c; ++k) {
-          m.triangles.push_back(t[k]);
-          owner.push_back(uint32_t(i));
+    // The crossings of the current triangulation, per polygon: partners with the number of
+    // crossing triangle pairs (symmetric), and crossings among its own triangles. Round 0 tests
+    // every polygon; later rounds only the polygons whose triangles changed (`dirty`), against
+    // their neighbours — the other polygons' pairs are unchanged.
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> crossing(n);
+    std::vector<uint32_t> self_hits(n, 0);
+    std::vector<uint8_t> is_dirty(n, 1);
+    // Polygons and vertices already tried whose neighbourhood has not changed since: trying
+    // them again would give the same answer.
+    std::vector<uint8_t> settled(n, 0), joint_settled(n, 0), vertex_settled(nv, 0);
+    std::vector<uint32_t> dirty(n);
+    std::iota(dirty.begin(), dirty.end(), 0u);
+    // Crossings of polygon i with the polygons `keep` accepts (and among its own triangles);
+    // zero-area triangles are skipped, as in the whole-mesh test.
+    auto crossings_of = [&](uint32_t i, auto&& keep, std::vector<std::pair<uint32_t, uint32_t>>& out, uint32_t& self) {
+      out.clear();
+      self = 0;
+      std::array<Tri, 4> t;
+      const int c = merged_tris(i, opt[i], t);
+      std::array<Box, 4> tb;
+      std::array<bool, 4> ok{};
+      for (int k = 0; k < c; ++k) {
+        ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
+        tb[k] = box_of(xm, t[k]);
+      }
+      for (int a = 0; a < c; ++a)
+        for (int b = a + 1; b < c; ++b) self += ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b]);
+      for (int a = 0; a < c; ++a) {
+        if (!ok[a]) continue;
+        tree->query(tb[a], [&](uint32_t j) {
+          if (j == i || !keep(j)) return;
+          std::array<Tri, 4> u;
+          const int cu = merged_tris(j, opt[j], u);
+          uint32_t hits = 0;
+          for (int b = 0; b < cu; ++b)
+            if (overlap(tb[a], box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0)
+              hits += triangles_intersect(xm, t[a], u[b]);
+          if (!hits) return;
+          auto it = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == j; });
+          if (it == out.end())
+            out.push_back({j, hits});
+          else
+            it->second += hits;
+        });
+      }
+    };
+    auto update_crossings = [&] {
+      std::sort(dirty.begin(), dirty.end());
+      dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
+      for (uint32_t i : dirty) is_dirty[i] = 1;
+      for (uint32_t i : dirty) {
+        for (const auto& [j, h] : crossing[i])
+          if (!is_dirty[j]) std::erase_if(crossing[j], [&](const auto& e) { return e.first == i; });
+        crossing[i].clear();
+      }
+      std::vector<std::vector<std::pair<uint32_t, uint32_t>>> found(dirty.size());
+      std::vector<uint32_t> found_self(dirty.size());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k < r.end(); ++k) {
+          const uint32_t i = dirty[k];
+          crossings_of(i, [&](uint32_t j) { return !is_dirty[j] || j > i; }, found[k], found_self[k]);
+        }
+      });
+      for (size_t k = 0; k < dirty.size(); ++k) {
+        const uint32_t i = dirty[k];
+        self_hits[i] = found_self[k];
+        for (const auto& [j, h] : found[k]) {
+          crossing[i].push_back({j, h});
+          crossing[j].push_back({i, h});
         }
       }
-      const auto pairs = self_intersecting_pairs(m);
-      if (round == 0) st.initial_intersections = pairs.size();
-      st.remaining_intersections = pairs.size();
-      st.rounds = round;
-      if (pairs.empty() || round == kMaxRounds) break;
-      std::vector<uint32_t> bad;
-      for (const auto& [a, b] : pairs) {
-        bad.push_back(owner[a]);
-        bad.push_back(owner[b]);
+      const bool all = dirty.size() == n;  // nothing was settled yet
+      for (uint32_t i : dirty) {
+        is_dirty[i] = 0;
+        if (!all)
+          tree->query(boxes[i], [&](uint32_t j) {
+            settled[j] = joint_settled[j] = 0;
+            for (int k = 0; k < polys[j].count; ++k) vertex_settled[polys[j].v[k]] = 0;
+          });
       }
-      std::sort(bad.begin(), bad.end());
-      bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+      dirty.clear();
+    };
+    bool moved = false;
+    for (int round = 0;; ++round) {
+      if (moved) build_tree(kMaxPull * finest);
+      moved = false;
+      update_crossings();
+      if (round == 0) build_tree(kMaxPull * finest);
+      size_t total = 0;
+      std::vector<uint32_t> bad;
+      for (uint32_t i = 0; i < n; ++i) {
+        total += self_hits[i];
+        for (const auto& e : crossing[i]) total += e.first > i ? e.second : 0;
+        if (self_hits[i] || !crossing[i].empty()) bad.push_back(i);
+      }
+      if (round == 0) st.initial_intersections = total;
+      st.remaining_intersections = total;
+      st.rounds = round;
+      if (total == 0 || round == kMaxRounds) break;
       // Partners: the polygons each bad polygon currently crosses.
       std::vector<std::pair<uint32_t, uint32_t>> partners;
-      for (const auto& [a, b] : pairs)
-        if (owner[a] != owner[b]) {
-          partners.push_back({owner[a], owner[b]});
-          partners.push_back({owner[b], owner[a]});
-        }
+      for (uint32_t i : bad)
+        for (const auto& e : crossing[i]) partners.push_back({i, e.first});
       std::sort(partners.begin(), partners.end());
-      partners.erase(std::unique(partners.begin(), partners.end()), partners.end());
       // Options that keep the surface where it is: the other diagonal only of a quad whose two
       // splits lie within kMaxDeviation of each other (the distance between its diagonals'
       // lines), the fan only when its point is that close to the current triangles' planes.
@@ -278,6 +376,8 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       };
       size_t changed = 0;
       for (uint32_t i : bad) {
+        if (settled[i]) continue;
+        settled[i] = 1;
         const uint8_t was = opt[i];
         uint8_t best = was;
         size_t best_cost = cost(i, uint32_t(-1));
@@ -291,32 +391,9 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
           }
         }
         opt[i] = best;
-        if (best != was) ++changed;
-        if (best_cost == 0) continue;
-        // Two polygons that cross may need to change together: try every pair of options
-        // with each partner (the pair's cost counts their mutual crossings once).
-        auto lo = std::lower_bound(partners.begin(), partners.end(), std::pair<uint32_t, uint32_t>{i, 0});
-        for (; lo != partners.end() && lo->first == i; ++lo) {
-          const uint32_t j = lo->second;
-          auto joint = [&] { return cost(i, uint32_t(-1)) + cost(j, i); };
-          const uint8_t oi0 = opt[i], oj0 = opt[j];
-          size_t best_joint = joint();
-          uint8_t bi = oi0, bj = oj0;
-          for (uint8_t oi : options(i))
-            for (uint8_t oj : options(j)) {
-              if ((oi == oi0 && oj == oj0) || best_joint == 0) continue;
-              opt[i] = oi;
-              opt[j] = oj;
-              const size_t c = joint();
-              if (c < best_joint) {
-                best_joint = c;
-                bi = oi;
-                bj = oj;
-              }
-            }
-          opt[i] = bi;
-          opt[j] = bj;
-          changed += (bi != oi0) + (bj != oj0);
+        if (best != was) {
+          ++changed;
+          dirty.push_back(i);
         }
       }
       if (changed) continue;
@@ -326,13 +403,13 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       // polygon neighbours, by 1/16 up to 1 finest cell, staying inside its cell — taking the
       // least move that removes the most crossings around it.
       std::vector<uint32_t> verts;
-      for (const auto& [a, b] : pairs)
-        for (uint32_t t : {a, b})
-          for (int k = 0; k < polys[owner[t]].count; ++k) verts.push_back(polys[owner[t]].v[k]);
+      for (uint32_t i : bad)
+        for (int k = 0; k < polys[i].count; ++k) verts.push_back(polys[i].v[k]);
       std::sort(verts.begin(), verts.end());
       verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
       for (uint32_t v : verts) {
-        if (copies[mid[v]] != 1) continue;  // a position shared by two vertices stays put
+        if (copies[mid[v]] != 1 || vertex_settled[v]) continue;  // a position shared by two vertices stays put
+        vertex_settled[v] = 1;
         const Vec3 was = xm[mid[v]];
         const size_t before = vertex_cost(v);
         if (before == 0) continue;
@@ -354,7 +431,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
             const Vec3 d = sub3(target, was);
             const double len = norm3(d);
             if (!(len > 0)) continue;
-            const double f = std::min(1.0, step * finest / len);
+            const double f = std::min(1.0, step * reach(v) / len);
             Vec3 q;
             bool inside = true;
             for (int k = 0; k < 3; ++k) {
@@ -375,8 +452,67 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         if (best != was) {
           x[v] = best;
           ++changed;
+          moved = true;
+          for (uint32_t k = first[v]; k < first[v + 1]; ++k) dirty.push_back(around[k]);
           ++st.moved_vertices;
         }
+      }
+      if (changed) continue;
+      // Two polygons that cross may need to change together: try every pair of options
+      // with each partner. Last resort before giving up (after the vertex moves): it costs
+      // up to 9 evaluations per partner.
+      for (uint32_t i : bad) {
+        if (joint_settled[i]) continue;
+        joint_settled[i] = 1;
+        if (self_hits[i] == 0 && crossing[i].empty()) continue;
+        // The pair's cost under (oi, oj) is i's crossings with everything but j, j's with
+        // everything but i, and their mutual ones: single costs (each against the other's
+        // current option) corrected by the mutual counts, which need no neighbour search.
+        auto lo = std::lower_bound(partners.begin(), partners.end(), std::pair<uint32_t, uint32_t>{i, 0});
+        for (; lo != partners.end() && lo->first == i; ++lo) {
+          const uint32_t j = lo->second;
+          const uint8_t oi0 = opt[i], oj0 = opt[j];
+          const std::vector<uint8_t> opts_i = options(i), opts_j = options(j);
+          std::array<size_t, 3> ci{}, cj{};
+          for (uint8_t o : opts_i) {
+            opt[i] = o;
+            ci[o] = cost(i, j);
+          }
+          opt[i] = oi0;
+          for (uint8_t o : opts_j) {
+            opt[j] = o;
+            cj[o] = cost(j, i);
+          }
+          opt[j] = oj0;
+          auto joint = [&](uint8_t oi, uint8_t oj) { return ci[oi] + cj[oj] + mutual(i, oi, j, oj); };
+          size_t best_joint = joint(oi0, oj0);
+          uint8_t bi = oi0, bj = oj0;
+          for (uint8_t oi : opts_i)
+            for (uint8_t oj : opts_j) {
+              if ((oi == oi0 && oj == oj0) || best_joint == 0) continue;
+              const size_t c = joint(oi, oj);
+              if (c < best_joint) {
+                best_joint = c;
+                bi = oi;
+                bj = oj;
+              }
+            }
+          opt[i] = bi;
+          opt[j] = bj;
+          changed += (bi != oi0) + (bj != oj0);
+          if (bi != oi0) dirty.push_back(i);
+          if (bj != oj0) dirty.push_back(j);
+        }
+      }
+      if (!changed && !last_resort) {
+        // What is left: let the vertices of coarse cells move further, and try everything once
+        // more (only the few polygons still crossing are tried).
+        last_resort = true;
+        moved = true;  // the tree needs the larger room
+        std::fill(settled.begin(), settled.end(), 0);
+        std::fill(joint_settled.begin(), joint_settled.end(), 0);
+        std::fill(vertex_settled.begin(), vertex_settled.end(), 0);
+        continue;
       }
       if (!changed) break;
     }
