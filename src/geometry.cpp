@@ -173,6 +173,36 @@ bool overlaps_box(const ITri& t, const I3& lo, const I3& hi) {
   return fmin <= 0 && fmax >= 0;
 }
 
+bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi) {
+  // Coordinates relative to the box centre (exact in double: below 2^33).
+  double v[3][3], half[3];
+  for (int k = 0; k < 3; ++k) {
+    const double c = (double(lo[k]) + double(hi[k])) / 2;
+    half[k] = (double(hi[k]) - double(lo[k])) / 2;
+    for (int i = 0; i < 3; ++i) v[i][k] = double(t.v[i][k]) - c;
+  }
+  for (int e = 0; e < 3; ++e) {
+    const double* a = v[e];
+    const double* b = v[(e + 1) % 3];
+    const double f[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    for (int k = 0; k < 3; ++k) {
+      // Axis = unit vector k x f: components (i, j) = (-f[j], f[i]) for (i, j) the other two.
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      double pmin = 1e300, pmax = -1e300, mag = 0;
+      for (const auto& w : v) {
+        const double p = -f[j] * w[i] + f[i] * w[j];
+        pmin = std::min(pmin, p);
+        pmax = std::max(pmax, p);
+        mag = std::max(mag, std::abs(f[j] * w[i]) + std::abs(f[i] * w[j]));
+      }
+      const double r = half[i] * std::abs(f[j]) + half[j] * std::abs(f[i]);
+      const double slack = 1e-12 * (mag + r) + 1;
+      if (pmin > r + slack || pmax < -r - slack) return false;
+    }
+  }
+  return true;
+}
+
 double clipped_area(const ITri& t, const IBox& box) {
   for (int k = 0; k < 3; ++k)
     if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return -1;

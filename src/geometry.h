@@ -69,6 +69,11 @@ int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& 
 
 /// Conservative overlap of a triangle with the closed box [lo, hi] (bbox + plane test, exact).
 bool overlaps_box(const ITri& t, const I3& lo, const I3& hi);
+/// False only when one of the 9 axes (box axis x triangle edge) clearly separates t from the
+/// closed box (floating point with a safety margin: "true" may still be apart). With
+/// overlaps_box it makes the separating-axis test complete, which long slivers need: their
+/// boxes and planes reach many cells their edges pass far from.
+bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi);
 
 /// Cell box in grid units.
 struct IBox {

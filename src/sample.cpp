@@ -118,7 +118,7 @@ void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
       // A triangle inside the child's box meets it; otherwise the exact plane test decides.
       const bool inside = t.lo[0] >= cb.lo[0] && t.lo[1] >= cb.lo[1] && t.lo[2] >= cb.lo[2] && t.hi[0] <= cb.hi[0] &&
                           t.hi[1] <= cb.hi[1] && t.hi[2] <= cb.hi[2];
-      if (inside || overlaps_box(t, cb.lo, cb.hi)) out[c].push_back(k);
+      if (inside || (overlaps_box(t, cb.lo, cb.hi) && edges_may_touch_box(t, cb.lo, cb.hi))) out[c].push_back(k);
     }
   }
 }
