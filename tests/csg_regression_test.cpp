@@ -84,7 +84,9 @@ TEST(CsgRegression, ThingiPairHasNoSlitAndNoSpecks) {
   const std::vector<double> da = distance_to_mesh(contour(ta), pts), db = distance_to_mesh(contour(tb), pts);
   double worst = 0;
   for (size_t i = 0; i < pts.size(); ++i) worst = std::max(worst, std::min(da[i], db[i]) / cell);
-  EXPECT_LT(worst, 3.0) << "a point of A − B's surface is " << worst << " cells from both operands";
+  // The slit was 8.3 cells deep. Below 3 cells before the intersection-free contour's last
+  // resort (a coarse cell's vertex may move 1/8 of its cell, up to ~1.5 finest cells here).
+  EXPECT_LT(worst, 4.5) << "a point of A − B's surface is " << worst << " cells from both operands";
   EXPECT_EQ(check_validity(r, false).components, 4u);
   std::printf("  [measure] Thingi A - B: %.2f cells from the operands at most, %zu components\n", worst,
               check_validity(r, false).components);
