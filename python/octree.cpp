@@ -177,6 +177,7 @@ py::dict sample_stats(const pic::SampleStats& st) {
   d["seconds"] = st.seconds;
   d["triangles_in"] = st.triangles_in;
   d["capped"] = st.capped;
+  d["depth_used"] = st.depth;
   d["inside"] = st.classifier;
   const auto& x = st.defects;
   defects["boundary_edges"] = x.boundary_edges;

@@ -10,6 +10,7 @@
 #include "pic/pic.h"
 #include "support/csg_cases.h"
 #include "support/exact_csg.h"
+#include "support/thingi_pair.h"
 
 namespace pic {
 namespace {
@@ -67,16 +68,12 @@ INSTANTIATE_TEST_SUITE_P(Kept, HarnessCase, ::testing::ValuesIn(kKept),
 // (a crack repair of B taken for an island, 8 cells from both) did not — and the result has
 // as many components as the exact difference (4; the specks made 6).
 TEST(CsgRegression, ThingiPairHasNoSlitAndNoSpecks) {
-  const char* env = std::getenv("PIC_THINGI_DIR");
-  const std::filesystem::path dir = env ? env : "/work/shared/data";
-  const auto pa = dir / "thingi10k-1706459.obj", pb = dir / "thingi10k-1514499.obj";
-  if (!std::filesystem::exists(pa) || !std::filesystem::exists(pb)) GTEST_SKIP() << "no Thingi10K pair in " << dir;
-  const TriMesh a = read_mesh(pa), b = read_mesh(pb);
-  TriMesh both = a;
-  both.positions.insert(both.positions.end(), b.positions.begin(), b.positions.end());
+  const auto pair = test::load_thingi_pair();
+  if (!pair) GTEST_SKIP() << "no Thingi10K pair (set PIC_THINGI_DIR)";
+  const auto& [a, b, cube] = *pair;
   SampleOptions so;
   so.depth = 12;
-  so.cube = bounding_cube(both);
+  so.cube = cube;
   const Octree ta = sample(a, so), tb = sample(b, so);
   const TriMesh r = written(csg(ta, tb, CsgOp::Subtract));
   const double cell = so.cube->size / double(1 << so.depth);

@@ -11,6 +11,7 @@
 #include "pic/pic.h"
 #include "pic/primitives.h"
 #include "support/mesh_checks.h"
+#include "support/thingi_pair.h"
 
 namespace pic {
 namespace {
@@ -185,14 +186,9 @@ TEST(Validity, SculptingRunStaysValid) {
 // meshes are not in this repository: the test runs where PIC_THINGI_DIR (or the workplace's
 // shared data folder) holds them, and is skipped elsewhere.
 TEST(Validity, ThingiDifferencePair) {
-  const char* env = std::getenv("PIC_THINGI_DIR");
-  const std::filesystem::path dir = env ? env : "/work/shared/data";
-  const auto pa = dir / "thingi10k-1706459.obj", pb = dir / "thingi10k-1514499.obj";
-  if (!std::filesystem::exists(pa) || !std::filesystem::exists(pb)) GTEST_SKIP() << "no Thingi10K pair in " << dir;
-  const TriMesh a = read_mesh(pa), b = read_mesh(pb);
-  TriMesh both = a;
-  both.positions.insert(both.positions.end(), b.positions.begin(), b.positions.end());
-  const Cube cube = bounding_cube(both);
+  const auto pair = test::load_thingi_pair();
+  if (!pair) GTEST_SKIP() << "no Thingi10K pair (set PIC_THINGI_DIR)";
+  const auto& [a, b, cube] = *pair;
   const Octree ta = sample_in(a, 10, cube), tb = sample_in(b, 10, cube);
   // No crossings, no pinched vertex: B's contour has sheets 0.7 cells apart that the split
   // makes two sheets with coincident copies, moved apart by a hair so that a reader merging
