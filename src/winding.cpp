@@ -177,18 +177,11 @@ uint32_t DipoleTree::build_range(uint32_t begin, uint32_t end, const std::functi
   return id;
 }
 
-double DipoleTree::exact(const Element& e, const Vec3& p, const I3* gp) const {
-  if (e.tri == UINT32_MAX) return dipole(p, e.centre, e.area, e.radius);
-  const auto& t = tris_[e.tri];
-  // The side of the plane by the exact, perturbed predicate (the one crossings use):
-  // det(a - p, b - p, c - p) = -(n . p - d).
-  return triangle_winding(p, t[0], t[1], t[2], [&] { return gp ? -plane_side(itris_[e.tri], *gp) : 0; });
-}
-
 DipoleTree::Value DipoleTree::evaluate(const Vec3& p, const I3* gp, double beta) const {
   // (inside() refines this adaptively; evaluate() is for values, e.g. gradients.)
   Value v;
   if (nodes_.empty()) return v;
+  AngleSum angles;
   uint32_t stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -202,12 +195,13 @@ DipoleTree::Value DipoleTree::evaluate(const Vec3& p, const I3* gp, double beta)
       continue;
     }
     if (n.count > 0) {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) v.w += exact(elems_[i], p, gp);
+      add_exact(n, p, gp, angles, v.w);
     } else {
       stack[top++] = n.right;
       stack[top++] = id + 1;
     }
   }
+  v.w += angles.turns();
   return v;
 }
 
@@ -219,6 +213,8 @@ void DipoleTree::add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum
       continue;
     }
     const auto& t = tris_[e.tri];
+    // The side of the plane by the exact, perturbed predicate (the one crossings use):
+    // det(a - p, b - p, c - p) = -(n . p - d).
     angles.add(triangle_angle_terms(p, t[0], t[1], t[2], [&] { return gp ? -plane_side(itris_[e.tri], *gp) : 0; }));
   }
 }
