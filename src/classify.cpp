@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <unordered_map>
 
 #include "vec3.h"
@@ -29,6 +30,11 @@ Vec3 unit_vec(const Vec3& v) {
   return l > 0 ? Vec3{v[0] / l, v[1] / l, v[2] / l} : Vec3{0, 0, 0};
 }
 
+I3 along(I3 p, int axis, i64 offset) {
+  p[axis] += offset;
+  return p;
+}
+
 /// Bisects the edge of `cell` from corner c0 to c1 (signs differ) for the sign change, with
 /// `inside_at(offset)` the sign at c0 + offset along the edge. Returns the unit-space point.
 template <class F>
@@ -39,9 +45,39 @@ Vec3 bisect_edge(const Cell& cell, int c0, int axis, bool s0, F&& inside_at) {
     const i64 mid = lo + (hi - lo) / 2;
     (inside_at(mid) == s0 ? lo : hi) = mid;
   }
-  I3 p = a;
-  p[axis] += lo + (hi - lo) / 2;
-  return to_unit(p);
+  return to_unit(along(a, axis, lo + (hi - lo) / 2));
+}
+
+/// The sign change on the edge of `cell` from corner c0 along `axis`, found on a smooth
+/// function instead of on decisions: `level(offset)` is |w| - 1/2 at c0 + offset, which is
+/// > 0 on c0's side (`s0` inside) and < 0 on the other when the approximate values agree with
+/// the decided signs. Regula falsi with the Illinois step needs 2-4 values where bisection
+/// needs 16 decisions, each of them a close call by construction. Returns nothing when the
+/// end values disagree with the signs (the caller bisects the decisions then).
+template <class G>
+std::optional<Vec3> level_on_edge(const Cell& cell, int c0, int axis, bool s0, G&& level) {
+  const double orient = s0 ? 1.0 : -1.0;  // f > 0 on c0's side
+  i64 lo = 0, hi = lattice_to_grid(cell.span());
+  double flo = orient * level(lo), fhi = orient * level(hi);
+  if (!(flo > 0) || !(fhi < 0)) return std::nullopt;
+  const i64 precision = std::max<i64>(1, hi / 1024);
+  int last = 0;  // which end moved last (Illinois: halve the other end's value when it repeats)
+  for (int it = 0; it < 8 && hi - lo > precision; ++it) {
+    const double t = flo / (flo - fhi);
+    const i64 x = std::clamp<i64>(lo + i64(std::llround(t * double(hi - lo))), lo + 1, hi - 1);
+    const double fx = orient * level(x);
+    if (fx > 0) {
+      lo = x, flo = fx;
+      if (last == 1) fhi /= 2;
+      last = 1;
+    } else {
+      hi = x, fhi = fx;
+      if (last == -1) flo /= 2;
+      last = -1;
+    }
+    if (std::abs(fx) < 1e-9) break;
+  }
+  return to_unit(along(lattice_to_grid(cell.corner(c0)), axis, lo + (hi - lo) / 2));
 }
 
 struct CacheEntry {
@@ -130,14 +166,23 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     int surface = 0;
     for (uint32_t k : idx) surface += (all_[k].use & kUseQef) && crosses(all_[k], a, axis, len);
     if (surface & 1) continue;  // the input's own surface changes the sign here
-    const Vec3 x = bisect_edge(cell, c0, axis, s0, [&](i64 off) {
+    auto winding_at = [&](i64 off) {
       int32_t w = (*wind)[c0];
       for (uint32_t k : idx)
         if (crosses(all_[k], a, axis, off)) w -= sgn(all_[k].n[axis]);
-      I3 p = a;
-      p[axis] += off;
-      return inside(p, w);
-    });
+      return w;
+    };
+    auto at = [&](i64 off) { return along(a, axis, off); };
+    // Without the input's surface on the edge, w is continuous along it (a cap's jump in the
+    // integer part cancels the cap's own jump).
+    std::optional<Vec3> level;
+    if (surface == 0)
+      level = level_on_edge(cell, c0, axis, s0, [&](i64 off) {
+        const I3 p = at(off);
+        return std::abs(double(winding_at(off)) - caps_.evaluate(to_unit(p), &p).w) - 0.5;
+      });
+    const Vec3 x =
+        level ? *level : bisect_edge(cell, c0, axis, s0, [&](i64 off) { return inside(at(off), winding_at(off)); });
     // Across a hole the level set's normal is the gradient of w: the field of the boundary.
     const Vec3 n = unit_vec(boundary_field(boundary_, x));
     if (n == Vec3{0, 0, 0}) continue;
@@ -332,11 +377,10 @@ void PointSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8*,
     const bool s0 = (signs >> c0) & 1;
     if (s0 == bool((signs >> c1) & 1)) continue;
     const I3 a = lattice_to_grid(cell.corner(c0));
-    const Vec3 x = bisect_edge(cell, c0, axis, s0, [&](i64 off) {
-      I3 p = a;
-      p[axis] += off;
-      return inside(p);
+    const auto level = level_on_edge(cell, c0, axis, s0, [&](i64 off) {
+      return std::abs(tree_.evaluate(to_unit(along(a, axis, off))).w) - 0.5;
     });
+    const Vec3 x = level ? *level : bisect_edge(cell, c0, axis, s0, [&](i64 off) { return inside(along(a, axis, off)); });
     const double h = cell.size() / 16;
     Vec3 grad;
     for (int k = 0; k < 3; ++k) {

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kInv4Pi = 1.0 / (4 * std::numbers::pi);
 constexpr double kBeta = 2.5;  // a node is far when its distance exceeds kBeta times its radius
-constexpr double kFirstBeta = 1.5;  // the first look: nearer nodes summarized too
+constexpr double kNearBeta = 1.5;  // inside(): nearer nodes are never summarized
 
 Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 Vec3 scale3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
@@ -222,23 +222,22 @@ void DipoleTree::add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum
 bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double tolerance) const {
   if (nodes_.empty()) return std::abs(offset) >= 0.5;
   if (tolerance >= 1) return std::abs(offset - evaluate(p, gp).w) >= 0.5;  // no decision can move
-  // Every node far enough is first summarized by its dipole, leaves included; a rigorous
-  // truncation bound says when that sum already decides |offset - w| >= 1/2 (most points).
-  // Otherwise the far leaves are summed exactly, then, while the decision is within the bound
-  // of the remaining (inner) far nodes, the one with the largest bound is opened, down to exact
-  // sums if need be, until that bound is below `tolerance`. Deterministic: it depends on p only.
+  // Nodes beyond kNearBeta radii are summarized by their dipoles, leaves included, each with a
+  // rigorous truncation bound. While the decision |offset - w| >= 1/2 is within the bounds'
+  // sum, the node with the largest bound is opened (its children replace it; a leaf is summed
+  // exactly), until the decision is clear — then it is the exact answer — or the bound is
+  // below `tolerance`. Deterministic: it depends on p only.
   struct Far {
     uint32_t node;
     double w, bound;
+    bool operator<(const Far& o) const { return bound < o.bound; }
   };
-  thread_local std::vector<Far> far;
-  far.clear();
+  thread_local std::vector<Far> heap;
+  heap.clear();
   AngleSum angles;
-  double w_far = 0, w_points = 0;
-  bool leaves_far = true;  // until the first refinement, far leaves are approximated too
-  double beta = kFirstBeta;
-  auto visit = [&](uint32_t id) {
-    // Opens `id`'s subtree down to nodes that are far enough (or exact leaves).
+  double w_far = 0, w_points = 0, bound = 0;
+  bool angles_changed = false, is_heap = false;  // the first look needs no order
+  auto open = [&](uint32_t id) {
     uint32_t stack[128];
     int n = 0;
     stack[n++] = id;
@@ -246,66 +245,48 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
       const uint32_t k = stack[--n];
       const DNode& nd = nodes_[k];
       const double d = norm3(sub3(nd.centre, p));
-      if (d > beta * nd.radius && nd.abs_area > 0 && (leaves_far || nd.count == 0)) {
-        far.push_back({k, far_field(nd, p), truncation_bound(nd, d)});
-        w_far += far.back().w;
+      if (d > kNearBeta * nd.radius && nd.abs_area > 0) {
+        const Far f{k, far_field(nd, p), truncation_bound(nd, d)};
+        heap.push_back(f);
+        if (is_heap) std::push_heap(heap.begin(), heap.end());
+        w_far += f.w;
+        bound += f.bound;
       } else if (nd.count > 0) {
         add_exact(nd, p, gp, angles, w_points);
+        angles_changed = true;
       } else {
         stack[n++] = nd.right;
         stack[n++] = k + 1;
       }
     }
   };
-  visit(0);
-  {
-    // The first look, with nearer nodes summarized too, decides most points; the others start
-    // again at the usual distance.
-    double bound = 0;
-    for (const Far& f : far) bound += f.bound;
-    const double w = w_far + w_points + angles.turns();
-    if (std::abs(std::abs(offset - w) - 0.5) > bound + 1e-9) return std::abs(offset - w) >= 0.5;
-    far.clear();
-    angles = AngleSum();
-    w_far = w_points = 0;
-    beta = kBeta;
-    visit(0);
-  }
+  open(0);
+  double turns = 0;
   for (;;) {
-    double bound = 0;
-    size_t worst = 0;
-    for (size_t i = 0; i < far.size(); ++i) {
-      bound += far[i].bound;
-      if (far[i].bound > far[worst].bound) worst = i;
-    }
-    const double w = w_far + w_points + angles.turns();
+    if (angles_changed) turns = angles.turns(), angles_changed = false;
+    const double w = w_far + w_points + turns;
     const double margin = std::abs(std::abs(offset - w) - 0.5);
-    // Rounding of the exact sums is far below 1e-9 for any mesh PIC can hold.
-    if (far.empty() || margin > bound + 1e-9) return std::abs(offset - w) >= 0.5;
-    if (leaves_far) {
-      // Leaves are summed exactly before any approximate decision is taken.
-      leaves_far = false;
-      size_t kept = 0;
-      for (const Far& f : far) {
-        const DNode& nd = nodes_[f.node];
-        if (nd.count > 0) {
-          w_far -= f.w;
-          add_exact(nd, p, gp, angles, w_points);
-        } else {
-          far[kept++] = f;
-        }
+    // Rounding of the exact sums, and of the running bound, is far below 1e-9.
+    if (heap.empty() || margin > bound + 1e-9 || bound < tolerance) return std::abs(offset - w) >= 0.5;
+    if (!is_heap) std::make_heap(heap.begin(), heap.end()), is_heap = true;
+    // Open the largest bounds until their sum has halved before looking again (each look
+    // costs an atan2).
+    const double target = bound / 2;
+    do {
+      std::pop_heap(heap.begin(), heap.end());
+      const Far f = heap.back();
+      heap.pop_back();
+      w_far -= f.w;
+      bound -= f.bound;
+      const DNode& nd = nodes_[f.node];
+      if (nd.count > 0) {
+        add_exact(nd, p, gp, angles, w_points);
+        angles_changed = true;
+      } else {
+        open(f.node + 1);
+        open(nd.right);
       }
-      far.resize(kept);
-      continue;
-    }
-    if (bound < tolerance) return std::abs(offset - w) >= 0.5;
-    const Far f = far[worst];
-    far[worst] = far.back();
-    far.pop_back();
-    w_far -= f.w;
-    const DNode& nd = nodes_[f.node];
-    visit(f.node + 1);
-    visit(nd.right);
+    } while (!heap.empty() && bound > target);
   }
 }
 
