@@ -194,7 +194,12 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         }
         boxes[i] = b;
       });
-      tree = std::make_unique<BoxTree>(boxes);
+      // The hierarchy of the first build serves every later one: vertices move by a cell at
+      // most, so refitting the boxes keeps the queries exact and costs no sorting.
+      if (tree)
+        tree->refit(boxes);
+      else
+        tree = std::make_unique<BoxTree>(boxes);
     };
     // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
     build_tree(0);
@@ -435,9 +440,34 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       // vertex of a crossing pair a little — toward its cell's centre or toward the mean of its
       // polygon neighbours, by 1/16 up to 1 finest cell, staying inside its cell — taking the
       // least move that removes the most crossings around it.
+      // Only a vertex of a crossing triangle can undo the crossing (moving any other leaves
+      // both triangles as they are), so only those are tried.
       std::vector<uint32_t> verts;
-      for (uint32_t i : bad)
-        for (int k = 0; k < polys[i].count; ++k) verts.push_back(polys[i].v[k]);
+      for (uint32_t i : bad) {
+        std::array<Tri, 4> t, raw;
+        const int c = merged_tris(i, opt[i], t);
+        P.triangles(i, opt[i], raw);
+        std::array<bool, 4> ok{}, hit{};
+        for (int k = 0; k < c; ++k) ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
+        for (int a = 0; a < c; ++a)
+          for (int b = a + 1; b < c; ++b)
+            if (ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b])) hit[a] = hit[b] = true;
+        for (const auto& [j, h] : crossing[i]) {
+          std::array<Tri, 4> u;
+          const int cu = merged_tris(j, opt[j], u);
+          for (int a = 0; a < c; ++a) {
+            if (!ok[a] || hit[a]) continue;
+            const Box ta = box_of(xm, t[a]);
+            for (int b = 0; b < cu && !hit[a]; ++b)
+              hit[a] = overlap(ta, box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0 &&
+                       triangles_intersect(xm, t[a], u[b]);
+          }
+        }
+        for (int a = 0; a < c; ++a)
+          if (hit[a])
+            for (uint32_t v : raw[a])
+              if (v < nv) verts.push_back(v);
+      }
       std::sort(verts.begin(), verts.end());
       verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
       for (uint32_t v : verts) {
