@@ -28,6 +28,23 @@ class BoxTree {
     std::iota(order_.begin(), order_.end(), 0u);
     if (!boxes.empty()) build(0, uint32_t(boxes.size()));
   }
+  /// Replaces the boxes (same count) and refits every node's box to them, keeping the
+  /// hierarchy: much cheaper than building anew when few boxes changed or all grew alike.
+  void refit(const std::vector<Box>& boxes) {
+    boxes_ = boxes;
+    // Children come after their parent in nodes_: refit from the back.
+    for (size_t id = nodes_.size(); id-- > 0;) {
+      N& n = nodes_[id];
+      if (n.count) {
+        Box b = boxes_[order_[n.first]];
+        for (uint32_t k = n.first + 1; k < n.first + n.count; ++k) grow(b, boxes_[order_[k]]);
+        n.box = b;
+      } else {
+        n.box = nodes_[n.first].box;
+        grow(n.box, nodes_[n.right].box);
+      }
+    }
+  }
   /// Calls f(j) for every box j > i overlapping box i.
   template <class F>
   void pairs_of(uint32_t i, F&& f) const {
@@ -56,6 +73,12 @@ class BoxTree {
   }
 
  private:
+  static void grow(Box& b, const Box& c) {
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = std::min(b.lo[a], c.lo[a]);
+      b.hi[a] = std::max(b.hi[a], c.hi[a]);
+    }
+  }
   struct N {
     Box box;
     uint32_t first, count, right;

@@ -235,9 +235,10 @@ std::array<uint8_t, 3> shade(const Camera& cam, const Vec3& normal, bool back) {
 }
 
 void draw_triangles(Canvas& cv, const Camera& cam, const TriMesh& mesh,
-                    const std::vector<ScreenPoint>& sp) {
+                    const std::vector<ScreenPoint>& sp, const std::vector<uint8_t>& marked) {
   const size_t nv = mesh.positions.size();
-  for (const auto& t : mesh.triangles) {
+  for (size_t ti = 0; ti < mesh.triangles.size(); ++ti) {
+    const auto& t = mesh.triangles[ti];
     if (t[0] >= nv || t[1] >= nv || t[2] >= nv) continue;  // validated by the caller
     const ScreenPoint &a = sp[t[0]], &b = sp[t[1]], &c = sp[t[2]];
     // Perspective: triangles crossing the near plane are dropped rather than clipped;
@@ -258,6 +259,7 @@ void draw_triangles(Canvas& cv, const Camera& cam, const TriMesh& mesh,
     // meet at equal depth, and float rounding would otherwise let back-face pixels through.
     const bool back = dot(n, cam.perspective ? sub(pa, cam.origin) : cam.forward) > 0;
     std::array<uint8_t, 3> col = shade(cam, mul(n, 1.0 / nl), back);
+    if (!marked.empty() && marked[ti]) col = {uint8_t(std::min(255, col[0] + 120)), uint8_t(col[1] / 3), uint8_t(col[2] / 3)};
 
     // Edge functions, normalised by the signed area so that they are barycentric weights
     // and positive inside whatever the winding on screen.
@@ -388,7 +390,12 @@ Image render(const TriMesh& mesh, const Octree* tree, const RenderOptions& opt) 
 
   std::vector<ScreenPoint> sp(mesh.positions.size());
   for (size_t i = 0; i < sp.size(); ++i) sp[i] = cam.project(mesh.positions[i]);
-  draw_triangles(cv, cam, mesh, sp);
+  std::vector<uint8_t> marked;
+  if (opt.highlight_crossings) {
+    marked.assign(mesh.triangles.size(), 0);
+    for (const auto& [a, c] : self_intersecting_pairs(mesh)) marked[a] = marked[c] = 1;
+  }
+  draw_triangles(cv, cam, mesh, sp, marked);
 
   if (opt.octree) {
     const std::array<uint8_t, 3> line_col{30, 34, 44};

@@ -21,6 +21,7 @@
 #include <numeric>
 #include <vector>
 
+#include <Eigen/Dense>
 #include <tbb/parallel_for.h>
 
 #include "box_tree.h"
@@ -42,6 +43,14 @@ constexpr int kMaxRounds = 16;
 constexpr double kMaxPull = 1.0;
 /// How far (in finest cells) the other diagonal or a fan may move the surface of a polygon.
 constexpr double kMaxDeviation = 0.25;
+/// How far (in finest cells) vertices of different cells that coincide are moved apart.
+constexpr double kSeparation = 1.0 / 64;
+/// How far (in finest cells) a last-resort move of a coarse vertex beyond a finest cell may take
+/// it off the planes of its triangles.
+constexpr double kFarMoveDeviation = 0.25;
+/// Directions along which the planes of a vertex's triangles vary less than this (relative
+/// eigenvalue of the sum of their normals' outer products) count as lying in all of them.
+constexpr double kNullCutoff = 0.05;
 
 enum Option : uint8_t { kPreferred = 0, kOtherDiagonal = 1, kFan = 2 };
 
@@ -102,6 +111,26 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
   TriangulationStats st;
 
   if (intersection_free && n > 0) {
+    // Two cells' vertices clamped to the same point (a corner or edge the cells share) are one
+    // vertex to a reader that merges equal positions: a pinch, and neither could move below.
+    // Each is moved a hair (kSeparation finest cells) toward its own cell's centre.
+    {
+      std::vector<uint32_t> perm(nv);
+      std::iota(perm.begin(), perm.end(), 0u);
+      std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
+      std::vector<uint32_t> shared;
+      for (size_t k = 0; k < perm.size(); ++k)
+        if ((k > 0 && x[perm[k]] == x[perm[k - 1]]) || (k + 1 < perm.size() && x[perm[k]] == x[perm[k + 1]]))
+          shared.push_back(perm[k]);
+      for (uint32_t v : shared) {
+        const Vec3 d = sub3(cells[v].center, x[v]);
+        const double len = norm3(d);
+        if (!(len > 0)) continue;
+        const double f = std::min(0.5, kSeparation * finest / len);
+        for (int a = 0; a < 3; ++a) x[v][a] += f * d[a];
+        ++st.moved_vertices;
+      }
+    }
     // Positions for the test: the vertices (bit-equal ones merged, as a reader of the file sees
     // them) followed by every polygon's candidate fan point.
     std::vector<Vec3> xm;
@@ -136,8 +165,12 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
     // How far a vertex may move in one round: a finest cell; in the last resort, 1/8 of its own
     // cell's side when that is larger (the long triangles of a coarse cell's vertex cross a fine
     // neighbour's folds by more than a finest cell).
-    bool last_resort = false;
+    // 0: none yet; 1: far moves that keep v on its triangles' planes; 2: any far move, the one
+    // that leaves those planes least among the ones that remove the most crossings.
+    int last_resort = 0;
     auto reach = [&](uint32_t v) { return kMaxPull * (last_resort ? std::max(finest, cells[v].half / 4) : finest); };
+    // Moves along a vertex's planes (last resort) may cross its whole cell.
+    auto room_of = [&](uint32_t v) { return last_resort ? std::max(reach(v), cells[v].half) : reach(v); };
     std::unique_ptr<BoxTree> tree;
     std::vector<Box> boxes(n);
     auto build_tree = [&](double room) {
@@ -154,14 +187,19 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
         for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
         double r = 0;  // room for the vertex pulls below
         if (room > 0)
-          for (int k = 0; k < p.count; ++k) r = std::max(r, reach(p.v[k]));
+          for (int k = 0; k < p.count; ++k) r = std::max(r, room_of(p.v[k]));
         for (int a = 0; a < 3; ++a) {
           b.lo[a] -= r;
           b.hi[a] += r;
         }
         boxes[i] = b;
       });
-      tree = std::make_unique<BoxTree>(boxes);
+      // The hierarchy of the first build serves every later one: vertices move by a cell at
+      // most, so refitting the boxes keeps the queries exact and costs no sorting.
+      if (tree)
+        tree->refit(boxes);
+      else
+        tree = std::make_unique<BoxTree>(boxes);
     };
     // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
     build_tree(0);
@@ -402,9 +440,34 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       // vertex of a crossing pair a little — toward its cell's centre or toward the mean of its
       // polygon neighbours, by 1/16 up to 1 finest cell, staying inside its cell — taking the
       // least move that removes the most crossings around it.
+      // Only a vertex of a crossing triangle can undo the crossing (moving any other leaves
+      // both triangles as they are), so only those are tried.
       std::vector<uint32_t> verts;
-      for (uint32_t i : bad)
-        for (int k = 0; k < polys[i].count; ++k) verts.push_back(polys[i].v[k]);
+      for (uint32_t i : bad) {
+        std::array<Tri, 4> t, raw;
+        const int c = merged_tris(i, opt[i], t);
+        P.triangles(i, opt[i], raw);
+        std::array<bool, 4> ok{}, hit{};
+        for (int k = 0; k < c; ++k) ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
+        for (int a = 0; a < c; ++a)
+          for (int b = a + 1; b < c; ++b)
+            if (ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b])) hit[a] = hit[b] = true;
+        for (const auto& [j, h] : crossing[i]) {
+          std::array<Tri, 4> u;
+          const int cu = merged_tris(j, opt[j], u);
+          for (int a = 0; a < c; ++a) {
+            if (!ok[a] || hit[a]) continue;
+            const Box ta = box_of(xm, t[a]);
+            for (int b = 0; b < cu && !hit[a]; ++b)
+              hit[a] = overlap(ta, box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0 &&
+                       triangles_intersect(xm, t[a], u[b]);
+          }
+        }
+        for (int a = 0; a < c; ++a)
+          if (hit[a])
+            for (uint32_t v : raw[a])
+              if (v < nv) verts.push_back(v);
+      }
       std::sort(verts.begin(), verts.end());
       verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
       for (uint32_t v : verts) {
@@ -426,12 +489,63 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
             }
         }
         for (double& r : ring) r /= count > 0 ? count : 1;
+        // Moves further than a finest cell (coarse vertices in the last resort) must keep the
+        // surface where it is: they go along the planes of v's triangles (their common null
+        // space: a flat face's plane, a crease's line) and are taken only if v stays within
+        // kFarMoveDeviation of every one of those planes.
+        std::vector<Vec3> normals;
+        std::vector<Vec3> targets{cells[v].center, ring};
+        std::vector<double> scale{reach(v), reach(v)};  // the largest move toward each target
+        // Moves along the planes keep the surface where it is, so they may cross the whole cell.
+        const double along_reach = room_of(v);
+        if (last_resort) {
+          Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+          for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+            std::array<Tri, 4> t;
+            const int c = merged_tris(around[k], opt[around[k]], t);
+            for (int a = 0; a < c; ++a) {
+              if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
+              const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
+              const double l = norm3(nn);
+              if (!(l > 0)) continue;
+              const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
+              normals.push_back({e[0], e[1], e[2]});
+              m += e * e.transpose();
+            }
+          }
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+          const Eigen::Vector3d ev = eig.eigenvalues();
+          for (size_t k = 0, c = targets.size(); k < c; ++k) {
+            const Eigen::Vector3d d(targets[k][0] - was[0], targets[k][1] - was[1], targets[k][2] - was[2]);
+            Eigen::Vector3d along = Eigen::Vector3d::Zero();
+            for (int a = 0; a < 3; ++a)
+              if (ev[a] < kNullCutoff * ev[2]) along += eig.eigenvectors().col(a) * eig.eigenvectors().col(a).dot(d);
+            if (along.norm() > 0) {
+              targets.push_back({was[0] + along[0], was[1] + along[1], was[2] + along[2]});
+              scale.push_back(along_reach);
+            }
+          }
+          // Straight along the planes both ways (an in-plane fold needs a sideways move).
+          for (int a = 0; a < 3; ++a)
+            if (ev[a] < kNullCutoff * ev[2])
+              for (double sgn : {-1.0, 1.0}) {
+                const Eigen::Vector3d e = sgn * along_reach * eig.eigenvectors().col(a);
+                targets.push_back({was[0] + e[0], was[1] + e[1], was[2] + e[2]});
+                scale.push_back(along_reach);
+              }
+        }
+        double best_deviation = 0;
+        auto deviation = [&](const Vec3& q) {
+          double w = 0;
+          for (const Vec3& nn : normals) w = std::max(w, std::abs(dot3(nn, sub3(q, was))));
+          return w;
+        };
         for (double step : {kMaxPull / 16, kMaxPull / 8, kMaxPull / 4, kMaxPull / 2, kMaxPull}) {
-          for (const Vec3& target : {cells[v].center, ring}) {
-            const Vec3 d = sub3(target, was);
+          for (size_t ti = 0; ti < targets.size(); ++ti) {
+            const Vec3 d = sub3(targets[ti], was);
             const double len = norm3(d);
             if (!(len > 0)) continue;
-            const double f = std::min(1.0, step * reach(v) / len);
+            const double f = std::min(1.0, step * scale[ti] / len);
             Vec3 q;
             bool inside = true;
             for (int k = 0; k < 3; ++k) {
@@ -439,14 +553,20 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
               inside = inside && std::abs(q[k] - cells[v].center[k]) <= cells[v].half;
             }
             if (!inside) continue;
+            const double dv = deviation(q);
+            // Stage 1 keeps every far move on the planes; stage 2 still the moves along them
+            // (which may go further than reach(v) only because they keep the surface).
+            const bool far = f * len > (last_resort == 1 ? kMaxPull * finest : reach(v));
+            if (far && dv > kFarMoveDeviation * finest) continue;
             xm[mid[v]] = q;
             const size_t c = vertex_cost(v);
-            if (c < best_cost) {
+            if (c < best_cost || (last_resort == 2 && c == best_cost && best != was && dv < best_deviation)) {
               best = q;
               best_cost = c;
+              best_deviation = dv;
             }
           }
-          if (best_cost == 0) break;
+          if (best_cost == 0 && (last_resort < 2 || best_deviation <= kFarMoveDeviation * finest)) break;
         }
         xm[mid[v]] = best;
         if (best != was) {
@@ -504,10 +624,10 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
           if (bj != oj0) dirty.push_back(j);
         }
       }
-      if (!changed && !last_resort) {
+      if (!changed && last_resort < 2) {
         // What is left: let the vertices of coarse cells move further, and try everything once
         // more (only the few polygons still crossing are tried).
-        last_resort = true;
+        ++last_resort;
         moved = true;  // the tree needs the larger room
         std::fill(settled.begin(), settled.end(), 0);
         std::fill(joint_settled.begin(), joint_settled.end(), 0);

@@ -161,6 +161,20 @@ TEST(Render, FlatShadingDistinguishesFaces) {
   EXPECT_EQ(big, 3u);
 }
 
+TEST(Render, CrossingTrianglesAreHighlighted) {
+  // Two boxes in one mesh cross along a loop; a single box crosses nothing.
+  TriMesh two = make_box({0, 0, 0}, {1, 1, 1});
+  const TriMesh b = make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});
+  const auto off = uint32_t(two.positions.size());
+  two.positions.insert(two.positions.end(), b.positions.begin(), b.positions.end());
+  for (auto t : b.triangles) two.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  RenderOptions o = ortho("iso");
+  EXPECT_EQ(red(render(two, nullptr, o)), 0u);  // off by default
+  o.highlight_crossings = true;
+  EXPECT_GT(red(render(two, nullptr, o)), 1000u);
+  EXPECT_EQ(red(render(make_box({0, 0, 0}, {1, 1, 1}), nullptr, o)), 0u);
+}
+
 /// A hand-built octree over the cube [0,2]^3: the root's four lower children (z < 1) are
 /// gray with a vertex in the cell centre, the upper four white.
 Octree make_tree() {

@@ -311,6 +311,11 @@ int main(int argc, char** argv) {
   cmd_render->add_option("--view", r_view, "iso|front|back|left|right|top|bottom")->capture_default_str();
   cmd_render->add_option("--camera", r_camera, "EX,EY,EZ,TX,TY,TZ,UX,UY,UZ (eye, target, up)");
   cmd_render->add_option("--depth", r_depth, "Sampling depth when the input is a mesh")->capture_default_str();
+  bool r_crossings = false;
+  cmd_render->add_flag("--crossings", r_crossings, "Draw triangles that cross another one in red (exact test)");
+  double r_half_extent = 0;
+  cmd_render->add_option("--half-extent", r_half_extent,
+                         "Close-up: world units from the image centre to its nearer border (centred on the --camera target)");
 
   // view
   auto* cmd_view = app.add_subcommand("view", "Write a self-contained interactive HTML viewer");
@@ -635,11 +640,16 @@ int main(int argc, char** argv) {
       ro.view = r_view;
       ro.octree = r_octree;
       ro.points = r_points;
+      ro.highlight_crossings = r_crossings;
       if (!r_camera.empty()) {
         const auto c = parse_numbers(r_camera, 9, "--camera");
         std::array<double, 9> cam;
         std::copy(c.begin(), c.end(), cam.begin());
         ro.camera = cam;
+      }
+      if (r_half_extent != 0) {
+        if (!(r_half_extent > 0) || !std::isfinite(r_half_extent)) throw pic::InvalidInput("--half-extent must be > 0");
+        ro.ortho_half_extent = r_half_extent;
       }
       pic::TriMesh mesh;
       const bool is_pic = r_in.size() > 4 && r_in.substr(r_in.size() - 4) == ".pic";

@@ -35,6 +35,9 @@ struct RenderOptions {
   bool octree = false;
   /// Draw representative vertices (or the mesh vertices if there is no tree) as red dots.
   bool points = false;
+  /// Draw the triangles that cross another one (pic::self_intersecting_pairs, exact) in red:
+  /// crossings are usually far below a pixel, this shows where they are.
+  bool highlight_crossings = false;
   /// Supersampling factor per axis (1 = none). 2 gives smooth edges at 4x the pixels.
   int supersample = 2;
 };
