@@ -127,6 +127,7 @@ int32_t WindingSource::ray_winding(const I3& p) const {
 
 bool WindingSource::inside(const I3& p, int32_t w) const {
   if (caps_.empty()) return w != 0;
+  if (const auto far = caps_.inside_far(to_unit(p), w)) return *far;
   if (const int known = cache_.find(p); known >= 0) return known;
   const bool in = caps_.inside(to_unit(p), &p, w, kCapTolerance);
   cache_.store(p, in);

@@ -1,5 +1,8 @@
 #include "mesh_repair.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <cstring>
 #include <unordered_map>
@@ -36,31 +39,38 @@ struct TriHash {
   }
 };
 
-// Triangles on each undirected edge, with the direction they traverse it.
-struct EdgeUses {
-  std::vector<uint32_t> tris;  // up to whatever count; the common case is 2
-  int net = 0;                 // traversals low->high minus high->low
+// Each triangle's traversal of each of its edges, sorted by undirected edge (then triangle):
+// the uses of one edge are a run. A sorted array, not a map of vectors: on a 69k-triangle mesh
+// the map's allocations cost 60 ms per table.
+struct EdgeUse {
+  uint64_t key;  // edge_key of the undirected edge
+  uint32_t tri;
+  int32_t dir;  // +1: the triangle traverses it low -> high, -1: high -> low
+  bool operator<(const EdgeUse& o) const { return key != o.key ? key < o.key : tri < o.tri; }
 };
-std::unordered_map<uint64_t, EdgeUses> edge_uses(const TriMesh& m) {
-  std::unordered_map<uint64_t, EdgeUses> edges;
-  edges.reserve(m.triangles.size() * 2);
-  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+std::vector<EdgeUse> edge_uses(const TriMesh& m) {
+  std::vector<EdgeUse> uses(m.triangles.size() * 3);
+  tbb::parallel_for(size_t{0}, m.triangles.size(), [&](size_t f) {
     const auto& t = m.triangles[f];
     for (int e = 0; e < 3; ++e) {
       const uint32_t a = t[e], b = t[(e + 1) % 3];
-      auto& u = edges[edge_key(a, b)];
-      u.tris.push_back(f);
-      u.net += a < b ? 1 : -1;
+      uses[3 * f + e] = {edge_key(a, b), uint32_t(f), a < b ? 1 : -1};
     }
-  }
-  return edges;
+  });
+  tbb::parallel_sort(uses.begin(), uses.end());
+  return uses;
 }
 
-// Whether triangle f traverses a -> b.
-bool traverses(const std::array<uint32_t, 3>& t, uint32_t a, uint32_t b) {
-  for (int e = 0; e < 3; ++e)
-    if (t[e] == a && t[(e + 1) % 3] == b) return true;
-  return false;
+// Calls f(key, first, count, net) for each undirected edge's run of uses.
+template <class F>
+void for_each_edge(const std::vector<EdgeUse>& uses, F&& f) {
+  for (size_t i = 0; i < uses.size();) {
+    size_t j = i;
+    int net = 0;
+    for (; j < uses.size() && uses[j].key == uses[i].key; ++j) net += uses[j].dir;
+    f(uses[i].key, &uses[i], j - i, net);
+    i = j;
+  }
 }
 
 double tri_area(const TriMesh& m, const std::array<uint32_t, 3>& t) {
@@ -69,15 +79,13 @@ double tri_area(const TriMesh& m, const std::array<uint32_t, 3>& t) {
 
 // Counts on a welded mesh without degenerate triangles; duplicates counted by the caller.
 void count_defects(const TriMesh& m, MeshDefects& d) {
-  const auto edges = edge_uses(m);
   UnionFind shells(m.triangles.size());
-  for (const auto& [key, u] : edges) {
-    const size_t n = u.tris.size();
+  for_each_edge(edge_uses(m), [&](uint64_t, const EdgeUse* u, size_t n, int net) {
     if (n == 1) ++d.boundary_edges;
     if (n > 2) ++d.nonmanifold_edges;
-    if (n == 2 && u.net != 0) ++d.inconsistent_edges;
-    for (size_t i = 1; i < n; ++i) shells.join(u.tris[i], u.tris[0]);
-  }
+    if (n == 2 && net != 0) ++d.inconsistent_edges;
+    for (size_t i = 1; i < n; ++i) shells.join(u[i].tri, u[0].tri);
+  });
   // Bounding boxes per shell; a sweep along x finds the first overlapping pair.
   std::unordered_map<size_t, std::array<Vec3, 2>> boxes;
   for (uint32_t f = 0; f < m.triangles.size(); ++f) {
@@ -167,16 +175,14 @@ CleanMesh clean_mesh(const TriMesh& input) {
   if (r.defects.inconsistent_edges == 0) return r;
   // Two classes per part linked through two-triangle edges: "as seeded" and "reversed
   // relative to the seed". Turn round whichever class has less area.
-  const auto edges = edge_uses(m);
   std::vector<std::vector<std::pair<uint32_t, bool>>> links(m.triangles.size());  // (other, same way)
-  for (const auto& [key, u] : edges) {
-    if (u.tris.size() != 2) continue;
-    const uint32_t f = u.tris[0], g = u.tris[1];
-    const uint32_t a = uint32_t(key >> 32), b = uint32_t(key);
-    const bool same = traverses(m.triangles[f], a, b) == traverses(m.triangles[g], a, b);
+  for_each_edge(edge_uses(m), [&](uint64_t, const EdgeUse* u, size_t n, int) {
+    if (n != 2) return;
+    const uint32_t f = u[0].tri, g = u[1].tri;
+    const bool same = u[0].dir == u[1].dir;
     links[f].push_back({g, same});
     links[g].push_back({f, same});
-  }
+  });
   std::vector<int8_t> cls(m.triangles.size(), -1);
   std::vector<uint32_t> part, stack;
   for (uint32_t seed = 0; seed < m.triangles.size(); ++seed) {
@@ -208,10 +214,10 @@ CleanMesh clean_mesh(const TriMesh& input) {
 
 std::vector<std::array<uint32_t, 2>> boundary_chain(const TriMesh& mesh) {
   std::vector<std::array<uint32_t, 2>> chain;
-  for (const auto& [key, u] : edge_uses(mesh)) {
+  for_each_edge(edge_uses(mesh), [&](uint64_t key, const EdgeUse*, size_t, int net) {
     const uint32_t lo = uint32_t(key >> 32), hi = uint32_t(key);
-    for (int k = 0; k < std::abs(u.net); ++k) chain.push_back(u.net > 0 ? std::array{lo, hi} : std::array{hi, lo});
-  }
+    for (int k = 0; k < std::abs(net); ++k) chain.push_back(net > 0 ? std::array{lo, hi} : std::array{hi, lo});
+  });
   // Deterministic order (the map's order is not).
   std::sort(chain.begin(), chain.end());
   return chain;

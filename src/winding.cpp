@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <optional>
 
 #include "vec3.h"
 
@@ -217,6 +218,32 @@ void DipoleTree::add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum
     // det(a - p, b - p, c - p) = -(n . p - d).
     angles.add(triangle_angle_terms(p, t[0], t[1], t[2], [&] { return gp ? -plane_side(itris_[e.tri], *gp) : 0; }));
   }
+}
+
+std::optional<bool> DipoleTree::inside_far(const Vec3& p, double offset) const {
+  if (nodes_.empty()) return std::abs(offset) >= 0.5;
+  // inside()'s first look, given up as soon as it would need an exact sum or many nodes.
+  constexpr int kMaxFar = 32;
+  uint32_t stack[128];
+  int n = 0, far = 0;
+  double w = 0, bound = 0;
+  stack[n++] = 0;
+  while (n > 0) {
+    const DNode& nd = nodes_[stack[--n]];
+    const double d = norm3(sub3(nd.centre, p));
+    if (d > kNearBeta * nd.radius && nd.abs_area > 0) {
+      if (++far > kMaxFar) return std::nullopt;
+      w += far_field(nd, p);
+      bound += truncation_bound(nd, d);
+    } else if (nd.count > 0) {
+      return std::nullopt;
+    } else {
+      stack[n++] = nd.right;
+      stack[n++] = uint32_t(&nd - nodes_.data()) + 1;
+    }
+  }
+  if (std::abs(std::abs(offset - w) - 0.5) > bound + 1e-9) return std::abs(offset - w) >= 0.5;
+  return std::nullopt;
 }
 
 bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double tolerance) const {

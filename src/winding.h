@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "geometry.h"
@@ -106,6 +107,9 @@ class DipoleTree {
   /// part computed by the caller). Far nodes are opened while the decision is within their
   /// truncation bound, until the bound is below `tolerance` (0: the decision is exact).
   bool inside(const Vec3& p, const I3* gp = nullptr, double offset = 0, double tolerance = 0) const;
+  /// The same decision when the dipoles of a few far nodes alone settle it (nothing otherwise):
+  /// cheaper than a memo lookup, so callers that memoize ask this first.
+  std::optional<bool> inside_far(const Vec3& p, double offset = 0) const;
 
  private:
   struct Element {
