@@ -20,6 +20,7 @@
 #include <chrono>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <tbb/parallel_for.h>
 
@@ -797,9 +798,44 @@ void stamp_under_surface(const PartialContour& a, const Octree& b, uint32_t nb, 
     for (int c = 0; c < 8; ++c) stamp_under_surface(a, b, y.index + c, cell.child(c), stamp, count, scratch);
 }
 
-/// The partial contour: dual polygons around stamped cells, indexed for box queries.
+/// Marks `node` and every node below it whose closed cell meets the closed lattice box
+/// [lo, hi].
+void mark_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                   std::unordered_set<uint32_t>& out) {
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  out.insert(node);
+  const Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal)
+    for (int c = 0; c < 8; ++c) mark_touching(t, n.index + c, cell.child(c), lo, hi, out);
+}
+
+/// The nodes around the stamped gray leaves coarser than the finest level: signs inside such
+/// a leaf come from crossing parity with the contour triangles in its cell, and a dual polygon
+/// of finer neighbours (none of them stamped) can cut through a corner of that cell. Without
+/// those triangles the parity is wrong over part of the cell (a box's coarse leaf took a
+/// cone's tip for outside the box: a stray shell 4 cells from the exact result).
+std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, uint32_t stamp) {
+  std::unordered_set<uint32_t> out;
+  std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
+    if (t.stamps[node] != stamp) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level < t.max_depth) {
+      mark_touching(t, 0, Cell{}, cell.lat, cell.corner(7), out);
+    }
+  };
+  walk(0, Cell{});
+  return out;
+}
+
+/// The partial contour: dual polygons around stamped cells and the cells next to stamped
+/// coarse leaves, indexed for box queries.
 void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
-  std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
+  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamp);
+  std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp || around.count(n) != 0; };
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
@@ -850,55 +886,120 @@ std::pair<uint32_t, Cell> leaf_containing(const Octree& t, const Lat& q) {
   return {node, cell};
 }
 
-/// Removes specks: a lattice point whose sign differs from every other corner of every leaf
-/// around it is a closed shell one cell across (12 triangles), or a void as small. The
-/// Boolean makes them where the two operands' surfaces pass within a fraction of a cell of
-/// each other (the lattice point falls between two contours that the exact result keeps
-/// together, or at the thin end of a wedge): a feature thinner than the finest cell, which
-/// the octree cannot hold. Such a point takes its neighbours' sign. Returns how many points.
-size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active) {
-  std::vector<Lat> candidates;
-  std::vector<uint32_t> path;
+/// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
+/// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
+/// void a cell or two across; `leaves` are the leaves around its points.
+struct Speck {
+  std::vector<Lat> points, rim;
+  std::vector<uint32_t> leaves;
+  bool inside = false;
+};
+
+/// At most this many lattice points make a speck: the Boolean's specks are 1-3 points (two
+/// surfaces passing within a fraction of a cell of each other); bigger regions are features.
+constexpr size_t kMaxSpeckPoints = 4;
+
+/// Corners of active finest-level gray leaves holding the leaf's minority sign (both signs
+/// when tied): where a speck's points must be.
+std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>& active) {
+  std::vector<Lat> out;
   std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
     if (!active(node)) return;
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth &&
-               (std::popcount(n.signs) == 1 || std::popcount(n.signs) == 7)) {
-      const uint8_t odd = std::popcount(n.signs) == 1 ? n.signs : uint8_t(~n.signs);
-      candidates.push_back(cell.corner(std::countr_zero(odd)));
+    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth && n.signs != 0 && n.signs != 0xff) {
+      const int in = std::popcount(n.signs);
+      for (int c = 0; c < 8; ++c)
+        if ((((n.signs >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
     }
   };
   collect(0, Cell{});
-  std::sort(candidates.begin(), candidates.end());
-  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The region of p's sign connected to p through shared leaves, if it is a speck: every leaf
+/// around its points gray with the point as a corner, one of them at least touched by this
+/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
+/// either way.
+std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>& active, const Lat& p,
+                                std::unordered_set<uint64_t>& seen) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  size_t removed = 0;
-  for (const Lat& p : candidates) {
-    std::array<std::pair<uint32_t, Cell>, 8> around;
-    bool speck = true;
-    int inside = -1;
-    for (int c = 0; c < 8 && speck; ++c) {
-      Lat q;
-      for (int k = 0; k < 3; ++k) q[k] = p[k] - ((c >> k) & 1) * step;
-      for (int k = 0; k < 3; ++k) speck = speck && q[k] >= 0 && q[k] + step <= kLimit;
-      if (!speck) break;
-      around[c] = leaf_containing(t, q);
-      const auto& [node, cell] = around[c];
-      const Node& n = t.nodes[node];
-      const int k = cell.corner_index(p);
-      if (n.kind != CellKind::Gray || k < 0 || !active(node)) {
-        speck = false;
-        break;
+  Speck sp;
+  std::vector<Lat> queue{p};
+  seen.insert(lattice_key(p));
+  bool ok = true, touched = false;
+  for (size_t i = 0; i < queue.size() && ok; ++i) {
+    const Lat q = queue[i];
+    for (int o = 0; o < 8 && ok; ++o) {
+      Lat c;
+      for (int k = 0; k < 3; ++k) {
+        c[k] = q[k] - ((o >> k) & 1) * step;
+        ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
       }
-      const int s = (n.signs >> k) & 1;
-      if (inside < 0) inside = s;
-      speck = s == inside && n.signs == (s ? uint8_t(1u << k) : uint8_t(~(1u << k)));
+      if (!ok) break;
+      const auto [node, cell] = leaf_containing(t, c);
+      const Node& n = t.nodes[node];
+      const int k0 = cell.corner_index(q);
+      ok = n.kind == CellKind::Gray && k0 >= 0;
+      if (!ok) break;
+      touched = touched || active(node);
+      if (i == 0 && o == 0) sp.inside = (n.signs >> k0) & 1;
+      sp.leaves.push_back(node);
+      for (int k = 0; k < 8; ++k) {
+        const Lat r = cell.corner(k);
+        const bool in = (n.signs >> k) & 1;
+        if (in != sp.inside) {
+          sp.rim.push_back(r);
+        } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
+          // A point seen before belongs to a region that was not a speck: so is this one.
+          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
+          queue.push_back(r);
+        }
+      }
     }
-    if (!speck) continue;
-    for (const auto& [node, cell] : around) t.nodes[node] = Node{0, inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+  }
+  if (!ok || !touched) return std::nullopt;
+  sp.points = std::move(queue);
+  std::sort(sp.leaves.begin(), sp.leaves.end());
+  sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
+  return sp;
+}
+
+/// Whether one operand alone shows the speck, so that it is that operand's own small
+/// component (which the exact Boolean keeps), not one the Boolean made: B's signs (as the
+/// operation sees them) give the result's pattern, or B is neutral over the whole speck (the
+/// result there is A, which then has the speck itself).
+bool speck_is_inherited(const Speck& sp, CsgOp op, const std::function<bool(const Lat&)>& sign_b) {
+  const bool neutral = op == CsgOp::Intersect;  // B's sign that leaves A's unchanged
+  bool all_neutral = true, b_shows = true;
+  auto check = [&](const Lat& p, bool result) {
+    const bool sb = sign_b(p);
+    all_neutral = all_neutral && sb == neutral;
+    b_shows = b_shows && (op == CsgOp::Subtract ? !sb : sb) == result;
+  };
+  for (const Lat& p : sp.points) check(p, sp.inside);
+  for (const Lat& p : sp.rim) check(p, !sp.inside);
+  return all_neutral || b_shows;
+}
+
+/// Removes specks the Boolean made: it makes them where the two operands' surfaces pass within
+/// a fraction of a cell of each other (lattice points fall between two contours that the exact
+/// result keeps together, or at the thin end of a wedge): a feature thinner than the finest
+/// cell, which the octree cannot hold. The speck's points take their neighbours' sign (its
+/// leaves become uniform). Returns how many specks.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active, CsgOp op,
+                     const std::function<bool(const Lat&)>& sign_b) {
+  std::unordered_set<uint64_t> seen;
+  size_t removed = 0;
+  for (const Lat& p : speck_candidates(t, active)) {
+    if (seen.count(lattice_key(p))) continue;
+    const std::optional<Speck> sp = grow_speck(t, active, p, seen);
+    if (!sp || speck_is_inherited(*sp, op, sign_b)) continue;
+    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
     ++removed;
   }
   return removed;
@@ -1046,7 +1147,11 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
     if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
-  remove_specks(a, stamped);
+  {
+    Operand ob(b, pb, stamp);
+    const std::function<bool(const Lat&)> sign_b = [&](const Lat& p) { return ob.sign(p); };
+    remove_specks(a, stamped, op, sign_b);
+  }
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);
