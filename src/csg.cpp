@@ -106,6 +106,12 @@ class SignMemo {
 struct PartialContour {
   std::vector<ITri> tris;
   TriangleBvh bvh;
+  /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
+  /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
+  /// crossings keep to `tris`, the operation's own cells.
+  bool wider = false;
+  std::vector<ITri> parity_tris;
+  TriangleBvh parity_bvh;
 };
 
 /// One operand as seen by one task of an operation: its tree, its partial contour, and the
@@ -115,14 +121,19 @@ struct Operand {
   const PartialContour& pc;
   const std::vector<ITri>& tris;
   const TriangleBvh& bvh;
+  const std::vector<ITri>& parity_tris;
+  const TriangleBvh& parity_bvh;
   std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
+  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_parity_tris;  // the same, of parity_tris
   SignMemo memo;                                                  // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
   uint32_t stamp = 0;
 
   Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
-      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh), stamp(op_stamp) {}
+      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
+        parity_tris(contour.wider ? contour.parity_tris : contour.tris),
+        parity_bvh(contour.wider ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -130,13 +141,13 @@ struct Operand {
   /// right next to such corners (cached per leaf).
   int anchor_corner(uint32_t leaf, const Cell& cell) {
     if (const auto it = anchors.find(leaf); it != anchors.end()) return it->second;
-    const auto& idx = triangles_in(leaf, cell);
+    const auto& idx = parity_triangles_in(leaf, cell);
     int best = 0;
     double best_d = -1;
     for (int c = 0; c < 8; ++c) {
       const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
       double d = 1e300;
-      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, tris[k]));
+      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, parity_tris[k]));
       if (d > best_d) {
         best_d = d;
         best = c;
@@ -153,6 +164,17 @@ struct Operand {
       const IBox b = cell.box();
       bvh.query(tris, b.lo, b.hi, it->second);
       std::sort(it->second.begin(), it->second.end());  // deterministic order
+    }
+    return it->second;
+  }
+  /// The same for the triangles the parity walks cross.
+  const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
+    if (&parity_tris == &tris) return triangles_in(leaf, cell);
+    auto [it, fresh] = leaf_parity_tris.try_emplace(leaf);
+    if (fresh) {
+      const IBox b = cell.box();
+      parity_bvh.query(parity_tris, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());
     }
     return it->second;
   }
@@ -224,18 +246,18 @@ struct Operand {
     const uint64_t key = lattice_key(p);
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
-    const auto& idx = triangles_in(h.leaf, h.cell);
+    const auto& idx = parity_triangles_in(h.leaf, h.cell);
     const int c = anchor_corner(h.leaf, h.cell);
     bool s = (n.signs >> c) & 1;
     I3 a = lattice_to_grid(h.cell.corner(c));
     const I3 g = lattice_to_grid(p);
     for (int axis = 0; axis < 3; ++axis) {
       const i64 len = g[axis] - a[axis];
-      if (len > 0) s ^= count_crossings(tris, idx, a, axis, len) & 1;
+      if (len > 0) s ^= count_crossings(parity_tris, idx, a, axis, len) & 1;
       if (len < 0) {
         I3 b = a;
         b[axis] = g[axis];
-        s ^= count_crossings(tris, idx, b, axis, -len) & 1;
+        s ^= count_crossings(parity_tris, idx, b, axis, -len) & 1;
       }
       a[axis] = g[axis];
     }
@@ -831,16 +853,14 @@ std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, uint32_t stam
   return out;
 }
 
-/// The partial contour: dual polygons around stamped cells and the cells next to stamped
-/// coarse leaves, indexed for box queries.
-void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
-  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamp);
-  std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp || around.count(n) != 0; };
+/// Dual polygons around the `active` cells, as grid-unit triangles.
+std::vector<ITri> contour_around(const Octree& t, const std::function<bool(uint32_t)>& active) {
+  std::vector<ITri> tris;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
     auto add = [&](int i, int j, int k) {
-      x.tris.push_back(make_itri(g[i], g[j], g[k]));
+      tris.push_back(make_itri(g[i], g[j], g[k]));
     };
     if (poly.count == 3) {
       add(0, 1, 2);
@@ -849,7 +869,19 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
     for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]})) add(tri[0], tri[1], tri[2]);
   };
   dual_walk(t, &active, emit);
+  return tris;
+}
+
+/// The partial contour: dual polygons around stamped cells, indexed for box queries; for the
+/// parity walks also those around the cells next to stamped coarse leaves.
+void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
+  x.tris = contour_around(t, [&](uint32_t n) { return t.stamps[n] == stamp; });
   x.bvh.build(x.tris);
+  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamp);
+  x.wider = !around.empty();
+  if (!x.wider) return;
+  x.parity_tris = contour_around(t, [&](uint32_t n) { return t.stamps[n] == stamp || around.count(n) != 0; });
+  x.parity_bvh.build(x.parity_tris);
 }
 
 /// Turns the stamped gray leaves without a sign change back into uniform leaves. Such a leaf
