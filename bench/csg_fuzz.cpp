@@ -146,10 +146,11 @@ void print(const CaseResult& c) {
   const CsgComparison& m = c.cmp;
   std::printf(
       "seed %llu depth %d: %s: components %zu/%zu, pic->exact %.2f cells at (%.4f %.4f %.4f), exact->pic %.2f cells at "
-      "(%.4f %.4f %.4f), volume %+.2e, %.2f s / %.2f s\n",
+      "(%.4f %.4f %.4f), volume %+.2e, %.2f s / %.2f s, thick %.2f at (%.4f %.4f %.4f)\n",
       (unsigned long long)c.seed, c.depth, c.text.c_str(), m.pic_components, m.exact_components, m.pic_to_exact,
       m.worst_pic[0], m.worst_pic[1], m.worst_pic[2], m.exact_to_pic, m.worst_exact[0], m.worst_exact[1],
-      m.worst_exact[2], m.volume_rel, c.pic_seconds, c.exact_seconds);
+      m.worst_exact[2], m.volume_rel, c.pic_seconds, c.exact_seconds, m.exact_to_pic_thick, m.worst_thick[0],
+      m.worst_thick[1], m.worst_thick[2]);
   std::fflush(stdout);
 }
 
@@ -211,5 +212,7 @@ int main(int argc, char** argv) {
   });
   worst("PIC -> exact distance (slits, specks)", [](const CaseResult& c) { return c.cmp.pic_to_exact; });
   worst("exact -> PIC distance (cut-off wedges)", [](const CaseResult& c) { return c.cmp.exact_to_pic; });
+  worst("exact -> PIC distance where the exact solid is thicker than a cell",
+        [](const CaseResult& c) { return c.cmp.exact_to_pic_thick; });
   return 0;
 }

@@ -20,6 +20,7 @@
 #include <chrono>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <tbb/parallel_for.h>
 
@@ -105,6 +106,12 @@ class SignMemo {
 struct PartialContour {
   std::vector<ITri> tris;
   TriangleBvh bvh;
+  /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
+  /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
+  /// crossings keep to `tris`, the operation's own cells.
+  bool wider = false;
+  std::vector<ITri> parity_tris;
+  TriangleBvh parity_bvh;
 };
 
 /// One operand as seen by one task of an operation: its tree, its partial contour, and the
@@ -114,14 +121,19 @@ struct Operand {
   const PartialContour& pc;
   const std::vector<ITri>& tris;
   const TriangleBvh& bvh;
+  const std::vector<ITri>& parity_tris;
+  const TriangleBvh& parity_bvh;
   std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
+  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_parity_tris;  // the same, of parity_tris
   SignMemo memo;                                                  // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
   uint32_t stamp = 0;
 
   Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
-      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh), stamp(op_stamp) {}
+      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
+        parity_tris(contour.wider ? contour.parity_tris : contour.tris),
+        parity_bvh(contour.wider ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -129,13 +141,13 @@ struct Operand {
   /// right next to such corners (cached per leaf).
   int anchor_corner(uint32_t leaf, const Cell& cell) {
     if (const auto it = anchors.find(leaf); it != anchors.end()) return it->second;
-    const auto& idx = triangles_in(leaf, cell);
+    const auto& idx = parity_triangles_in(leaf, cell);
     int best = 0;
     double best_d = -1;
     for (int c = 0; c < 8; ++c) {
       const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
       double d = 1e300;
-      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, tris[k]));
+      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, parity_tris[k]));
       if (d > best_d) {
         best_d = d;
         best = c;
@@ -152,6 +164,17 @@ struct Operand {
       const IBox b = cell.box();
       bvh.query(tris, b.lo, b.hi, it->second);
       std::sort(it->second.begin(), it->second.end());  // deterministic order
+    }
+    return it->second;
+  }
+  /// The same for the triangles the parity walks cross.
+  const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
+    if (&parity_tris == &tris) return triangles_in(leaf, cell);
+    auto [it, fresh] = leaf_parity_tris.try_emplace(leaf);
+    if (fresh) {
+      const IBox b = cell.box();
+      parity_bvh.query(parity_tris, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());
     }
     return it->second;
   }
@@ -223,18 +246,18 @@ struct Operand {
     const uint64_t key = lattice_key(p);
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
-    const auto& idx = triangles_in(h.leaf, h.cell);
+    const auto& idx = parity_triangles_in(h.leaf, h.cell);
     const int c = anchor_corner(h.leaf, h.cell);
     bool s = (n.signs >> c) & 1;
     I3 a = lattice_to_grid(h.cell.corner(c));
     const I3 g = lattice_to_grid(p);
     for (int axis = 0; axis < 3; ++axis) {
       const i64 len = g[axis] - a[axis];
-      if (len > 0) s ^= count_crossings(tris, idx, a, axis, len) & 1;
+      if (len > 0) s ^= count_crossings(parity_tris, idx, a, axis, len) & 1;
       if (len < 0) {
         I3 b = a;
         b[axis] = g[axis];
-        s ^= count_crossings(tris, idx, b, axis, -len) & 1;
+        s ^= count_crossings(parity_tris, idx, b, axis, -len) & 1;
       }
       a[axis] = g[axis];
     }
@@ -797,14 +820,64 @@ void stamp_under_surface(const PartialContour& a, const Octree& b, uint32_t nb, 
     for (int c = 0; c < 8; ++c) stamp_under_surface(a, b, y.index + c, cell.child(c), stamp, count, scratch);
 }
 
-/// The partial contour: dual polygons around stamped cells, indexed for box queries.
+/// Marks `node` and every node below it whose closed cell meets an edge of the lattice box
+/// [lo, hi]: meets the box, and holds one of its bounds along two axes.
+void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                         std::unordered_set<uint32_t>& out) {
+  const int64_t s = cell.span();
+  int bounds = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+    auto holds = [&](int64_t x) { return cell.lat[k] <= x && x <= cell.lat[k] + s; };
+    bounds += holds(lo[k]) || holds(hi[k]);
+  }
+  if (bounds < 2) return;
+  out.insert(node);
+  const Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal)
+    for (int c = 0; c < 8; ++c) mark_touching_edges(t, n.index + c, cell.child(c), lo, hi, out);
+}
+
+/// The nodes around the edges of the stamped gray leaves coarser than the finest level: signs
+/// inside such a leaf come from crossing parity with the contour triangles in its cell, and a
+/// dual polygon of finer neighbours (none of them stamped) can cut through a corner of that
+/// cell. Without those triangles the parity is wrong over part of the cell (a box's coarse
+/// leaf took a cone's tip for outside the box: a stray shell 4 cells from the exact result,
+/// harness seed 81). Only cells at the leaf's edges matter: a polygon's vertices lie in their
+/// cells, and cells that touch only the inside of one face all lie beyond that face's plane,
+/// and so do their polygons.
+std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, uint32_t stamp) {
+  std::unordered_set<uint32_t> out;
+  std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
+    if (t.stamps[node] != stamp) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level < t.max_depth) {
+      mark_touching_edges(t, 0, Cell{}, cell.lat, cell.corner(7), out);
+    }
+  };
+  walk(0, Cell{});
+  return out;
+}
+
+/// The partial contour: dual polygons around stamped cells, indexed for box queries; for the
+/// parity walks also those around the edges of stamped coarse leaves. One walk: a polygon
+/// with a stamped leaf is the operation's own.
 void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
-  std::function<bool(uint32_t)> active = [&](uint32_t n) { return t.stamps[n] == stamp; };
+  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamp);
+  const std::function<bool(uint32_t)> active = [&](uint32_t n) {
+    return t.stamps[n] == stamp || around.count(n) != 0;
+  };
+  std::vector<ITri> extra;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
+    bool own = false;
+    for (int k = 0; k < poly.count; ++k) own = own || t.stamps[poly.leaf[k]] == stamp;
+    std::vector<ITri>& out = own ? x.tris : extra;
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
     auto add = [&](int i, int j, int k) {
-      x.tris.push_back(make_itri(g[i], g[j], g[k]));
+      out.push_back(make_itri(g[i], g[j], g[k]));
     };
     if (poly.count == 3) {
       add(0, 1, 2);
@@ -814,6 +887,11 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
+  x.wider = !extra.empty();
+  if (!x.wider) return;
+  x.parity_tris = x.tris;
+  x.parity_tris.insert(x.parity_tris.end(), extra.begin(), extra.end());
+  x.parity_bvh.build(x.parity_tris);
 }
 
 /// Turns the stamped gray leaves without a sign change back into uniform leaves. Such a leaf
@@ -850,55 +928,120 @@ std::pair<uint32_t, Cell> leaf_containing(const Octree& t, const Lat& q) {
   return {node, cell};
 }
 
-/// Removes specks: a lattice point whose sign differs from every other corner of every leaf
-/// around it is a closed shell one cell across (12 triangles), or a void as small. The
-/// Boolean makes them where the two operands' surfaces pass within a fraction of a cell of
-/// each other (the lattice point falls between two contours that the exact result keeps
-/// together, or at the thin end of a wedge): a feature thinner than the finest cell, which
-/// the octree cannot hold. Such a point takes its neighbours' sign. Returns how many points.
-size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active) {
-  std::vector<Lat> candidates;
-  std::vector<uint32_t> path;
+/// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
+/// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
+/// void a cell or two across; `leaves` are the leaves around its points.
+struct Speck {
+  std::vector<Lat> points, rim;
+  std::vector<uint32_t> leaves;
+  bool inside = false;
+};
+
+/// At most this many lattice points make a speck: the Boolean's specks are 1-3 points (two
+/// surfaces passing within a fraction of a cell of each other); bigger regions are features.
+constexpr size_t kMaxSpeckPoints = 4;
+
+/// Corners of active finest-level gray leaves holding the leaf's minority sign (both signs
+/// when tied): where a speck's points must be.
+std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>& active) {
+  std::vector<Lat> out;
   std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
     if (!active(node)) return;
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth &&
-               (std::popcount(n.signs) == 1 || std::popcount(n.signs) == 7)) {
-      const uint8_t odd = std::popcount(n.signs) == 1 ? n.signs : uint8_t(~n.signs);
-      candidates.push_back(cell.corner(std::countr_zero(odd)));
+    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth && n.signs != 0 && n.signs != 0xff) {
+      const int in = std::popcount(n.signs);
+      for (int c = 0; c < 8; ++c)
+        if ((((n.signs >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
     }
   };
   collect(0, Cell{});
-  std::sort(candidates.begin(), candidates.end());
-  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The region of p's sign connected to p through shared leaves, if it is a speck: every leaf
+/// around its points gray with the point as a corner, one of them at least touched by this
+/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
+/// either way.
+std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>& active, const Lat& p,
+                                std::unordered_set<uint64_t>& seen) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  size_t removed = 0;
-  for (const Lat& p : candidates) {
-    std::array<std::pair<uint32_t, Cell>, 8> around;
-    bool speck = true;
-    int inside = -1;
-    for (int c = 0; c < 8 && speck; ++c) {
-      Lat q;
-      for (int k = 0; k < 3; ++k) q[k] = p[k] - ((c >> k) & 1) * step;
-      for (int k = 0; k < 3; ++k) speck = speck && q[k] >= 0 && q[k] + step <= kLimit;
-      if (!speck) break;
-      around[c] = leaf_containing(t, q);
-      const auto& [node, cell] = around[c];
-      const Node& n = t.nodes[node];
-      const int k = cell.corner_index(p);
-      if (n.kind != CellKind::Gray || k < 0 || !active(node)) {
-        speck = false;
-        break;
+  Speck sp;
+  std::vector<Lat> queue{p};
+  seen.insert(lattice_key(p));
+  bool ok = true, touched = false;
+  for (size_t i = 0; i < queue.size() && ok; ++i) {
+    const Lat q = queue[i];
+    for (int o = 0; o < 8 && ok; ++o) {
+      Lat c;
+      for (int k = 0; k < 3; ++k) {
+        c[k] = q[k] - ((o >> k) & 1) * step;
+        ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
       }
-      const int s = (n.signs >> k) & 1;
-      if (inside < 0) inside = s;
-      speck = s == inside && n.signs == (s ? uint8_t(1u << k) : uint8_t(~(1u << k)));
+      if (!ok) break;
+      const auto [node, cell] = leaf_containing(t, c);
+      const Node& n = t.nodes[node];
+      const int k0 = cell.corner_index(q);
+      ok = n.kind == CellKind::Gray && k0 >= 0;
+      if (!ok) break;
+      touched = touched || active(node);
+      if (i == 0 && o == 0) sp.inside = (n.signs >> k0) & 1;
+      sp.leaves.push_back(node);
+      for (int k = 0; k < 8; ++k) {
+        const Lat r = cell.corner(k);
+        const bool in = (n.signs >> k) & 1;
+        if (in != sp.inside) {
+          sp.rim.push_back(r);
+        } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
+          // A point seen before belongs to a region that was not a speck: so is this one.
+          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
+          queue.push_back(r);
+        }
+      }
     }
-    if (!speck) continue;
-    for (const auto& [node, cell] : around) t.nodes[node] = Node{0, inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+  }
+  if (!ok || !touched) return std::nullopt;
+  sp.points = std::move(queue);
+  std::sort(sp.leaves.begin(), sp.leaves.end());
+  sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
+  return sp;
+}
+
+/// Whether one operand alone shows the speck, so that it is that operand's own small
+/// component (which the exact Boolean keeps), not one the Boolean made: B's signs (as the
+/// operation sees them) give the result's pattern, or B is neutral over the whole speck (the
+/// result there is A, which then has the speck itself).
+bool speck_is_inherited(const Speck& sp, CsgOp op, const std::function<bool(const Lat&)>& sign_b) {
+  const bool neutral = op == CsgOp::Intersect;  // B's sign that leaves A's unchanged
+  bool all_neutral = true, b_shows = true;
+  auto check = [&](const Lat& p, bool result) {
+    const bool sb = sign_b(p);
+    all_neutral = all_neutral && sb == neutral;
+    b_shows = b_shows && (op == CsgOp::Subtract ? !sb : sb) == result;
+  };
+  for (const Lat& p : sp.points) check(p, sp.inside);
+  for (const Lat& p : sp.rim) check(p, !sp.inside);
+  return all_neutral || b_shows;
+}
+
+/// Removes specks the Boolean made: it makes them where the two operands' surfaces pass within
+/// a fraction of a cell of each other (lattice points fall between two contours that the exact
+/// result keeps together, or at the thin end of a wedge): a feature thinner than the finest
+/// cell, which the octree cannot hold. The speck's points take their neighbours' sign (its
+/// leaves become uniform). Returns how many specks.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active, CsgOp op,
+                     const std::function<bool(const Lat&)>& sign_b) {
+  std::unordered_set<uint64_t> seen;
+  size_t removed = 0;
+  for (const Lat& p : speck_candidates(t, active)) {
+    if (seen.count(lattice_key(p))) continue;
+    const std::optional<Speck> sp = grow_speck(t, active, p, seen);
+    if (!sp || speck_is_inherited(*sp, op, sign_b)) continue;
+    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
     ++removed;
   }
   return removed;
@@ -1046,7 +1189,11 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
     if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
-  remove_specks(a, stamped);
+  {
+    Operand ob(b, pb, stamp);
+    const std::function<bool(const Lat&)> sign_b = [&](const Lat& p) { return ob.sign(p); };
+    remove_specks(a, stamped, op, sign_b);
+  }
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);

@@ -4,14 +4,21 @@
 // bench/csg_fuzz.cpp.
 #pragma once
 
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Simple_cartesian.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <cmath>
+#include <limits>
+#include <boost/variant/get.hpp>
 #include <map>
 #include <numeric>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include "pic/pic.h"
@@ -124,6 +131,76 @@ inline std::vector<MeshComponent> mesh_components(const TriMesh& m) {
   return out;
 }
 
+/// Points on a mesh's surface (area-weighted, deterministic) with the triangle each lies on.
+struct SurfaceSample {
+  Vec3 p;
+  uint32_t triangle;
+};
+inline std::vector<SurfaceSample> sample_with_triangles(const TriMesh& m, size_t n, uint64_t seed) {
+  std::vector<double> cum(m.triangles.size());
+  double total = 0;
+  auto corner = [&](uint32_t f, int k) { return m.positions[m.triangles[f][k]]; };
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const Vec3 a = corner(f, 0), b = corner(f, 1), c = corner(f, 2);
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+    total += std::sqrt(x * x + y * y + z * z) / 2;
+    cum[f] = total;
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<SurfaceSample> out;
+  if (total <= 0) return out;
+  for (size_t i = 0; i < n; ++i) {
+    const auto f = uint32_t(std::lower_bound(cum.begin(), cum.end(), unit(rng) * total) - cum.begin());
+    if (f >= m.triangles.size()) continue;
+    double r1 = unit(rng), r2 = unit(rng);
+    if (r1 + r2 > 1) r1 = 1 - r1, r2 = 1 - r2;
+    const Vec3 a = corner(f, 0), b = corner(f, 1), c = corner(f, 2);
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = a[k] + r1 * (b[k] - a[k]) + r2 * (c[k] - a[k]);
+    out.push_back({p, f});
+  }
+  return out;
+}
+
+/// The solid's local size at each sample: along the surface normal, the distance to the mesh
+/// inward (how thick the solid is there: a wedge near its edge, a thin sheet) and outward (how
+/// wide the gap is: a thin slot); the smaller one. Infinite when neither ray hits.
+inline std::vector<double> local_size(const TriMesh& m, const std::vector<SurfaceSample>& samples) {
+  using K = CGAL::Simple_cartesian<double>;
+  using Tri = K::Triangle_3;
+  using Prim = CGAL::AABB_triangle_primitive<K, std::vector<Tri>::const_iterator>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Prim>>;
+  std::vector<Tri> tris;
+  tris.reserve(m.triangles.size());
+  auto pt = [&](uint32_t i) { return K::Point_3(m.positions[i][0], m.positions[i][1], m.positions[i][2]); };
+  for (const auto& t : m.triangles) tris.emplace_back(pt(t[0]), pt(t[1]), pt(t[2]));
+  Tree tree(tris.begin(), tris.end());
+  tree.accelerate_distance_queries();
+  std::vector<double> out;
+  out.reserve(samples.size());
+  for (const SurfaceSample& s : samples) {
+    const Tri& own = tris[s.triangle];
+    if (own.is_degenerate()) {
+      out.push_back(std::numeric_limits<double>::infinity());
+      continue;
+    }
+    const K::Vector_3 n = own.supporting_plane().orthogonal_vector();
+    const K::Point_3 p(s.p[0], s.p[1], s.p[2]);
+    double best = std::numeric_limits<double>::infinity();
+    for (const K::Vector_3& d : {n, -n}) {
+      const auto skip = [&](std::vector<Tri>::const_iterator it) { return &*it == &own; };
+      const auto hit = tree.first_intersection(K::Ray_3(p, d), skip);
+      if (!hit) continue;
+      if (const K::Point_3* q = boost::get<K::Point_3>(&hit->first))
+        best = std::min(best, std::sqrt(CGAL::squared_distance(p, *q)));
+    }
+    out.push_back(best);
+  }
+  return out;
+}
+
 /// PIC's result against the exact one. Distances in finest cells of the octree.
 struct CsgComparison {
   size_t pic_components = 0, exact_components = 0;
@@ -133,6 +210,11 @@ struct CsgComparison {
   double volume_rel = 0;       ///< (vol PIC − vol exact) / vol exact
   Vec3 worst_pic{0, 0, 0};     ///< the point of PIC's surface farthest from the exact one
   Vec3 worst_exact{0, 0, 0};   ///< the point of the exact surface farthest from PIC's
+  /// exact_to_pic over the points where the exact solid (or its gap) is at least a cell thick
+  /// along the normal: what is left once the resolution limit (one vertex per finest cell, so
+  /// nothing thinner than a cell) is set aside.
+  double exact_to_pic_thick = 0;
+  Vec3 worst_thick{0, 0, 0};
 };
 
 inline CsgComparison compare_to_exact(const TriMesh& pic_mesh, const TriMesh& exact, double cell,
@@ -160,6 +242,15 @@ inline CsgComparison compare_to_exact(const TriMesh& pic_mesh, const TriMesh& ex
   c.pic_to_exact = one_side(pic_mesh, exact, c.worst_pic);
   c.exact_to_pic = one_side(exact, pic_mesh, c.worst_exact);
   c.hausdorff = std::max(c.pic_to_exact, c.exact_to_pic);
+  const std::vector<SurfaceSample> es = sample_with_triangles(exact, samples, 778);
+  std::vector<Vec3> pts;
+  for (const auto& s : es) pts.push_back(s.p);
+  const std::vector<double> d = distance_to_mesh(pic_mesh, pts), size = local_size(exact, es);
+  for (size_t i = 0; i < d.size(); ++i)
+    if (size[i] >= cell && d[i] / cell > c.exact_to_pic_thick) {
+      c.exact_to_pic_thick = d[i] / cell;
+      c.worst_thick = pts[i];
+    }
   return c;
 }
 
