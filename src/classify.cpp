@@ -173,17 +173,17 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
         if (crosses(all_[k], a, axis, off)) w -= sgn(all_[k].n[axis]);
       return w;
     };
-    auto at = [&](i64 off) { return along(a, axis, off); };
     // Without the input's surface on the edge, w is continuous along it (a cap's jump in the
     // integer part cancels the cap's own jump).
     std::optional<Vec3> level;
     if (surface == 0)
       level = level_on_edge(cell, c0, axis, s0, [&](i64 off) {
-        const I3 p = at(off);
+        const I3 p = along(a, axis, off);
         return std::abs(double(winding_at(off)) - caps_.evaluate(to_unit(p), &p).w) - 0.5;
       });
-    const Vec3 x =
-        level ? *level : bisect_edge(cell, c0, axis, s0, [&](i64 off) { return inside(at(off), winding_at(off)); });
+    const Vec3 x = level ? *level : bisect_edge(cell, c0, axis, s0, [&](i64 off) {
+      return inside(along(a, axis, off), winding_at(off));
+    });
     // Across a hole the level set's normal is the gradient of w: the field of the boundary.
     const Vec3 n = unit_vec(boundary_field(boundary_, x));
     if (n == Vec3{0, 0, 0}) continue;

@@ -77,10 +77,11 @@ double tri_area(const TriMesh& m, const std::array<uint32_t, 3>& t) {
   return norm3(cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]])));
 }
 
-// Counts on a welded mesh without degenerate triangles; duplicates counted by the caller.
-void count_defects(const TriMesh& m, MeshDefects& d) {
+// Counts on a welded mesh without degenerate triangles (`uses`: its edge_uses); duplicates
+// counted by the caller.
+void count_defects(const TriMesh& m, const std::vector<EdgeUse>& uses, MeshDefects& d) {
   UnionFind shells(m.triangles.size());
-  for_each_edge(edge_uses(m), [&](uint64_t, const EdgeUse* u, size_t n, int net) {
+  for_each_edge(uses, [&](uint64_t, const EdgeUse* u, size_t n, int net) {
     if (n == 1) ++d.boundary_edges;
     if (n > 2) ++d.nonmanifold_edges;
     if (n == 2 && net != 0) ++d.inconsistent_edges;
@@ -171,12 +172,13 @@ CleanMesh clean_mesh(const TriMesh& input) {
   CleanMesh r;
   r.mesh = drop_repeats(weld(input), r.defects);
   TriMesh& m = r.mesh;
-  count_defects(m, r.defects);
+  const std::vector<EdgeUse> uses = edge_uses(m);
+  count_defects(m, uses, r.defects);
   if (r.defects.inconsistent_edges == 0) return r;
   // Two classes per part linked through two-triangle edges: "as seeded" and "reversed
   // relative to the seed". Turn round whichever class has less area.
   std::vector<std::vector<std::pair<uint32_t, bool>>> links(m.triangles.size());  // (other, same way)
-  for_each_edge(edge_uses(m), [&](uint64_t, const EdgeUse* u, size_t n, int) {
+  for_each_edge(uses, [&](uint64_t, const EdgeUse* u, size_t n, int) {
     if (n != 2) return;
     const uint32_t f = u[0].tri, g = u[1].tri;
     const bool same = u[0].dir == u[1].dir;

@@ -13,7 +13,6 @@ namespace pic::detail {
 namespace {
 
 constexpr double kInv4Pi = 1.0 / (4 * std::numbers::pi);
-constexpr double kBeta = 2.5;  // a node is far when its distance exceeds kBeta times its radius
 constexpr double kNearBeta = 1.5;  // inside(): nearer nodes are never summarized
 
 Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
@@ -220,6 +219,8 @@ void DipoleTree::add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum
   }
 }
 
+bool DipoleTree::summarized(const DNode& n, double d) { return d > kNearBeta * n.radius && n.abs_area > 0; }
+
 std::optional<bool> DipoleTree::inside_far(const Vec3& p, double offset) const {
   if (nodes_.empty()) return std::abs(offset) >= 0.5;
   // inside()'s first look, given up as soon as it would need an exact sum or many nodes.
@@ -229,9 +230,10 @@ std::optional<bool> DipoleTree::inside_far(const Vec3& p, double offset) const {
   double w = 0, bound = 0;
   stack[n++] = 0;
   while (n > 0) {
-    const DNode& nd = nodes_[stack[--n]];
+    const uint32_t k = stack[--n];
+    const DNode& nd = nodes_[k];
     const double d = norm3(sub3(nd.centre, p));
-    if (d > kNearBeta * nd.radius && nd.abs_area > 0) {
+    if (summarized(nd, d)) {
       if (++far > kMaxFar) return std::nullopt;
       w += far_field(nd, p);
       bound += truncation_bound(nd, d);
@@ -239,7 +241,7 @@ std::optional<bool> DipoleTree::inside_far(const Vec3& p, double offset) const {
       return std::nullopt;
     } else {
       stack[n++] = nd.right;
-      stack[n++] = uint32_t(&nd - nodes_.data()) + 1;
+      stack[n++] = k + 1;
     }
   }
   if (std::abs(std::abs(offset - w) - 0.5) > bound + 1e-9) return std::abs(offset - w) >= 0.5;
@@ -272,7 +274,7 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
       const uint32_t k = stack[--n];
       const DNode& nd = nodes_[k];
       const double d = norm3(sub3(nd.centre, p));
-      if (d > kNearBeta * nd.radius && nd.abs_area > 0) {
+      if (summarized(nd, d)) {
         const Far f{k, far_field(nd, p), truncation_bound(nd, d)};
         heap.push_back(f);
         if (is_heap) std::push_heap(heap.begin(), heap.end());

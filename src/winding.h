@@ -131,6 +131,8 @@ class DipoleTree {
   uint32_t build_classes(const std::vector<uint32_t>& starts, size_t first, uint32_t end);
   static double truncation_bound(const DNode& n, double d);
   static double far_field(const DNode& n, const Vec3& p);
+  /// Whether a decision (inside(), inside_far()) takes node `n`, at distance d, as its dipole.
+  static bool summarized(const DNode& n, double d);
   /// Adds leaf `n`'s exact sum: triangles' angles to `angles`, points' discs to `w`.
   void add_exact(const DNode& n, const Vec3& p, const I3* gp, AngleSum& angles, double& w) const;
   void build();

@@ -110,6 +110,20 @@ TriMesh written(const Octree& t) {
   return m;
 }
 
+/// The `--fast` contour (crossings kept) and the default one, with the latter's stats.
+struct TwoContours {
+  TriMesh plain, clean;
+  ContourStats stats;
+};
+TwoContours fast_and_default(const Octree& t) {
+  ContourOptions fast;
+  fast.intersection_free = false;
+  TwoContours r;
+  r.plain = contour(t, fast);
+  r.clean = contour(t, ContourOptions{}, &r.stats);
+  return r;
+}
+
 class ModelValidity : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ModelValidity, ContourIsAValidSolid) {
@@ -141,11 +155,7 @@ TEST(Validity, FastContourKeepsTheCrossingsTheDefaultRemoves) {
   SampleOptions o;
   o.depth = 10;
   const Octree t = sample(read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj"), o);
-  ContourOptions fast;
-  fast.intersection_free = false;
-  ContourStats st;
-  const TriMesh plain = contour(t, fast);
-  const TriMesh clean = contour(t, ContourOptions{}, &st);
+  const auto [plain, clean, st] = fast_and_default(t);
   EXPECT_GT(count_self_intersections(plain), 0u);
   EXPECT_EQ(count_self_intersections(clean), 0u);
   EXPECT_EQ(st.remaining_intersections, 0u);
@@ -210,11 +220,7 @@ TEST(Validity, LastResortMovesKeepTheSurface) {
   const auto pair = test::load_thingi_pair();
   if (!pair) GTEST_SKIP() << "no Thingi10K pair (set PIC_THINGI_DIR)";
   const Octree t = sample_in(pair->a, 11, pair->cube);
-  ContourOptions fast;
-  fast.intersection_free = false;
-  ContourStats st;
-  const TriMesh plain = contour(t, fast);
-  const TriMesh clean = contour(t, ContourOptions{}, &st);
+  const auto [plain, clean, st] = fast_and_default(t);
   EXPECT_EQ(count_self_intersections(clean), 0u);
   const double off = largest_move_off_planes(plain, clean, t.cube.size / 2048);
   std::printf("  [measure] Thingi A depth 11: %zu moved vertices, largest move off the plain planes %.3f cells\n",
