@@ -36,9 +36,7 @@ class BoxTree {
     for (size_t id = nodes_.size(); id-- > 0;) {
       N& n = nodes_[id];
       if (n.count) {
-        Box b = boxes_[order_[n.first]];
-        for (uint32_t k = n.first + 1; k < n.first + n.count; ++k) grow(b, boxes_[order_[k]]);
-        n.box = b;
+        n.box = span_of(n.first, n.first + n.count);
       } else {
         n.box = nodes_[n.first].box;
         grow(n.box, nodes_[n.right].box);
@@ -83,15 +81,16 @@ class BoxTree {
     Box box;
     uint32_t first, count, right;
   };
+  /// The union of the boxes order_[begin, end).
+  Box span_of(uint32_t begin, uint32_t end) const {
+    Box b = boxes_[order_[begin]];
+    for (uint32_t k = begin + 1; k < end; ++k) grow(b, boxes_[order_[k]]);
+    return b;
+  }
   uint32_t build(uint32_t begin, uint32_t end) {
     const uint32_t id = uint32_t(nodes_.size());
     nodes_.push_back({});
-    Box b = boxes_[order_[begin]];
-    for (uint32_t k = begin + 1; k < end; ++k)
-      for (int a = 0; a < 3; ++a) {
-        b.lo[a] = std::min(b.lo[a], boxes_[order_[k]].lo[a]);
-        b.hi[a] = std::max(b.hi[a], boxes_[order_[k]].hi[a]);
-      }
+    const Box b = span_of(begin, end);
     if (end - begin <= 4) {
       nodes_[id] = {b, begin, end - begin, 0};
       return id;

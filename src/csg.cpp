@@ -730,10 +730,9 @@ class Combiner {
   /// meet, Q_sum's vertex where they do (paper eq. 3); nothing when the cell must split.
   std::optional<Node> gray_leaf(const Cell& cell, const Side& a, const Side& b, uint8_t sr, const EdgeVerdict& ev,
                                 bool at_cap) {
-    const bool meets = surfaces_meet(a_, a, b_, b, cell);
     const bool simple = at_cap || refinement_is_simple(op_, a_, a, b_, b, cell, sr);
     if (!simple) return std::nullopt;
-    if (!meets) {
+    if (!surfaces_meet(a_, a, b_, b, cell)) {
       // The surfaces do not meet here, so the result is one operand's cell, or uniform, when
       // the signs agree.
       const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
