@@ -911,22 +911,6 @@ void withdraw_crack_repairs(Octree& t, uint32_t node, const std::function<bool(u
   }
 }
 
-/// The leaf whose cell contains the finest-level cell at lattice point q (descending from the
-/// root), with its cell.
-std::pair<uint32_t, Cell> leaf_containing(const Octree& t, const Lat& q) {
-  uint32_t node = 0;
-  Cell cell;
-  while (t.nodes[node].kind == CellKind::Internal) {
-    const int64_t h = cell.span() / 2;
-    int c = 0;
-    for (int k = 0; k < 3; ++k)
-      if (q[k] >= cell.lat[k] + h) c |= 1 << k;
-    node = t.nodes[node].index + c;
-    cell = cell.child(c);
-  }
-  return {node, cell};
-}
-
 /// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
 /// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
 /// void a cell or two across; `leaves` are the leaves around its points.
@@ -982,7 +966,7 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
         ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
       }
       if (!ok) break;
-      const auto [node, cell] = leaf_containing(t, c);
+      const auto [node, cell] = leaf_at(t, c);
       const Node& n = t.nodes[node];
       const int k0 = cell.corner_index(q);
       ok = n.kind == CellKind::Gray && k0 >= 0;

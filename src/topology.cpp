@@ -14,11 +14,6 @@ namespace {
 
 using Lat = std::array<int64_t, 3>;
 
-struct LeafRef {
-  uint32_t node;
-  Cell cell;
-};
-
 /// The node covering cell `target`, or the leaf above it; `path` gets the nodes from the
 /// root down to it.
 LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path = nullptr) {
@@ -37,10 +32,6 @@ LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path
   return {node, cell};
 }
 
-/// The leaf containing the finest lattice cell whose min corner is `q`.
-LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path = nullptr) {
-  return node_at(t, Cell{kMaxLevel, q}, path);
-}
 
 /// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
 /// in depth-first order.
@@ -112,6 +103,10 @@ void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
 }
 
 }  // namespace
+
+LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path) {
+  return node_at(t, Cell{kMaxLevel, q}, path);
+}
 
 namespace {
 

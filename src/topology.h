@@ -9,10 +9,20 @@
 #include <cstdint>
 #include <functional>
 #include <unordered_set>
+#include <vector>
 
 #include "octree_util.h"
 
 namespace pic::detail {
+
+/// A leaf (or node) and its cell.
+struct LeafRef {
+  uint32_t node;
+  Cell cell;
+};
+/// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the nodes
+/// from the root down to it.
+LeafRef leaf_at(const Octree& t, const std::array<int64_t, 3>& q, std::vector<uint32_t>* path = nullptr);
 
 /// Lattice points (key: x | y << 21 | z << 42) that remove_islands set in this operation, which
 /// enforce_one_component should not flip back when anything else will do.
