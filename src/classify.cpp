@@ -212,15 +212,15 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
   if (!wind || idx.size() > kMaxTested) return meets_cell(all_, idx, cell);
   const IBox box = cell.box();
   const i64 delta = std::max<i64>(1, (box.hi[0] - box.lo[0]) / 1024);
-  const Vec3 centre = to_unit({(box.lo[0] + box.hi[0]) / 2, (box.lo[1] + box.hi[1]) / 2, (box.lo[2] + box.hi[2]) / 2});
   for (uint32_t k : idx) {
     const ITri& t = all_[k];
-    if (!(t.use & kUseMeets) || is_degenerate(t) || clipped_area(t, box) < 0) continue;
-    // The triangle's point nearest the cell's centre, and one point on each side of it.
-    const Vec3 x = closest_point_on_triangle(centre, to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2]));
+    if (!(t.use & kUseMeets) || is_degenerate(t)) continue;
+    // A point of the triangle inside the cell, and one point on each side of it.
+    const std::optional<Vec3> x = point_in_box(t, box);
+    if (!x) continue;
     I3 side[2];
     for (int s = 0; s < 2; ++s) {
-      const I3 g = to_grid(x);
+      const I3 g = to_grid(*x);
       for (int a = 0; a < 3; ++a) {
         const i64 off = i64(std::llround((s ? -1.0 : 1.0) * t.unit_normal[a] * double(delta)));
         side[s][a] = std::clamp<i64>(g[a] + off, box.lo[a], box.hi[a]);

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "pic/pic.h"
@@ -89,6 +90,9 @@ inline IBox cell_box(int level, const std::array<int64_t, 3>& lat) {
 /// so it counts as 0; a piece of zero area inside the box counts as a tiny positive weight.
 /// Returns < 0 when the triangle does not meet the box. Double precision (used for QEFs).
 double clipped_area(const ITri& t, const IBox& box);
+/// A point of the triangle inside the closed box (the mean of the clipped polygon's corners),
+/// under the same convention; nothing when they do not meet.
+std::optional<Vec3> point_in_box(const ITri& t, const IBox& box);
 
 /// Parameter in [0,1] of the crossings of `t` on the segment (double; for directed distances).
 double crossing_param(const ITri& t, const I3& a, int axis, i64 len);
