@@ -3,12 +3,14 @@
 #include "classify.h"
 #include "mesh_repair.h"
 #include "topology.h"
+#include "vec3.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <unordered_map>
 
@@ -361,12 +363,60 @@ SampleParams params_of(const SampleOptions& options) {
   return p;
 }
 
-/// Runs the sampler from the root and assembles the tree. `settle`: the signs may change
-/// inside uniform leaves (a winding number's level set can cross a cell without touching its
-/// corners), so finer neighbours can show islands and cracks on their faces; the CSG
-/// clean-up settles them.
+/// Where a tree's signs may disagree between levels (islands, cracks): everywhere, or only
+/// within these unit-space boxes.
+struct SettleRegion {
+  bool everywhere = true;
+  std::vector<std::array<Vec3, 2>> boxes;
+};
+
+/// Per node: whether its cell meets one of the region's boxes (an ancestor of such a node
+/// does too, as the passes in topology.h need of an `active` filter).
+std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
+  std::vector<uint8_t> in(t.nodes.size(), 0);
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    const Vec3 lo = cell.min_unit();
+    const double s = cell.size();
+    bool meets = false;
+    for (const auto& [blo, bhi] : region.boxes) {
+      bool overlap = true;
+      for (int k = 0; k < 3 && overlap; ++k) overlap = lo[k] <= bhi[k] && blo[k] <= lo[k] + s;
+      if ((meets = overlap)) break;
+    }
+    if (!meets) return;
+    in[node] = 1;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+  };
+  walk(walk, 0, Cell{});
+  return in;
+}
+
+/// Settles the signs of a tree whose signs may change inside uniform leaves (a winding
+/// number's level set can cross a cell without touching its corners): finer neighbours can
+/// then show islands and cracks on their faces. The passes visit the region only, plus every
+/// leaf a flip touched.
+void settle_signs(Octree& tree, const SettleRegion& region) {
+  std::vector<uint8_t> in;
+  if (!region.everywhere) in = nodes_in(tree, region);
+  const std::function<bool(uint32_t)> active = [&](uint32_t n) { return in[n] != 0; };
+  const std::function<void(uint32_t)> touched = [&](uint32_t n) { in[n] = 1; };
+  const auto* a = region.everywhere ? nullptr : &active;
+  const auto* t = region.everywhere ? nullptr : &touched;
+  PinnedPoints pinned;
+  for (int round = 0; round < 4; ++round) {
+    const size_t islands = remove_islands(tree, a, t, &pinned);
+    // Leaves at the depth cap may hold two components anywhere: this pass is cheap, and global.
+    if (enforce_one_component(tree, nullptr, t, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
+  }
+  repair_cracks(tree, a);
+}
+
+/// Runs the sampler from the root and assembles the tree, then settles its signs in `settle`
+/// (nothing to settle: only the depth cap's two-component leaves are split).
 Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
-                  const Wind8* root_wind, size_t& capped, bool settle = false) {
+                  const Wind8* root_wind, size_t& capped, const SettleRegion* settle = nullptr) {
   std::vector<uint32_t> idx(src.tris().size());
   for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
   Builder b;
@@ -378,17 +428,36 @@ Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const 
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
   if (settle) {
-    PinnedPoints pinned;
-    for (int round = 0; round < 4; ++round) {
-      const size_t islands = remove_islands(tree, nullptr, nullptr, &pinned);
-      if (enforce_one_component(tree, nullptr, nullptr, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
-    }
-    repair_cracks(tree, nullptr);
+    settle_signs(tree, *settle);
   } else if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) {
     // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
     repair_cracks(tree, nullptr);
   }
   return tree;
+}
+
+/// Where the winding tree's signs can differ from crossing parity of input + caps: next to
+/// the caps. Outside a loop's convex hull its cap subtends less than a hemisphere, |w_C| < 1/2,
+/// so |w_int - w_C| >= 1/2 exactly when w_int != 0 — parity, which needs no settling. With
+/// overlapping shells or non-manifold edges, interior walls can end anywhere: everywhere.
+SettleRegion winding_settle_region(const CleanMesh& clean, const std::vector<std::array<uint32_t, 2>>& chain,
+                                   const std::vector<I3>& grid, int depth) {
+  SettleRegion r;
+  if (clean.defects.overlapping_shells || clean.defects.nonmanifold_edges > 0) return r;
+  r.everywhere = false;
+  // The margin covers the decisions' tolerance next to the loop (|w_C| close to 1/2 there).
+  const double cell = 1.0 / double(int64_t{1} << depth);
+  for (const auto& loop : boundary_loops(chain)) {
+    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (uint32_t v : loop) {
+      const Vec3 p = to_unit(grid[v]);
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    }
+    const double margin = 0.1 * norm3(sub3(hi, lo)) + 16 * cell;
+    for (int k = 0; k < 3; ++k) lo[k] -= margin, hi[k] += margin;
+    r.boxes.push_back({lo, hi});
+  }
+  return r;
 }
 
 Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
@@ -416,7 +485,8 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   uint8_t signs = 0;
   for (int c = 0; c < 8; ++c)
     signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
-  Octree tree = build_tree(src, options, cube, signs, &root_wind, capped, true);
+  const SettleRegion region = winding_settle_region(clean, chain, grid, options.depth);
+  Octree tree = build_tree(src, options, cube, signs, &root_wind, capped, &region);
   if (tree.vertices.empty())
     throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
   return tree;
@@ -503,7 +573,8 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
   const double spacing = src.spacing();
   if (spacing > 0) opt.depth = std::clamp(int(std::ceil(std::log2(2 / spacing))), 1, options.depth);
   size_t capped = 0;
-  Octree tree = build_tree(src, opt, cube, signs, nullptr, capped, true);
+  const SettleRegion everywhere;
+  Octree tree = build_tree(src, opt, cube, signs, nullptr, capped, &everywhere);
   if (tree.vertices.empty())
     throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
   if (stats) {
