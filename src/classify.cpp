@@ -108,8 +108,9 @@ void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, 
 
 // ---- triangle soups -----------------------------------------------------------------------
 
-WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary)
-    : all_(std::move(tris)), mesh_count_(mesh_count), boundary_(std::move(boundary)) {
+WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary,
+                             std::vector<Box> cap_boxes)
+    : all_(std::move(tris)), mesh_count_(mesh_count), cap_boxes_(cap_boxes), boundary_(std::move(boundary)) {
   tris_ = &all_;
   bvh_.build(all_);
   if (all_.size() > mesh_count_) caps_.build_triangles({all_.begin() + long(mesh_count_), all_.end()});
@@ -127,9 +128,16 @@ int32_t WindingSource::ray_winding(const I3& p) const {
 
 bool WindingSource::inside(const I3& p, int32_t w) const {
   if (caps_.empty()) return w != 0;
-  if (const auto far = caps_.inside_far(to_unit(p), w)) return *far;
+  // Outside a loop's convex hull its cap subtends less than a hemisphere (unless the loop,
+  // seen from p, winds twice round some direction), so |w_C| < 1/2 and |w - w_C| >= 1/2
+  // exactly when w != 0. Most decisions near the input's surface are settled here.
+  const Vec3 u = to_unit(p);
+  bool near_cap = false;
+  cap_boxes_.query({u, u}, [&](uint32_t) { near_cap = true; });
+  if (!near_cap) return w != 0;
+  if (const auto far = caps_.inside_far(u, w)) return *far;
   if (const int known = cache_.find(p); known >= 0) return known;
-  const bool in = caps_.inside(to_unit(p), &p, w, kCapTolerance);
+  const bool in = caps_.inside(u, &p, w, kCapTolerance);
   cache_.store(p, in);
   return in;
 }

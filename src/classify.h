@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "box_tree.h"
 #include "bvh.h"
 #include "sample.h"
 #include "winding.h"
@@ -37,8 +38,11 @@ class DecisionCache {
 
 class WindingSource : public SurfaceSource {
  public:
-  /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it.
-  WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary);
+  /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it;
+  /// `boundary`: the input's boundary edges; `cap_boxes`: a box around each boundary loop
+  /// (unit space), outside which the caps' solid angle is taken to be below 1/2.
+  WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary,
+                std::vector<Box> cap_boxes);
   void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
                         Wind27* wind) const override;
   bool tracks_winding() const override { return true; }
@@ -63,6 +67,7 @@ class WindingSource : public SurfaceSource {
   size_t mesh_count_;
   TriangleBvh bvh_;
   DipoleTree caps_;
+  BoxTree cap_boxes_;
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
   DecisionCache cache_;
 };

@@ -367,22 +367,19 @@ SampleParams params_of(const SampleOptions& options) {
 /// within these unit-space boxes.
 struct SettleRegion {
   bool everywhere = true;
-  std::vector<std::array<Vec3, 2>> boxes;
+  std::vector<Box> boxes;
 };
 
 /// Per node: whether its cell meets one of the region's boxes (an ancestor of such a node
 /// does too, as the passes in topology.h need of an `active` filter).
 std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
   std::vector<uint8_t> in(t.nodes.size(), 0);
+  const BoxTree boxes(region.boxes);
   auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
     const Vec3 lo = cell.min_unit();
     const double s = cell.size();
     bool meets = false;
-    for (const auto& [blo, bhi] : region.boxes) {
-      bool overlap = true;
-      for (int k = 0; k < 3 && overlap; ++k) overlap = lo[k] <= bhi[k] && blo[k] <= lo[k] + s;
-      if ((meets = overlap)) break;
-    }
+    boxes.query({lo, {lo[0] + s, lo[1] + s, lo[2] + s}}, [&](uint32_t) { meets = true; });
     if (!meets) return;
     in[node] = 1;
     const Node& n = t.nodes[node];
@@ -436,28 +433,21 @@ Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const 
   return tree;
 }
 
-/// Where the winding tree's signs can differ from crossing parity of input + caps: next to
-/// the caps. Outside a loop's convex hull its cap subtends less than a hemisphere, |w_C| < 1/2,
-/// so |w_int - w_C| >= 1/2 exactly when w_int != 0 — parity, which needs no settling. With
-/// overlapping shells or non-manifold edges, interior walls can end anywhere: everywhere.
-SettleRegion winding_settle_region(const CleanMesh& clean, const std::vector<std::array<uint32_t, 2>>& chain,
-                                   const std::vector<I3>& grid, int depth) {
-  SettleRegion r;
-  if (clean.defects.overlapping_shells || clean.defects.nonmanifold_edges > 0) return r;
-  r.everywhere = false;
-  // The margin covers the decisions' tolerance next to the loop (|w_C| close to 1/2 there).
-  const double cell = 1.0 / double(int64_t{1} << depth);
-  for (const auto& loop : boundary_loops(chain)) {
-    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+/// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
+std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
+                            double margin, double spread) {
+  std::vector<Box> out;
+  for (const auto& loop : loops) {
+    Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
     for (uint32_t v : loop) {
       const Vec3 p = to_unit(grid[v]);
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+      for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], p[k]), b.hi[k] = std::max(b.hi[k], p[k]);
     }
-    const double margin = 0.1 * norm3(sub3(hi, lo)) + 16 * cell;
-    for (int k = 0; k < 3; ++k) lo[k] -= margin, hi[k] += margin;
-    r.boxes.push_back({lo, hi});
+    const double grow = margin + spread * norm3(sub3(b.hi, b.lo));
+    for (int k = 0; k < 3; ++k) b.lo[k] -= grow, b.hi[k] += grow;
+    out.push_back(b);
   }
-  return r;
+  return out;
 }
 
 Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
@@ -476,7 +466,12 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   std::vector<std::array<Vec3, 2>> boundary;
   boundary.reserve(chain.size());
   for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
-  WindingSource src(std::move(tris), clean.mesh.triangles.size(), std::move(boundary));
+  // Caps decide signs only in their loops' boxes (two cells of slack): a box holds its loop's
+  // convex hull, outside which the signs are parity's (see WindingSource::inside).
+  const auto loops = boundary_loops(chain);
+  const double cell = 1.0 / double(int64_t{1} << options.depth);
+  WindingSource src(std::move(tris), clean.mesh.triangles.size(), std::move(boundary),
+                    loop_boxes(loops, grid, 2 * cell, 0));
   // Interior walls exist only where parts meet or overlap.
   if (clean.defects.shells > 1 || clean.defects.nonmanifold_edges > 0)
     st.interior_triangles = src.drop_interior_triangles();
@@ -485,7 +480,12 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   uint8_t signs = 0;
   for (int c = 0; c < 8; ++c)
     signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
-  const SettleRegion region = winding_settle_region(clean, chain, grid, options.depth);
+  // Islands and cracks come from the caps' decisions: settle near the caps, with room for the
+  // leaves around them. With overlapping shells or non-manifold edges, interior walls can end
+  // anywhere, and so can their islands and cracks: everywhere.
+  SettleRegion region;
+  if (!clean.defects.overlapping_shells && clean.defects.nonmanifold_edges == 0)
+    region = {false, loop_boxes(loops, grid, 16 * cell, 0.1)};
   Octree tree = build_tree(src, options, cube, signs, &root_wind, capped, &region);
   if (tree.vertices.empty())
     throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
