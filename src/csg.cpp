@@ -911,89 +911,6 @@ void withdraw_crack_repairs(Octree& t, uint32_t node, const std::function<bool(u
   }
 }
 
-/// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
-/// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
-/// void a cell or two across; `leaves` are the leaves around its points.
-struct Speck {
-  std::vector<Lat> points, rim;
-  std::vector<uint32_t> leaves;
-  bool inside = false;
-};
-
-/// At most this many lattice points make a speck: the Boolean's specks are 1-3 points (two
-/// surfaces passing within a fraction of a cell of each other); bigger regions are features.
-constexpr size_t kMaxSpeckPoints = 4;
-
-/// Corners of active finest-level gray leaves holding the leaf's minority sign (both signs
-/// when tied): where a speck's points must be.
-std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>& active) {
-  std::vector<Lat> out;
-  std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
-    if (!active(node)) return;
-    const Node& n = t.nodes[node];
-    if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level == t.max_depth && n.signs != 0 && n.signs != 0xff) {
-      const int in = std::popcount(n.signs);
-      for (int c = 0; c < 8; ++c)
-        if ((((n.signs >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
-    }
-  };
-  collect(0, Cell{});
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-/// The region of p's sign connected to p through shared leaves, if it is a speck: every leaf
-/// around its points gray with the point as a corner, one of them at least touched by this
-/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
-/// either way.
-std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>& active, const Lat& p,
-                                std::unordered_set<uint64_t>& seen) {
-  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  Speck sp;
-  std::vector<Lat> queue{p};
-  seen.insert(lattice_key(p));
-  bool ok = true, touched = false;
-  for (size_t i = 0; i < queue.size() && ok; ++i) {
-    const Lat q = queue[i];
-    for (int o = 0; o < 8 && ok; ++o) {
-      Lat c;
-      for (int k = 0; k < 3; ++k) {
-        c[k] = q[k] - ((o >> k) & 1) * step;
-        ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
-      }
-      if (!ok) break;
-      const auto [node, cell] = leaf_at(t, c);
-      const Node& n = t.nodes[node];
-      const int k0 = cell.corner_index(q);
-      ok = n.kind == CellKind::Gray && k0 >= 0;
-      if (!ok) break;
-      touched = touched || active(node);
-      if (i == 0 && o == 0) sp.inside = (n.signs >> k0) & 1;
-      sp.leaves.push_back(node);
-      for (int k = 0; k < 8; ++k) {
-        const Lat r = cell.corner(k);
-        const bool in = (n.signs >> k) & 1;
-        if (in != sp.inside) {
-          sp.rim.push_back(r);
-        } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
-          // A point seen before belongs to a region that was not a speck: so is this one.
-          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
-          queue.push_back(r);
-        }
-      }
-    }
-  }
-  if (!ok || !touched) return std::nullopt;
-  sp.points = std::move(queue);
-  std::sort(sp.leaves.begin(), sp.leaves.end());
-  sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
-  return sp;
-}
-
 /// Whether one operand alone shows the speck, so that it is that operand's own small
 /// component (which the exact Boolean keeps), not one the Boolean made: B's signs (as the
 /// operation sees them) give the result's pattern, or B is neutral over the whole speck (the
@@ -1009,25 +926,6 @@ bool speck_is_inherited(const Speck& sp, CsgOp op, const std::function<bool(cons
   for (const Lat& p : sp.points) check(p, sp.inside);
   for (const Lat& p : sp.rim) check(p, !sp.inside);
   return all_neutral || b_shows;
-}
-
-/// Removes specks the Boolean made: it makes them where the two operands' surfaces pass within
-/// a fraction of a cell of each other (lattice points fall between two contours that the exact
-/// result keeps together, or at the thin end of a wedge): a feature thinner than the finest
-/// cell, which the octree cannot hold. The speck's points take their neighbours' sign (its
-/// leaves become uniform). Returns how many specks.
-size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>& active, CsgOp op,
-                     const std::function<bool(const Lat&)>& sign_b) {
-  std::unordered_set<uint64_t> seen;
-  size_t removed = 0;
-  for (const Lat& p : speck_candidates(t, active)) {
-    if (seen.count(lattice_key(p))) continue;
-    const std::optional<Speck> sp = grow_speck(t, active, p, seen);
-    if (!sp || speck_is_inherited(*sp, op, sign_b)) continue;
-    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
-    ++removed;
-  }
-  return removed;
 }
 
 /// Drops unreachable nodes and vertices (left behind by in-place replacement).
@@ -1175,7 +1073,9 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   {
     Operand ob(b, pb, stamp);
     const std::function<bool(const Lat&)> sign_b = [&](const Lat& p) { return ob.sign(p); };
-    remove_specks(a, stamped, op, sign_b);
+    // Specks the Boolean made (where the two operands' surfaces pass within a fraction of a
+    // cell of each other); one operand's own small components stay.
+    remove_specks(a, &stamped, [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); });
   }
   stats.repaired = repair_cracks(a, &stamped);
   stats.cleanup_seconds = since(tclean);

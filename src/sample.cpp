@@ -407,6 +407,9 @@ void settle_signs(Octree& tree, const SettleRegion& region) {
     // Leaves at the depth cap may hold two components anywhere: this pass is cheap, and global.
     if (enforce_one_component(tree, nullptr, t, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
   }
+  // Where |w| hovers at 1/2 (an open part's end inside another part) the level set leaves
+  // specks a cell across, closed shells or voids of a few triangles: resolution noise.
+  remove_specks(tree, a, [](const Speck&) { return false; }, {tree.max_depth - 1, true});
   repair_cracks(tree, a);
 }
 

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -197,8 +199,8 @@ struct IslandSearch {
     path.push_back(node);
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c), active, path);
-    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 4) {
-      // Islands are features near the finest cell size, next to leaves a few levels up.
+    } else if (n.kind == CellKind::Gray) {
+      // Islands are features near the finest cell size, next to leaves of any level.
       leaves.push_back({node, cell, paths.size()});
       paths.insert(paths.end(), path.begin(), path.end());
     }
@@ -509,6 +511,111 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
     }
   }
   return fix;
+}
+
+namespace {
+
+/// At most this many lattice points make a speck: the Boolean's specks are 1-3 points (two
+/// surfaces passing within a fraction of a cell of each other); bigger regions are features.
+constexpr size_t kMaxSpeckPoints = 4;
+
+/// Corners of active finest-level gray leaves holding the leaf's minority sign (both signs
+/// when tied): where a speck's points must be.
+std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active, int min_level) {
+  std::vector<Lat> out;
+  std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level >= min_level && n.signs != 0 && n.signs != 0xff) {
+      const int in = std::popcount(n.signs);
+      for (int c = 0; c < 8; ++c)
+        if ((((n.signs >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
+    }
+  };
+  collect(0, Cell{});
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The region of p's sign connected to p through shared leaves, if it is a speck: every leaf
+/// around its points gray with the point as a corner, one of them at least touched by this
+/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
+/// either way.
+std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p,
+                                bool uniform_rim, std::unordered_set<uint64_t>& seen) {
+  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  Speck sp;
+  if (uniform_rim) {
+    // p's sign, from a gray leaf that has it as a corner (the candidate came from one).
+    const std::vector<Around> around = leaves_around(t, p);
+    const auto gray = std::find_if(around.begin(), around.end(),
+                                   [&](const Around& a) { return t.nodes[a.node].kind == CellKind::Gray; });
+    if (gray == around.end()) return std::nullopt;
+    sp.inside = (t.nodes[gray->node].signs >> gray->corner) & 1;
+  }
+  std::vector<Lat> queue{p};
+  seen.insert(lattice_key(p));
+  bool ok = true, touched = false;
+  for (size_t i = 0; i < queue.size() && ok; ++i) {
+    const Lat q = queue[i];
+    for (int o = 0; o < 8 && ok; ++o) {
+      Lat c;
+      for (int k = 0; k < 3; ++k) {
+        c[k] = q[k] - ((o >> k) & 1) * step;
+        ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
+      }
+      if (!ok) break;
+      const auto [node, cell] = leaf_at(t, c);
+      const Node& n = t.nodes[node];
+      if (uniform_rim && n.kind != CellKind::Gray) {
+        // A uniform leaf of the other sign: all of it is rim already.
+        ok = (n.kind == CellKind::Black) != sp.inside;
+        continue;
+      }
+      const int k0 = cell.corner_index(q);
+      ok = n.kind == CellKind::Gray && k0 >= 0;
+      if (!ok) break;
+      touched = touched || !active || (*active)(node);
+      if (i == 0 && o == 0 && !uniform_rim) sp.inside = (n.signs >> k0) & 1;
+      sp.leaves.push_back(node);
+      for (int k = 0; k < 8; ++k) {
+        const Lat r = cell.corner(k);
+        const bool in = (n.signs >> k) & 1;
+        if (in != sp.inside) {
+          sp.rim.push_back(r);
+        } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
+          // A point seen before belongs to a region that was not a speck: so is this one.
+          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
+          queue.push_back(r);
+        }
+      }
+    }
+  }
+  if (!ok || !touched) return std::nullopt;
+  sp.points = std::move(queue);
+  std::sort(sp.leaves.begin(), sp.leaves.end());
+  sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
+  return sp;
+}
+
+}  // namespace
+
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
+                     const std::function<bool(const Speck&)>& keep, const SpeckSearch& search) {
+  std::unordered_set<uint64_t> seen;
+  size_t removed = 0;
+  for (const Lat& p : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
+    if (seen.count(lattice_key(p))) continue;
+    const std::optional<Speck> sp = grow_speck(t, active, p, search.uniform_rim, seen);
+    if (!sp || keep(*sp)) continue;
+    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+    ++removed;
+  }
+  return removed;
 }
 
 /// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing

@@ -49,6 +49,26 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
                       const std::function<void(uint32_t)>* touched = nullptr, PinnedPoints* pinned = nullptr);
 
+/// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
+/// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
+/// void a cell or two across; `leaves` are the leaves around its points.
+struct Speck {
+  std::vector<std::array<int64_t, 3>> points, rim;
+  std::vector<uint32_t> leaves;
+  bool inside = false;
+};
+/// Where remove_specks looks. By default as the CSG clean-up needs: points that are corners
+/// of finest gray leaves only, every leaf around them gray.
+struct SpeckSearch {
+  int min_level = -1;        ///< the coarsest gray leaves whose corners may be specks (-1: finest)
+  bool uniform_rim = false;  ///< uniform leaves of the other sign may surround the speck too
+};
+/// Removes the specks with a leaf for which `active` is true (all when null) unless `keep`
+/// says otherwise: the speck's points take their neighbours' sign (its leaves become uniform).
+/// Specks are features about a cell across. Returns how many were removed.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
+                     const std::function<bool(const Speck&)>& keep, const SpeckSearch& search = {});
+
 /// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
 /// edges' midpoint), so the contour stays closed. Returns how many leaves changed.
 size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active);
