@@ -220,12 +220,15 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
   if (!wind || idx.size() > kMaxTested) return meets_cell(all_, idx, cell);
   const IBox box = cell.box();
   const i64 delta = std::max<i64>(1, (box.hi[0] - box.lo[0]) / 1024);
+  bool met = false;
   for (uint32_t k : idx) {
     const ITri& t = all_[k];
-    if (!(t.use & kUseMeets) || is_degenerate(t)) continue;
+    if (is_degenerate(t)) continue;
     // A point of the triangle inside the cell, and one point on each side of it.
     const std::optional<Vec3> x = point_in_box(t, box);
     if (!x) continue;
+    met = true;
+    if (!(t.use & kUseMeets)) continue;
     I3 side[2];
     for (int s = 0; s < 2; ++s) {
       const I3 g = to_grid(*x);
@@ -238,7 +241,16 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
         inside(side[1], winding_in_cell(cell, *wind, idx, side[1])))
       return true;
   }
+  if (met) {
+    const std::lock_guard lock(skipped_mutex_);
+    skipped_.push_back(cell);
+  }
   return false;
+}
+
+std::vector<Cell> WindingSource::skipped_cells() const {
+  const std::lock_guard lock(skipped_mutex_);
+  return skipped_;
 }
 
 size_t WindingSource::drop_interior_triangles() {

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "box_tree.h"
@@ -58,6 +59,10 @@ class WindingSource : public SurfaceSource {
   /// Integer winding number at grid point p of `cell` (corner windings `wind`), by a path
   /// along the cell's edges directions from its first corner.
   int32_t winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx, const I3& p) const;
+  /// Uniform cells that input triangles meet without showing a sign change on them (interior
+  /// walls, flaps): a sign change elsewhere in such a cell goes unseen, so finer neighbours
+  /// can show islands and cracks there. Thread-safe; in no particular order.
+  std::vector<Cell> skipped_cells() const;
   /// Marks input triangles with the solid on both sides or on neither (interior walls of
   /// overlapping shells, stray sheets) as playing no part in the surface. Returns how many.
   size_t drop_interior_triangles();
@@ -70,6 +75,8 @@ class WindingSource : public SurfaceSource {
   BoxTree cap_boxes_;
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
   DecisionCache cache_;
+  mutable std::mutex skipped_mutex_;
+  mutable std::vector<Cell> skipped_;
 };
 
 class PointSource : public SurfaceSource {

@@ -413,10 +413,9 @@ void settle_signs(Octree& tree, const SettleRegion& region) {
   repair_cracks(tree, a);
 }
 
-/// Runs the sampler from the root and assembles the tree, then settles its signs in `settle`
-/// (nothing to settle: only the depth cap's two-component leaves are split).
-Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
-                  const Wind8* root_wind, size_t& capped, const SettleRegion* settle = nullptr) {
+/// Runs the sampler from the root and assembles the tree.
+Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
+                   const Wind8* root_wind, size_t& capped) {
   std::vector<uint32_t> idx(src.tris().size());
   for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
   Builder b;
@@ -427,12 +426,6 @@ Octree build_tree(const SurfaceSource& src, const SampleOptions& options, const 
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
-  if (settle) {
-    settle_signs(tree, *settle);
-  } else if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) {
-    // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
-    repair_cracks(tree, nullptr);
-  }
   return tree;
 }
 
@@ -483,13 +476,17 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   uint8_t signs = 0;
   for (int c = 0; c < 8; ++c)
     signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
-  // Islands and cracks come from the caps' decisions: settle near the caps, with room for the
-  // leaves around them. With overlapping shells or non-manifold edges, interior walls can end
-  // anywhere, and so can their islands and cracks: everywhere.
-  SettleRegion region;
-  if (!clean.defects.overlapping_shells && clean.defects.nonmanifold_edges == 0)
-    region = {false, loop_boxes(loops, grid, 16 * cell, 0.1)};
-  Octree tree = build_tree(src, options, cube, signs, &root_wind, capped, &region);
+  Octree tree = sample_tree(src, options, cube, signs, &root_wind, capped);
+  // Islands and cracks come from the caps' decisions and from uniform cells whose triangles
+  // showed no sign change (the sampler's only departures from crossing parity): settle there,
+  // with room for the leaves around them.
+  SettleRegion region{false, loop_boxes(loops, grid, 16 * cell, 0.1)};
+  for (const Cell& c : src.skipped_cells()) {
+    const Vec3 lo = c.min_unit();
+    const double s = c.size();
+    region.boxes.push_back({{lo[0] - s, lo[1] - s, lo[2] - s}, {lo[0] + 2 * s, lo[1] + 2 * s, lo[2] + 2 * s}});
+  }
+  settle_signs(tree, region);
   if (tree.vertices.empty())
     throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
   return tree;
@@ -535,7 +532,9 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     tris.reserve(clean.mesh.triangles.size());
     for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(grid[t[0]], grid[t[1]], grid[t[2]]));
     // Root corners are outside: the mesh lies strictly inside the cube.
-    tree = build_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
+    tree = sample_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
+    // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
+    if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) repair_cracks(tree, nullptr);
   } else {
     tree = sample_winding(clean, grid, options, cube, st, capped);
   }
@@ -576,8 +575,8 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
   const double spacing = src.spacing();
   if (spacing > 0) opt.depth = std::clamp(int(std::ceil(std::log2(2 / spacing))), 1, options.depth);
   size_t capped = 0;
-  const SettleRegion everywhere;
-  Octree tree = build_tree(src, opt, cube, signs, nullptr, capped, &everywhere);
+  Octree tree = sample_tree(src, opt, cube, signs, nullptr, capped);
+  settle_signs(tree, SettleRegion{});
   if (tree.vertices.empty())
     throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
   if (stats) {
