@@ -205,33 +205,29 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi) {
 
 namespace {
 
-/// The part of `t` inside the closed box, under clipped_area's perturbation convention.
-/// Returns false when there is none; `whole` when no clipping was needed.
-bool clip_to_box(const ITri& t, const IBox& box, Poly& out, bool& whole) {
+/// The part of `t` inside the closed box, under clipped_area's perturbation convention, in
+/// one of `bufs`; null when there is none. `whole`: no clipping was needed (bufs[0] is `t`).
+const Poly* clip_to_box(const ITri& t, const IBox& box, Poly (&bufs)[2], bool& whole) {
   for (int k = 0; k < 3; ++k)
-    if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return false;
-  Poly bufs[2];
+    if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return nullptr;
   int cur = 0;
   bufs[0].n = 3;
   for (int k = 0; k < 3; ++k) bufs[0].p[k] = to_unit(t.v[k]);
   // Wholly inside the box, away from its low faces: no clipping needed.
   whole = t.lo[0] > box.lo[0] && t.lo[1] > box.lo[1] && t.lo[2] > box.lo[2] && t.hi[0] <= box.hi[0] &&
           t.hi[1] <= box.hi[1] && t.hi[2] <= box.hi[2];
-  if (whole) {
-    out = bufs[0];
-    return true;
-  }
+  if (whole) return &bufs[0];
   // Only the planes the triangle's box crosses can cut it (exact: same integer bounds).
   for (int k = 0; k < 3; ++k) {
     if (t.hi[k] > box.hi[k]) {
       clip(bufs[cur], bufs[1 - cur], k, grid_to_unit(box.hi[k]), true);
       cur = 1 - cur;
-      if (bufs[cur].n == 0) return false;
+      if (bufs[cur].n == 0) return nullptr;
     }
     if (t.lo[k] < box.lo[k]) {
       clip(bufs[cur], bufs[1 - cur], k, grid_to_unit(box.lo[k]), false);
       cur = 1 - cur;
-      if (bufs[cur].n == 0) return false;
+      if (bufs[cur].n == 0) return nullptr;
     }
   }
   const Poly& poly = bufs[cur];
@@ -239,34 +235,35 @@ bool clip_to_box(const ITri& t, const IBox& box, Poly& out, bool& whole) {
   for (int k = 0; k < 3; ++k) {
     bool all_low = true;
     for (int q = 0; q < poly.n && all_low; ++q) all_low = poly.p[q][k] == lo[k];
-    if (all_low) return false;  // lies in a low face: the perturbation hands it to the neighbour
+    if (all_low) return nullptr;  // lies in a low face: the perturbation hands it to the neighbour
   }
-  out = poly;
-  return true;
+  return &poly;
 }
 
 }  // namespace
 
 double clipped_area(const ITri& t, const IBox& box) {
-  Poly poly;
+  Poly bufs[2];
   bool whole = false;
-  if (!clip_to_box(t, box, poly, whole)) return -1;
+  const Poly* poly = clip_to_box(t, box, bufs, whole);
+  if (!poly) return -1;
   if (whole) return t.area;
   Vec3 acc{0, 0, 0};
-  for (int q = 1; q + 1 < poly.n; ++q) {
-    const Vec3 c = cross3(sub3(poly.p[q], poly.p[0]), sub3(poly.p[q + 1], poly.p[0]));
+  for (int q = 1; q + 1 < poly->n; ++q) {
+    const Vec3 c = cross3(sub3(poly->p[q], poly->p[0]), sub3(poly->p[q + 1], poly->p[0]));
     acc = {acc[0] + c[0], acc[1] + c[1], acc[2] + c[2]};
   }
   return 0.5 * std::sqrt(dot3(acc, acc));
 }
 
 std::optional<Vec3> point_in_box(const ITri& t, const IBox& box) {
-  Poly poly;
+  Poly bufs[2];
   bool whole = false;
-  if (!clip_to_box(t, box, poly, whole)) return std::nullopt;
+  const Poly* poly = clip_to_box(t, box, bufs, whole);
+  if (!poly) return std::nullopt;
   Vec3 mean{0, 0, 0};
-  for (int q = 0; q < poly.n; ++q)
-    for (int k = 0; k < 3; ++k) mean[k] += poly.p[q][k] / poly.n;
+  for (int q = 0; q < poly->n; ++q)
+    for (int k = 0; k < 3; ++k) mean[k] += poly->p[q][k] / poly->n;
   return mean;
 }
 
