@@ -95,6 +95,24 @@ CacheEntry& cache_slot(const I3& p) {
   return slots[(h ^ (h >> 29)) & ((size_t{1} << kCacheBits) - 1)];
 }
 
+/// A crossing found on a cell edge across a hole, with the level set's normal there: up to 4
+/// cells of a level share each edge, and each would search it again.
+struct CrossingEntry {
+  I3 a;
+  i64 len = 0;
+  int axis = 0;
+  uint32_t id = 0;  // 0: empty
+  Vec3 x, n;
+};
+
+CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
+  constexpr size_t kBits = 13;
+  thread_local std::vector<CrossingEntry> slots(size_t{1} << kBits);
+  const uint64_t h = (uint64_t(a[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(a[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                     (uint64_t(a[2]) * 0x165667B19E3779F9ull) ^ (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis);
+  return slots[(h ^ (h >> 29)) & ((size_t{1} << kBits) - 1)];
+}
+
 }  // namespace
 
 DecisionCache::DecisionCache() : id_(g_next_cache_id++) {}
@@ -175,6 +193,11 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     int surface = 0;
     for (uint32_t k : idx) surface += (all_[k].use & kUseQef) && crosses(all_[k], a, axis, len);
     if (surface & 1) continue;  // the input's own surface changes the sign here
+    CrossingEntry& memo = crossing_slot(a, axis, len);
+    if (memo.id == cache_.id() && memo.a == a && memo.axis == axis && memo.len == len) {
+      if (memo.n != Vec3{0, 0, 0}) q.add_plane(memo.n, dot3(memo.n, memo.x), 0.5);
+      continue;
+    }
     auto winding_at = [&](i64 off) {
       int32_t w = (*wind)[c0];
       for (uint32_t k : idx)
@@ -194,6 +217,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     });
     // Across a hole the level set's normal is the gradient of w: the field of the boundary.
     const Vec3 n = unit_vec(boundary_field(boundary_, x));
+    memo = {a, len, axis, cache_.id(), x, n};
     if (n == Vec3{0, 0, 0}) continue;
     q.add_plane(n, dot3(n, x), 0.5);
   }

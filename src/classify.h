@@ -32,6 +32,8 @@ class DecisionCache {
   /// The cached decision at p (-1: none).
   int find(const I3& p) const;
   void store(const I3& p, bool inside) const;
+  /// Tells this source's entries in per-thread memos from those of other sources.
+  uint32_t id() const { return id_; }
 
  private:
   uint32_t id_;  // tells this source's entries from an earlier source's in the same thread
