@@ -249,10 +249,10 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
     const ITri& t = all_[k];
     if (is_degenerate(t)) continue;
     // A point of the triangle inside the cell, and one point on each side of it.
+    if (!(t.use & kUseMeets)) continue;
     const std::optional<Vec3> x = point_in_box(t, box);
     if (!x) continue;
     met = true;
-    if (!(t.use & kUseMeets)) continue;
     I3 side[2];
     for (int s = 0; s < 2; ++s) {
       const I3 g = to_grid(*x);

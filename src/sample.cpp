@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <numeric>
 #include <string>
 #include <unordered_map>
 
@@ -371,20 +372,26 @@ struct SettleRegion {
 };
 
 /// Per node: whether its cell meets one of the region's boxes (an ancestor of such a node
-/// does too, as the passes in topology.h need of an `active` filter).
+/// does too, as the passes in topology.h need of an `active` filter). Each node tests only
+/// the boxes its parent met.
 std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
   std::vector<uint8_t> in(t.nodes.size(), 0);
-  const BoxTree boxes(region.boxes);
+  std::vector<std::vector<uint32_t>> met(kMaxLevel + 2);  // per level: the boxes the cell meets
+  met[0].resize(region.boxes.size());
+  std::iota(met[0].begin(), met[0].end(), 0u);
   auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
     const Vec3 lo = cell.min_unit();
     const double s = cell.size();
-    bool meets = false;
-    boxes.query({lo, {lo[0] + s, lo[1] + s, lo[2] + s}}, [&](uint32_t) { meets = true; });
-    if (!meets) return;
+    const std::vector<uint32_t>& from = met[cell.level];
+    std::vector<uint32_t>& here = met[cell.level + 1];
+    here.clear();
+    for (uint32_t i : from)
+      if (overlap(region.boxes[i], {lo, {lo[0] + s, lo[1] + s, lo[2] + s}})) here.push_back(i);
+    if (here.empty()) return;
     in[node] = 1;
     const Node& n = t.nodes[node];
-    if (n.kind == CellKind::Internal)
-      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    if (n.kind != CellKind::Internal) return;
+    for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));  // children fill the next list
   };
   walk(walk, 0, Cell{});
   return in;

@@ -199,8 +199,9 @@ struct IslandSearch {
     path.push_back(node);
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c), active, path);
-    } else if (n.kind == CellKind::Gray) {
-      // Islands are features near the finest cell size, next to leaves of any level.
+    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 5) {
+      // Islands are features near the finest cell size, next to leaves up to 5 levels up (the
+      // teapot had one on a leaf 5 levels up; coarser faces cost more than they find).
       leaves.push_back({node, cell, paths.size()});
       paths.insert(paths.end(), path.begin(), path.end());
     }
