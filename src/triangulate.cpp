@@ -378,11 +378,6 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       st.remaining_intersections = total;
       st.rounds = round;
       if (total == 0 || round == kMaxRounds) break;
-      // Partners: the polygons each bad polygon currently crosses.
-      std::vector<std::pair<uint32_t, uint32_t>> partners;
-      for (uint32_t i : bad)
-        for (const auto& e : crossing[i]) partners.push_back({i, e.first});
-      std::sort(partners.begin(), partners.end());
       // Options that keep the surface where it is: the other diagonal only of a quad whose two
       // splits lie within kMaxDeviation of each other (the distance between its diagonals'
       // lines), the fan only when its point is that close to the current triangles' planes.
@@ -581,18 +576,22 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       // Two polygons that cross may need to change together: try every pair of options
       // with each partner. Last resort before giving up (after the vertex moves): it costs
       // up to 9 evaluations per partner.
+      // `crossing` stays as the round began until the next update_crossings, so each bad
+      // polygon's partners are those it crossed then, tried in increasing order.
       for (uint32_t i : bad) {
         if (joint_settled[i]) continue;
         joint_settled[i] = 1;
-        if (self_hits[i] == 0 && crossing[i].empty()) continue;
+        std::vector<uint32_t> partners;
+        for (const auto& e : crossing[i]) partners.push_back(e.first);
+        std::sort(partners.begin(), partners.end());
+        // Options depend on positions only, which the joint pass does not move.
+        const std::vector<uint8_t> opts_i = options(i);
         // The pair's cost under (oi, oj) is i's crossings with everything but j, j's with
         // everything but i, and their mutual ones: single costs (each against the other's
         // current option) corrected by the mutual counts, which need no neighbour search.
-        auto lo = std::lower_bound(partners.begin(), partners.end(), std::pair<uint32_t, uint32_t>{i, 0});
-        for (; lo != partners.end() && lo->first == i; ++lo) {
-          const uint32_t j = lo->second;
+        for (const uint32_t j : partners) {
           const uint8_t oi0 = opt[i], oj0 = opt[j];
-          const std::vector<uint8_t> opts_i = options(i), opts_j = options(j);
+          const std::vector<uint8_t> opts_j = options(j);
           std::array<size_t, 3> ci{}, cj{};
           for (uint8_t o : opts_i) {
             opt[i] = o;
