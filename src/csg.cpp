@@ -159,22 +159,22 @@ struct Operand {
 
   /// Partial-contour triangles meeting a leaf's cell (cached per leaf).
   const std::vector<uint32_t>& triangles_in(uint32_t leaf, const Cell& cell) {
-    auto [it, fresh] = leaf_tris.try_emplace(leaf);
-    if (fresh) {
-      const IBox b = cell.box();
-      bvh.query(tris, b.lo, b.hi, it->second);
-      std::sort(it->second.begin(), it->second.end());  // deterministic order
-    }
-    return it->second;
+    return cached_query(leaf_tris, tris, bvh, leaf, cell);
   }
   /// The same for the triangles the parity walks cross.
   const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
     if (&parity_tris == &tris) return triangles_in(leaf, cell);
-    auto [it, fresh] = leaf_parity_tris.try_emplace(leaf);
+    return cached_query(leaf_parity_tris, parity_tris, parity_bvh, leaf, cell);
+  }
+  /// The triangles of `in` (indexed by `index`) meeting a leaf's cell, cached in `cache`.
+  static const std::vector<uint32_t>& cached_query(std::unordered_map<uint32_t, std::vector<uint32_t>>& cache,
+                                                   const std::vector<ITri>& in, const TriangleBvh& index,
+                                                   uint32_t leaf, const Cell& cell) {
+    auto [it, fresh] = cache.try_emplace(leaf);
     if (fresh) {
       const IBox b = cell.box();
-      parity_bvh.query(parity_tris, b.lo, b.hi, it->second);
-      std::sort(it->second.begin(), it->second.end());
+      index.query(in, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());  // deterministic order
     }
     return it->second;
   }
