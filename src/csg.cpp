@@ -108,10 +108,11 @@ struct PartialContour {
   TriangleBvh bvh;
   /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
   /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
-  /// crossings keep to `tris`, the operation's own cells.
-  bool wider = false;
+  /// crossings keep to `tris`, the operation's own cells. Empty when there are none.
   std::vector<ITri> parity_tris;
   TriangleBvh parity_bvh;
+  /// Whether the parity walks cross more than `tris` (parity_tris holds tris and the rest).
+  bool wider() const { return !parity_tris.empty(); }
 };
 
 /// One operand as seen by one task of an operation: its tree, its partial contour, and the
@@ -132,8 +133,8 @@ struct Operand {
 
   Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
       : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
-        parity_tris(contour.wider ? contour.parity_tris : contour.tris),
-        parity_bvh(contour.wider ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
+        parity_tris(contour.wider() ? contour.parity_tris : contour.tris),
+        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -886,8 +887,7 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
-  x.wider = !extra.empty();
-  if (!x.wider) return;
+  if (extra.empty()) return;
   x.parity_tris = x.tris;
   x.parity_tris.insert(x.parity_tris.end(), extra.begin(), extra.end());
   x.parity_bvh.build(x.parity_tris);
