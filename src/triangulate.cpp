@@ -93,6 +93,110 @@ Box box_of(const std::vector<Vec3>& x, const Tri& t) {
   return b;
 }
 
+/// Vertex ids sorted by position (ties by id).
+std::vector<uint32_t> sorted_by_position(const std::vector<Vec3>& x) {
+  std::vector<uint32_t> perm(x.size());
+  std::iota(perm.begin(), perm.end(), 0u);
+  std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
+  return perm;
+}
+
+/// Two cells' vertices clamped to the same point (a corner or edge the cells share) are one
+/// vertex to a reader that merges equal positions: a pinch, and neither could move later.
+/// Each is moved a hair (kSeparation finest cells) toward its own cell's centre. Returns how
+/// many moved.
+size_t separate_coincident(std::vector<Vec3>& x, const std::vector<VertexCell>& cells, double finest) {
+  const std::vector<uint32_t> perm = sorted_by_position(x);
+  std::vector<uint32_t> shared;
+  for (size_t k = 0; k < perm.size(); ++k)
+    if ((k > 0 && x[perm[k]] == x[perm[k - 1]]) || (k + 1 < perm.size() && x[perm[k]] == x[perm[k + 1]]))
+      shared.push_back(perm[k]);
+  size_t moved = 0;
+  for (uint32_t v : shared) {
+    const Vec3 d = sub3(cells[v].center, x[v]);
+    const double len = norm3(d);
+    if (!(len > 0)) continue;
+    const double f = std::min(0.5, kSeparation * finest / len);
+    for (int a = 0; a < 3; ++a) x[v][a] += f * d[a];
+    ++moved;
+  }
+  return moved;
+}
+
+/// Positions for the exact test: the vertices (bit-equal ones merged, as a reader of the file
+/// sees them) followed by every polygon's candidate fan point.
+struct MergedPositions {
+  std::vector<Vec3> xm;
+  std::vector<uint32_t> mid;     // vertex id (fan point of polygon i: nv + i) -> index in xm
+  std::vector<uint32_t> copies;  // vertices at each merged position
+};
+
+MergedPositions merge_positions(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys) {
+  const auto nv = static_cast<uint32_t>(x.size());
+  const size_t n = polys.size();
+  MergedPositions m;
+  m.mid.resize(size_t(nv) + n);
+  const std::vector<uint32_t> perm = sorted_by_position(x);
+  for (size_t k = 0; k < perm.size(); ++k) {
+    if (k == 0 || x[perm[k]] != x[perm[k - 1]]) m.xm.push_back(x[perm[k]]);
+    m.mid[perm[k]] = uint32_t(m.xm.size() - 1);
+  }
+  m.copies.assign(m.xm.size(), 0);
+  for (uint32_t v = 0; v < nv; ++v) ++m.copies[m.mid[v]];
+  for (size_t i = 0; i < n; ++i) {
+    const MeshPolygon& p = polys[i];
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
+    m.mid[nv + i] = uint32_t(m.xm.size());
+    m.xm.push_back(fan_point(q, p.count, p.e0, p.e1));
+  }
+  return m;
+}
+
+/// Whether each quad may take its other diagonal: not when that is an edge the mesh has (or
+/// may have) elsewhere — a polygon's side or another quad's diagonal would become an edge of
+/// four triangles.
+std::vector<uint8_t> other_diagonal_allowed(const std::vector<MeshPolygon>& polys) {
+  auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
+  std::vector<uint64_t> pairs_used;
+  for (const auto& p : polys) {
+    for (int k = 0; k < p.count; ++k) pairs_used.push_back(key(p.v[k], p.v[(k + 1) % p.count]));
+    if (p.count == 4) {
+      pairs_used.push_back(key(p.v[0], p.v[2]));
+      pairs_used.push_back(key(p.v[1], p.v[3]));
+    }
+  }
+  std::sort(pairs_used.begin(), pairs_used.end());
+  auto uses = [&](uint64_t k) {
+    return std::upper_bound(pairs_used.begin(), pairs_used.end(), k) - std::lower_bound(pairs_used.begin(), pairs_used.end(), k);
+  };
+  std::vector<uint8_t> ok(polys.size(), 0);
+  for (size_t i = 0; i < polys.size(); ++i)
+    if (polys[i].count == 4) {
+      const auto& v = polys[i].v;
+      ok[i] = uses(key(v[0], v[2])) == 1 && uses(key(v[1], v[3])) == 1;
+    }
+  return ok;
+}
+
+/// The polygons around each vertex v: around[first[v] .. first[v + 1]).
+struct PolygonsAround {
+  std::vector<uint32_t> first, around;
+};
+
+PolygonsAround polygons_around(const std::vector<MeshPolygon>& polys, uint32_t nv) {
+  PolygonsAround r;
+  r.first.assign(size_t(nv) + 1, 0);
+  for (const auto& p : polys)
+    for (int k = 0; k < p.count; ++k) ++r.first[p.v[k] + 1];
+  for (size_t v = 0; v < nv; ++v) r.first[v + 1] += r.first[v];
+  r.around.resize(r.first[nv]);
+  std::vector<uint32_t> fill(r.first.begin(), r.first.end() - 1);
+  for (uint32_t i = 0; i < polys.size(); ++i)
+    for (int k = 0; k < polys[i].count; ++k) r.around[fill[polys[i].v[k]]++] = i;
+  return r;
+}
+
 }  // namespace
 
 std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
@@ -111,48 +215,11 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
   TriangulationStats st;
 
   if (intersection_free && n > 0) {
-    // Two cells' vertices clamped to the same point (a corner or edge the cells share) are one
-    // vertex to a reader that merges equal positions: a pinch, and neither could move below.
-    // Each is moved a hair (kSeparation finest cells) toward its own cell's centre.
-    {
-      std::vector<uint32_t> perm(nv);
-      std::iota(perm.begin(), perm.end(), 0u);
-      std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
-      std::vector<uint32_t> shared;
-      for (size_t k = 0; k < perm.size(); ++k)
-        if ((k > 0 && x[perm[k]] == x[perm[k - 1]]) || (k + 1 < perm.size() && x[perm[k]] == x[perm[k + 1]]))
-          shared.push_back(perm[k]);
-      for (uint32_t v : shared) {
-        const Vec3 d = sub3(cells[v].center, x[v]);
-        const double len = norm3(d);
-        if (!(len > 0)) continue;
-        const double f = std::min(0.5, kSeparation * finest / len);
-        for (int a = 0; a < 3; ++a) x[v][a] += f * d[a];
-        ++st.moved_vertices;
-      }
-    }
-    // Positions for the test: the vertices (bit-equal ones merged, as a reader of the file sees
-    // them) followed by every polygon's candidate fan point.
-    std::vector<Vec3> xm;
-    std::vector<uint32_t> mid(size_t(nv) + n);
-    {
-      std::vector<uint32_t> perm(nv);
-      std::iota(perm.begin(), perm.end(), 0u);
-      std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
-      for (size_t k = 0; k < perm.size(); ++k) {
-        if (k == 0 || x[perm[k]] != x[perm[k - 1]]) xm.push_back(x[perm[k]]);
-        mid[perm[k]] = uint32_t(xm.size() - 1);
-      }
-    }
-    std::vector<uint32_t> copies(xm.size(), 0);  // vertices at each merged position
-    for (uint32_t v = 0; v < nv; ++v) ++copies[mid[v]];
-    for (size_t i = 0; i < n; ++i) {
-      const MeshPolygon& p = polys[i];
-      std::array<Vec3, 4> q;
-      for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
-      mid[nv + i] = uint32_t(xm.size());
-      xm.push_back(fan_point(q, p.count, p.e0, p.e1));
-    }
+    st.moved_vertices += separate_coincident(x, cells, finest);
+    MergedPositions merged = merge_positions(x, polys);
+    std::vector<Vec3>& xm = merged.xm;
+    const std::vector<uint32_t>& mid = merged.mid;
+    const std::vector<uint32_t>& copies = merged.copies;
     auto merged_tris = [&](size_t i, uint8_t o, std::array<Tri, 4>& t) {
       const int c = P.triangles(i, o, t);
       for (int k = 0; k < c; ++k)
@@ -203,40 +270,10 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
     };
     // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
     build_tree(0);
-    // The other diagonal must not be an edge the mesh has (or may have) elsewhere: a polygon's
-    // side or another quad's diagonal would become an edge of four triangles.
-    std::vector<uint8_t> other_ok(n, 0);
-    {
-      auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
-      std::vector<uint64_t> pairs_used;
-      for (const auto& p : polys) {
-        for (int k = 0; k < p.count; ++k) pairs_used.push_back(key(p.v[k], p.v[(k + 1) % p.count]));
-        if (p.count == 4) {
-          pairs_used.push_back(key(p.v[0], p.v[2]));
-          pairs_used.push_back(key(p.v[1], p.v[3]));
-        }
-      }
-      std::sort(pairs_used.begin(), pairs_used.end());
-      auto uses = [&](uint64_t k) {
-        return std::upper_bound(pairs_used.begin(), pairs_used.end(), k) - std::lower_bound(pairs_used.begin(), pairs_used.end(), k);
-      };
-      for (size_t i = 0; i < n; ++i)
-        if (polys[i].count == 4) {
-          const auto& v = polys[i].v;
-          other_ok[i] = uses(key(v[0], v[2])) == 1 && uses(key(v[1], v[3])) == 1;
-        }
-    }
-    // Polygons around each vertex.
-    std::vector<uint32_t> first(size_t(nv) + 1, 0), around;
-    for (const auto& p : polys)
-      for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
-    for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
-    around.resize(first[nv]);
-    {
-      std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-      for (uint32_t i = 0; i < n; ++i)
-        for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = i;
-    }
+    const std::vector<uint8_t> other_ok = other_diagonal_allowed(polys);
+    const PolygonsAround star = polygons_around(polys, nv);
+    const std::vector<uint32_t>& first = star.first;
+    const std::vector<uint32_t>& around = star.around;
     // Exact intersections of polygon i's triangles under its current option with its
     // neighbours' current triangles and with each other; a degenerate triangle rules the
     // option out. `except`: a neighbour left out (counted once by the caller).
@@ -645,9 +682,6 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
     std::array<Tri, 4> t;
     const int c = P.triangles(i, opt[i], t);
     if (opt[i] == kFan) {
-      const MeshPolygon& p = polys[i];
-      std::array<Vec3, 4> q;
-      for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
       const auto id = static_cast<uint32_t>(x.size());
       x.push_back(fans_at[i]);
       for (int k = 0; k < c; ++k) t[k][0] = id;
