@@ -93,6 +93,60 @@ Box box_of(const std::vector<Vec3>& x, const Tri& t) {
   return b;
 }
 
+/// Options that keep the surface where it is, for a polygon with corners q[0..count) and fan
+/// point f: the other diagonal only of a quad whose two splits lie within `limit` of each
+/// other (the distance between its diagonals' lines) and that may take it (`other_ok`), the
+/// fan only when f is that close to the current triangles' planes. A big non-planar quad
+/// folded the other way moves the surface by up to its bulge.
+std::vector<uint8_t> surface_keeping_options(const std::array<Vec3, 4>& q, int count, const Vec3& f, bool other_ok,
+                                             double limit) {
+  std::vector<uint8_t> o{kPreferred};
+  auto plane_distance = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& r) {
+    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+    const double l = norm3(n);
+    return l > 0 ? std::abs(dot3(n, sub3(r, a))) / l : 0.0;
+  };
+  if (count == 3) {
+    if (plane_distance(q[0], q[1], q[2], f) <= limit) o.push_back(kFan);
+    return o;
+  }
+  const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
+  const double l = norm3(n);
+  const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
+  if (bulge <= limit && other_ok) o.push_back(kOtherDiagonal);
+  if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
+      std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
+    o.push_back(kFan);
+  return o;
+}
+
+/// Move targets for a vertex at `was` along the common null space of its triangles' planes
+/// (m: the sum of their unit normals' outer products; a flat face's plane, a crease's line):
+/// the existing targets projected onto it, and straight along it both ways (an in-plane fold
+/// needs a sideways move), each reaching up to `along_reach`.
+void add_targets_along_planes(const Eigen::Matrix3d& m, const Vec3& was, double along_reach,
+                              std::vector<Vec3>& targets, std::vector<double>& scale) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  const Eigen::Vector3d ev = eig.eigenvalues();
+  for (size_t k = 0, c = targets.size(); k < c; ++k) {
+    const Eigen::Vector3d d(targets[k][0] - was[0], targets[k][1] - was[1], targets[k][2] - was[2]);
+    Eigen::Vector3d along = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 3; ++a)
+      if (ev[a] < kNullCutoff * ev[2]) along += eig.eigenvectors().col(a) * eig.eigenvectors().col(a).dot(d);
+    if (along.norm() > 0) {
+      targets.push_back({was[0] + along[0], was[1] + along[1], was[2] + along[2]});
+      scale.push_back(along_reach);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    if (ev[a] < kNullCutoff * ev[2])
+      for (double sgn : {-1.0, 1.0}) {
+        const Eigen::Vector3d e = sgn * along_reach * eig.eigenvectors().col(a);
+        targets.push_back({was[0] + e[0], was[1] + e[1], was[2] + e[2]});
+        scale.push_back(along_reach);
+      }
+}
+
 /// Vertex ids sorted by position (ties by id).
 std::vector<uint32_t> sorted_by_position(const std::vector<Vec3>& x) {
   std::vector<uint32_t> perm(x.size());
@@ -415,34 +469,11 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
       st.remaining_intersections = total;
       st.rounds = round;
       if (total == 0 || round == kMaxRounds) break;
-      // Options that keep the surface where it is: the other diagonal only of a quad whose two
-      // splits lie within kMaxDeviation of each other (the distance between its diagonals'
-      // lines), the fan only when its point is that close to the current triangles' planes.
-      // A big non-planar quad folded the other way moves the surface by up to its bulge.
       auto options = [&](uint32_t i) {
-        std::vector<uint8_t> o{kPreferred};
         const MeshPolygon& p = polys[i];
-        const double limit = kMaxDeviation * finest;
-        const Vec3& f = xm[mid[nv + i]];
-        auto plane_distance = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& q) {
-          const Vec3 n = cross3(sub3(b, a), sub3(c, a));
-          const double l = norm3(n);
-          return l > 0 ? std::abs(dot3(n, sub3(q, a))) / l : 0.0;
-        };
         std::array<Vec3, 4> q;
         for (int k = 0; k < p.count; ++k) q[k] = xm[mid[p.v[k]]];
-        if (p.count == 3) {
-          if (plane_distance(q[0], q[1], q[2], f) <= limit) o.push_back(kFan);
-          return o;
-        }
-        const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
-        const double l = norm3(n);
-        const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
-        if (bulge <= limit && other_ok[i]) o.push_back(kOtherDiagonal);
-        if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
-            std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
-          o.push_back(kFan);
-        return o;
+        return surface_keeping_options(q, p.count, xm[mid[nv + i]], other_ok[i], kMaxDeviation * finest);
       };
       size_t changed = 0;
       for (uint32_t i : bad) {
@@ -545,26 +576,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
               m += e * e.transpose();
             }
           }
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
-          const Eigen::Vector3d ev = eig.eigenvalues();
-          for (size_t k = 0, c = targets.size(); k < c; ++k) {
-            const Eigen::Vector3d d(targets[k][0] - was[0], targets[k][1] - was[1], targets[k][2] - was[2]);
-            Eigen::Vector3d along = Eigen::Vector3d::Zero();
-            for (int a = 0; a < 3; ++a)
-              if (ev[a] < kNullCutoff * ev[2]) along += eig.eigenvectors().col(a) * eig.eigenvectors().col(a).dot(d);
-            if (along.norm() > 0) {
-              targets.push_back({was[0] + along[0], was[1] + along[1], was[2] + along[2]});
-              scale.push_back(along_reach);
-            }
-          }
-          // Straight along the planes both ways (an in-plane fold needs a sideways move).
-          for (int a = 0; a < 3; ++a)
-            if (ev[a] < kNullCutoff * ev[2])
-              for (double sgn : {-1.0, 1.0}) {
-                const Eigen::Vector3d e = sgn * along_reach * eig.eigenvectors().col(a);
-                targets.push_back({was[0] + e[0], was[1] + e[1], was[2] + e[2]});
-                scale.push_back(along_reach);
-              }
+          add_targets_along_planes(m, was, along_reach, targets, scale);
         }
         double best_deviation = 0;
         auto deviation = [&](const Vec3& q) {
