@@ -579,17 +579,21 @@ class Untangler {
     return changed;
   }
 
-  // Moves vertex v to the best of its candidate positions; whether it moved.
-  bool move_vertex(uint32_t v) {
-    std::vector<Vec3>& xm = merged_.xm;
+  // Where vertex v (at `was`) may move: toward its cell's centre and toward the mean of its
+  // polygon neighbours, each by up to reach(v). Moves further than a finest cell (coarse
+  // vertices in the last resort) must keep the surface where it is: they go along the planes
+  // of v's triangles (their common null space: a flat face's plane, a crease's line) and are
+  // taken only if v stays within kFarMoveDeviation of every one of those planes (`normals`).
+  struct MoveTargets {
+    std::vector<Vec3> targets;
+    std::vector<double> scale;  // the largest move toward each target
+    std::vector<Vec3> normals;  // unit normals of v's triangles (last resort only)
+  };
+  MoveTargets move_targets(uint32_t v, const Vec3& was) const {
+    const std::vector<Vec3>& xm = merged_.xm;
     const std::vector<uint32_t>& mid = merged_.mid;
     const std::vector<uint32_t>& first = star_.first;
     const std::vector<uint32_t>& around = star_.around;
-    const Vec3 was = xm[mid[v]];
-    const size_t before = vertex_cost(v);
-    if (before == 0) return false;
-    Vec3 best = was;
-    size_t best_cost = before;
     Vec3 ring{0, 0, 0};
     double count = 0;
     for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
@@ -601,32 +605,43 @@ class Untangler {
         }
     }
     for (double& r : ring) r /= count > 0 ? count : 1;
-    // Moves further than a finest cell (coarse vertices in the last resort) must keep the
-    // surface where it is: they go along the planes of v's triangles (their common null
-    // space: a flat face's plane, a crease's line) and are taken only if v stays within
-    // kFarMoveDeviation of every one of those planes.
-    std::vector<Vec3> normals;
-    std::vector<Vec3> targets{cells_[v].center, ring};
-    std::vector<double> scale{reach(v), reach(v)};  // the largest move toward each target
+    MoveTargets mt{{cells_[v].center, ring}, {reach(v), reach(v)}, {}};
+    if (!last_resort_) return mt;
     // Moves along the planes keep the surface where it is, so they may cross the whole cell.
     const double along_reach = room_of(v);
-    if (last_resort_) {
-      Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-      for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-        std::array<Tri, 4> t;
-        const int c = merged_tris(around[k], opt_[around[k]], t);
-        for (int a = 0; a < c; ++a) {
-          if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
-          const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
-          const double l = norm3(nn);
-          if (!(l > 0)) continue;
-          const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
-          normals.push_back({e[0], e[1], e[2]});
-          m += e * e.transpose();
-        }
+    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+    for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+      std::array<Tri, 4> t;
+      const int c = merged_tris(around[k], opt_[around[k]], t);
+      for (int a = 0; a < c; ++a) {
+        if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
+        const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
+        const double l = norm3(nn);
+        if (!(l > 0)) continue;
+        const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
+        mt.normals.push_back({e[0], e[1], e[2]});
+        m += e * e.transpose();
       }
-      add_targets_along_planes(m, was, along_reach, targets, scale);
     }
+    add_targets_along_planes(m, was, along_reach, mt.targets, mt.scale);
+    return mt;
+  }
+
+  // Moves vertex v to the best of its candidate positions; whether it moved.
+  bool move_vertex(uint32_t v) {
+    std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    const std::vector<uint32_t>& first = star_.first;
+    const std::vector<uint32_t>& around = star_.around;
+    const Vec3 was = xm[mid[v]];
+    const size_t before = vertex_cost(v);
+    if (before == 0) return false;
+    Vec3 best = was;
+    size_t best_cost = before;
+    const MoveTargets mt = move_targets(v, was);
+    const std::vector<Vec3>& targets = mt.targets;
+    const std::vector<double>& scale = mt.scale;
+    const std::vector<Vec3>& normals = mt.normals;
     double best_deviation = 0;
     auto deviation = [&](const Vec3& q) {
       double w = 0;
