@@ -55,6 +55,18 @@ void print_components(const TriMesh& pic_mesh, const TriMesh& exact, double cell
                   c.extent() / cell, (c.lo[0] + c.hi[0]) / 2, (c.lo[1] + c.hi[1]) / 2, (c.lo[2] + c.hi[2]) / 2);
 }
 
+/// With --out: a case's meshes as DIR/PREFIX_NAME.obj, the operands' contours under their own
+/// names, PIC's result as _pic and the exact one, when CGAL gave one, as _exact.
+void write_meshes(const std::string& out_dir, const std::string& prefix,
+                  const std::vector<std::pair<std::string, TriMesh>>& operands, const TriMesh& pic_mesh,
+                  const std::optional<TriMesh>& exact) {
+  std::filesystem::create_directories(out_dir);
+  const std::string base = out_dir + "/" + prefix + "_";
+  for (const auto& [name, mesh] : operands) write_mesh(mesh, base + name + ".obj");
+  write_mesh(pic_mesh, base + "pic.obj");
+  if (exact) write_mesh(*exact, base + "exact.obj");
+}
+
 CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) {
   CaseResult res;
   res.seed = seed;
@@ -80,11 +92,9 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
   for (size_t i = 1; i < trees.size() && exact; ++i) exact = exact_boolean(*exact, written(trees[i]), ops[i - 1]);
   res.exact_seconds = since(t0);
   if (!out_dir.empty()) {
-    std::filesystem::create_directories(out_dir);
-    const std::string base = out_dir + "/case" + std::to_string(seed);
-    for (size_t i = 0; i < trees.size(); ++i) write_mesh(written(trees[i]), base + "_op" + std::to_string(i) + ".obj");
-    write_mesh(pic_mesh, base + "_pic.obj");
-    if (exact) write_mesh(*exact, base + "_exact.obj");
+    std::vector<std::pair<std::string, TriMesh>> operands;
+    for (size_t i = 0; i < trees.size(); ++i) operands.emplace_back("op" + std::to_string(i), written(trees[i]));
+    write_meshes(out_dir, "case" + std::to_string(seed), operands, pic_mesh, exact);
   }
   if (!exact) {
     res.skipped = true;
@@ -119,13 +129,7 @@ CaseResult run_pair(const std::string& pa, CsgOp op, const std::string& pb, int 
               count_self_intersections(cb));
   const std::optional<TriMesh> exact = exact_boolean(ca, cb, op, false);
   res.exact_seconds = since(t0);
-  if (!out_dir.empty()) {
-    std::filesystem::create_directories(out_dir);
-    write_mesh(pic_mesh, out_dir + "/pair_pic.obj");
-    write_mesh(ca, out_dir + "/pair_a.obj");
-    write_mesh(cb, out_dir + "/pair_b.obj");
-    if (exact) write_mesh(*exact, out_dir + "/pair_exact.obj");
-  }
+  if (!out_dir.empty()) write_meshes(out_dir, "pair", {{"a", ca}, {"b", cb}}, pic_mesh, exact);
   if (!exact) {
     res.skipped = true;
     res.why = "CGAL failed";

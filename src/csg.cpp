@@ -108,10 +108,11 @@ struct PartialContour {
   TriangleBvh bvh;
   /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
   /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
-  /// crossings keep to `tris`, the operation's own cells.
-  bool wider = false;
+  /// crossings keep to `tris`, the operation's own cells. Empty when there are none.
   std::vector<ITri> parity_tris;
   TriangleBvh parity_bvh;
+  /// Whether the parity walks cross more than `tris` (parity_tris holds tris and the rest).
+  bool wider() const { return !parity_tris.empty(); }
 };
 
 /// One operand as seen by one task of an operation: its tree, its partial contour, and the
@@ -132,8 +133,8 @@ struct Operand {
 
   Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
       : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
-        parity_tris(contour.wider ? contour.parity_tris : contour.tris),
-        parity_bvh(contour.wider ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
+        parity_tris(contour.wider() ? contour.parity_tris : contour.tris),
+        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -159,22 +160,22 @@ struct Operand {
 
   /// Partial-contour triangles meeting a leaf's cell (cached per leaf).
   const std::vector<uint32_t>& triangles_in(uint32_t leaf, const Cell& cell) {
-    auto [it, fresh] = leaf_tris.try_emplace(leaf);
-    if (fresh) {
-      const IBox b = cell.box();
-      bvh.query(tris, b.lo, b.hi, it->second);
-      std::sort(it->second.begin(), it->second.end());  // deterministic order
-    }
-    return it->second;
+    return cached_query(leaf_tris, tris, bvh, leaf, cell);
   }
   /// The same for the triangles the parity walks cross.
   const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
     if (&parity_tris == &tris) return triangles_in(leaf, cell);
-    auto [it, fresh] = leaf_parity_tris.try_emplace(leaf);
+    return cached_query(leaf_parity_tris, parity_tris, parity_bvh, leaf, cell);
+  }
+  /// The triangles of `in` (indexed by `index`) meeting a leaf's cell, cached in `cache`.
+  static const std::vector<uint32_t>& cached_query(std::unordered_map<uint32_t, std::vector<uint32_t>>& cache,
+                                                   const std::vector<ITri>& in, const TriangleBvh& index,
+                                                   uint32_t leaf, const Cell& cell) {
+    auto [it, fresh] = cache.try_emplace(leaf);
     if (fresh) {
       const IBox b = cell.box();
-      parity_bvh.query(parity_tris, b.lo, b.hi, it->second);
-      std::sort(it->second.begin(), it->second.end());
+      index.query(in, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());  // deterministic order
     }
     return it->second;
   }
@@ -886,8 +887,7 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
-  x.wider = !extra.empty();
-  if (!x.wider) return;
+  if (extra.empty()) return;
   x.parity_tris = x.tris;
   x.parity_tris.insert(x.parity_tris.end(), extra.begin(), extra.end());
   x.parity_bvh.build(x.parity_tris);
@@ -960,28 +960,10 @@ void compact(Octree& t) {
   t.stamps = std::move(c.stamps);
 }
 
-}  // namespace
-
-size_t reachable_nodes(const Octree& t) {
-  size_t n = 0;
-  std::function<void(uint32_t)> walk = [&](uint32_t i) {
-    ++n;
-    if (t.nodes[i].kind == CellKind::Internal)
-      for (int c = 0; c < 8; ++c) walk(t.nodes[i].index + c);
-  };
-  walk(0);
-  return n;
-}
-
-}  // namespace detail
-
-void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& options, CsgStats* stats_out) {
-  using namespace detail;
-  const auto t0 = Clock::now();
-  CsgStats stats;
-  // One frame: re-express B in A's cube when they differ (resample its contour). When B's
-  // surface does not fit in A's cube, both are resampled into the cube around both cubes
-  // (A then changes cube: its root grows).
+/// One frame: B re-expressed in A's cube when they differ (its contour resampled). When B's
+/// surface does not fit in A's cube, both are resampled into the cube around both cubes (A then
+/// changes cube: its root grows). A op A works on a copy of B. Empty when B serves as it is.
+std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptions& options, CsgStats& stats) {
   std::optional<Octree> resampled;
   if (!(a.cube == b_in.cube)) {
     SampleOptions so;
@@ -1010,17 +992,18 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   } else if (&a == &b_in) {
     resampled = b_in;
   }
-  const Octree& b = resampled ? *resampled : b_in;
-  const int depth = std::max(a.max_depth, b.max_depth);
+  return resampled;
+}
 
-  const uint32_t stamp = ++g_timestamp;
-  stats.stamp = stamp;
+/// Stamps the cells where the operands' surfaces may meet (tag, then stamp_under_surface for
+/// the subtrees of B it deferred) and builds both operands' partial contours.
+void stamp_overlap(Octree& a, const Octree& b, uint32_t stamp, PartialContour& pa, PartialContour& pb,
+                   CsgStats& stats) {
   if (a.stamps.size() != a.nodes.size()) a.stamps.resize(a.nodes.size(), 0);
   if (b.stamps.size() != b.nodes.size()) b.stamps.resize(b.nodes.size(), 0);
   std::vector<Deferred> deferred;
   tag(a, 0, b, 0, Cell{}, stamp, stats.cells_stamped, deferred);
 
-  PartialContour pa, pb;
   auto tc = Clock::now();
   partial_contour(a, stamp, pa);
   stats.contour_a_seconds = since(tc);
@@ -1035,29 +1018,31 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   }
   partial_contour(b, stamp, pb);
   stats.contour_b_seconds = since(tc);
+}
 
-  tc = Clock::now();
-  const size_t before = a.nodes.size();
-  {
-    // Every task reads A as it was; the new nodes land after A's, and A's own slots are
-    // written only once all tasks are done.
-    Fragment f;
-    Operand oa(a, pa, stamp), ob(b, pb, stamp);
-    CombineCounts counts;
-    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
-    const Node root = comb.run();
-    stats.cells_visited = counts.cells_visited;
-    stats.gray_pairs = counts.gray_pairs;
-    stats.forced_subdivisions = counts.forced_subdivisions;
-    const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
-    for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
-    a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
-    a.stamps.resize(a.nodes.size(), stamp);
-    for (const auto& [slot, n] : f.pending) a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
-    a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
-  }
-  a.max_depth = depth;
-  const auto tclean = Clock::now();
+/// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
+/// A's, and A's own slots are written only once all tasks are done.
+void combine_stamped(Octree& a, const Octree& b, const PartialContour& pa, const PartialContour& pb, CsgOp op,
+                     const CsgOptions& options, int depth, uint32_t stamp, CsgStats& stats) {
+  Fragment f;
+  Operand oa(a, pa, stamp), ob(b, pb, stamp);
+  CombineCounts counts;
+  Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
+  const Node root = comb.run();
+  stats.cells_visited = counts.cells_visited;
+  stats.gray_pairs = counts.gray_pairs;
+  stats.forced_subdivisions = counts.forced_subdivisions;
+  const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
+  for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
+  a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
+  a.stamps.resize(a.nodes.size(), stamp);
+  for (const auto& [slot, n] : f.pending) a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+  a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
+}
+
+/// Clean-up of the stamped part of the result: crack repairs withdrawn and redone, islands,
+/// cells of more than one component and specks the Boolean made removed.
+void clean_up(Octree& a, const Octree& b, const PartialContour& pb, CsgOp op, uint32_t stamp, CsgStats& stats) {
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
@@ -1078,6 +1063,42 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
     remove_specks(a, &stamped, [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); });
   }
   stats.repaired = repair_cracks(a, &stamped);
+}
+
+}  // namespace
+
+size_t reachable_nodes(const Octree& t) {
+  size_t n = 0;
+  std::function<void(uint32_t)> walk = [&](uint32_t i) {
+    ++n;
+    if (t.nodes[i].kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) walk(t.nodes[i].index + c);
+  };
+  walk(0);
+  return n;
+}
+
+}  // namespace detail
+
+void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& options, CsgStats* stats_out) {
+  using namespace detail;
+  const auto t0 = Clock::now();
+  CsgStats stats;
+  const std::optional<Octree> resampled = common_frame(a, b_in, options, stats);
+  const Octree& b = resampled ? *resampled : b_in;
+  const int depth = std::max(a.max_depth, b.max_depth);
+
+  const uint32_t stamp = ++g_timestamp;
+  stats.stamp = stamp;
+  PartialContour pa, pb;
+  stamp_overlap(a, b, stamp, pa, pb, stats);
+
+  const auto tc = Clock::now();
+  const size_t before = a.nodes.size();
+  combine_stamped(a, b, pa, pb, op, options, depth, stamp, stats);
+  a.max_depth = depth;
+  const auto tclean = Clock::now();
+  clean_up(a, b, pb, op, stamp, stats);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);
   // Amortized garbage collection of replaced subtrees.

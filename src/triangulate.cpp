@@ -93,6 +93,682 @@ Box box_of(const std::vector<Vec3>& x, const Tri& t) {
   return b;
 }
 
+/// Options that keep the surface where it is, for a polygon with corners q[0..count) and fan
+/// point f: the other diagonal only of a quad whose two splits lie within `limit` of each
+/// other (the distance between its diagonals' lines) and that may take it (`other_ok`), the
+/// fan only when f is that close to the current triangles' planes. A big non-planar quad
+/// folded the other way moves the surface by up to its bulge.
+std::vector<uint8_t> surface_keeping_options(const std::array<Vec3, 4>& q, int count, const Vec3& f, bool other_ok,
+                                             double limit) {
+  std::vector<uint8_t> o{kPreferred};
+  auto plane_distance = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& r) {
+    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+    const double l = norm3(n);
+    return l > 0 ? std::abs(dot3(n, sub3(r, a))) / l : 0.0;
+  };
+  if (count == 3) {
+    if (plane_distance(q[0], q[1], q[2], f) <= limit) o.push_back(kFan);
+    return o;
+  }
+  const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
+  const double l = norm3(n);
+  const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
+  if (bulge <= limit && other_ok) o.push_back(kOtherDiagonal);
+  if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
+      std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
+    o.push_back(kFan);
+  return o;
+}
+
+/// Move targets for a vertex at `was` along the common null space of its triangles' planes
+/// (m: the sum of their unit normals' outer products; a flat face's plane, a crease's line):
+/// the existing targets projected onto it, and straight along it both ways (an in-plane fold
+/// needs a sideways move), each reaching up to `along_reach`.
+void add_targets_along_planes(const Eigen::Matrix3d& m, const Vec3& was, double along_reach,
+                              std::vector<Vec3>& targets, std::vector<double>& scale) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  const Eigen::Vector3d ev = eig.eigenvalues();
+  for (size_t k = 0, c = targets.size(); k < c; ++k) {
+    const Eigen::Vector3d d(targets[k][0] - was[0], targets[k][1] - was[1], targets[k][2] - was[2]);
+    Eigen::Vector3d along = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 3; ++a)
+      if (ev[a] < kNullCutoff * ev[2]) along += eig.eigenvectors().col(a) * eig.eigenvectors().col(a).dot(d);
+    if (along.norm() > 0) {
+      targets.push_back({was[0] + along[0], was[1] + along[1], was[2] + along[2]});
+      scale.push_back(along_reach);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    if (ev[a] < kNullCutoff * ev[2])
+      for (double sgn : {-1.0, 1.0}) {
+        const Eigen::Vector3d e = sgn * along_reach * eig.eigenvectors().col(a);
+        targets.push_back({was[0] + e[0], was[1] + e[1], was[2] + e[2]});
+        scale.push_back(along_reach);
+      }
+}
+
+/// Vertex ids sorted by position (ties by id).
+std::vector<uint32_t> sorted_by_position(const std::vector<Vec3>& x) {
+  std::vector<uint32_t> perm(x.size());
+  std::iota(perm.begin(), perm.end(), 0u);
+  std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
+  return perm;
+}
+
+/// Two cells' vertices clamped to the same point (a corner or edge the cells share) are one
+/// vertex to a reader that merges equal positions: a pinch, and neither could move later.
+/// Each is moved a hair (kSeparation finest cells) toward its own cell's centre. Returns how
+/// many moved.
+size_t separate_coincident(std::vector<Vec3>& x, const std::vector<VertexCell>& cells, double finest) {
+  const std::vector<uint32_t> perm = sorted_by_position(x);
+  std::vector<uint32_t> shared;
+  for (size_t k = 0; k < perm.size(); ++k)
+    if ((k > 0 && x[perm[k]] == x[perm[k - 1]]) || (k + 1 < perm.size() && x[perm[k]] == x[perm[k + 1]]))
+      shared.push_back(perm[k]);
+  size_t moved = 0;
+  for (uint32_t v : shared) {
+    const Vec3 d = sub3(cells[v].center, x[v]);
+    const double len = norm3(d);
+    if (!(len > 0)) continue;
+    const double f = std::min(0.5, kSeparation * finest / len);
+    for (int a = 0; a < 3; ++a) x[v][a] += f * d[a];
+    ++moved;
+  }
+  return moved;
+}
+
+/// Positions for the exact test: the vertices (bit-equal ones merged, as a reader of the file
+/// sees them) followed by every polygon's candidate fan point.
+struct MergedPositions {
+  std::vector<Vec3> xm;
+  std::vector<uint32_t> mid;     // vertex id (fan point of polygon i: nv + i) -> index in xm
+  std::vector<uint32_t> copies;  // vertices at each merged position
+};
+
+MergedPositions merge_positions(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys) {
+  const auto nv = static_cast<uint32_t>(x.size());
+  const size_t n = polys.size();
+  MergedPositions m;
+  m.mid.resize(size_t(nv) + n);
+  const std::vector<uint32_t> perm = sorted_by_position(x);
+  for (size_t k = 0; k < perm.size(); ++k) {
+    if (k == 0 || x[perm[k]] != x[perm[k - 1]]) m.xm.push_back(x[perm[k]]);
+    m.mid[perm[k]] = uint32_t(m.xm.size() - 1);
+  }
+  m.copies.assign(m.xm.size(), 0);
+  for (uint32_t v = 0; v < nv; ++v) ++m.copies[m.mid[v]];
+  for (size_t i = 0; i < n; ++i) {
+    const MeshPolygon& p = polys[i];
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
+    m.mid[nv + i] = uint32_t(m.xm.size());
+    m.xm.push_back(fan_point(q, p.count, p.e0, p.e1));
+  }
+  return m;
+}
+
+/// Whether each quad may take its other diagonal: not when that is an edge the mesh has (or
+/// may have) elsewhere — a polygon's side or another quad's diagonal would become an edge of
+/// four triangles.
+std::vector<uint8_t> other_diagonal_allowed(const std::vector<MeshPolygon>& polys) {
+  auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
+  std::vector<uint64_t> pairs_used;
+  for (const auto& p : polys) {
+    for (int k = 0; k < p.count; ++k) pairs_used.push_back(key(p.v[k], p.v[(k + 1) % p.count]));
+    if (p.count == 4) {
+      pairs_used.push_back(key(p.v[0], p.v[2]));
+      pairs_used.push_back(key(p.v[1], p.v[3]));
+    }
+  }
+  std::sort(pairs_used.begin(), pairs_used.end());
+  auto uses = [&](uint64_t k) {
+    return std::upper_bound(pairs_used.begin(), pairs_used.end(), k) - std::lower_bound(pairs_used.begin(), pairs_used.end(), k);
+  };
+  std::vector<uint8_t> ok(polys.size(), 0);
+  for (size_t i = 0; i < polys.size(); ++i)
+    if (polys[i].count == 4) {
+      const auto& v = polys[i].v;
+      ok[i] = uses(key(v[0], v[2])) == 1 && uses(key(v[1], v[3])) == 1;
+    }
+  return ok;
+}
+
+/// The polygons around each vertex v: around[first[v] .. first[v + 1]).
+struct PolygonsAround {
+  std::vector<uint32_t> first, around;
+};
+
+PolygonsAround polygons_around(const std::vector<MeshPolygon>& polys, uint32_t nv) {
+  PolygonsAround r;
+  r.first.assign(size_t(nv) + 1, 0);
+  for (const auto& p : polys)
+    for (int k = 0; k < p.count; ++k) ++r.first[p.v[k] + 1];
+  for (size_t v = 0; v < nv; ++v) r.first[v + 1] += r.first[v];
+  r.around.resize(r.first[nv]);
+  std::vector<uint32_t> fill(r.first.begin(), r.first.end() - 1);
+  for (uint32_t i = 0; i < polys.size(); ++i)
+    for (int k = 0; k < polys[i].count; ++k) r.around[fill[polys[i].v[k]]++] = i;
+  return r;
+}
+
+/// The search for a triangulation without crossings (see the top of this file): rounds of
+/// re-testing what changed, then trying each crossing polygon's options, then moving the
+/// vertices of crossing triangles, then changing crossing pairs of polygons jointly, with
+/// ever larger moves when nothing else is left. Positions are tested as a reader of the file
+/// sees them (bit-equal vertices merged); `x` receives every vertex move.
+class Untangler {
+ public:
+  Untangler(std::vector<Vec3>& x, const std::vector<VertexCell>& cells, const Polygons& polygons, double finest,
+            std::vector<uint8_t>& opt, TriangulationStats& st)
+      : x_(x), cells_(cells), polys_(polygons.polys), polygons_(polygons), finest_(finest), opt_(opt), st_(st),
+        n_(polys_.size()), nv_(static_cast<uint32_t>(x.size())) {
+    st_.moved_vertices += separate_coincident(x_, cells_, finest_);
+    merged_ = merge_positions(x_, polys_);
+    boxes_.resize(n_);
+    // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
+    build_tree(0);
+    other_ok_ = other_diagonal_allowed(polys_);
+    star_ = polygons_around(polys_, nv_);
+    crossing_.resize(n_);
+    self_hits_.assign(n_, 0);
+    is_dirty_.assign(n_, 1);
+    settled_.assign(n_, 0);
+    joint_settled_.assign(n_, 0);
+    vertex_settled_.assign(nv_, 0);
+    dirty_.resize(n_);
+    std::iota(dirty_.begin(), dirty_.end(), 0u);
+  }
+
+  /// Runs the rounds; returns each polygon's fan point.
+  std::vector<Vec3> run() {
+    std::vector<Vec3>& xm = merged_.xm;
+    bool moved = false;
+    for (int round = 0;; ++round) {
+      if (moved) build_tree(kMaxPull * finest_);
+      moved = false;
+      update_crossings();
+      if (round == 0) build_tree(kMaxPull * finest_);
+      size_t total = 0;
+      std::vector<uint32_t> bad;
+      for (uint32_t i = 0; i < n_; ++i) {
+        total += self_hits_[i];
+        for (const auto& e : crossing_[i]) total += e.first > i ? e.second : 0;
+        if (self_hits_[i] || !crossing_[i].empty()) bad.push_back(i);
+      }
+      if (round == 0) st_.initial_intersections = total;
+      st_.remaining_intersections = total;
+      st_.rounds = round;
+      if (total == 0 || round == kMaxRounds) break;
+      if (try_options(bad)) continue;
+      if (move_vertices(bad)) {
+        moved = true;
+        continue;
+      }
+      if (try_joint_options(bad)) continue;
+      if (last_resort_ == 2) break;
+      // What is left: let the vertices of coarse cells move further, and try everything once
+      // more (only the few polygons still crossing are tried).
+      ++last_resort_;
+      moved = true;  // the tree needs the larger room
+      std::fill(settled_.begin(), settled_.end(), 0);
+      std::fill(joint_settled_.begin(), joint_settled_.end(), 0);
+      std::fill(vertex_settled_.begin(), vertex_settled_.end(), 0);
+    }
+    return std::vector<Vec3>(xm.begin() + ptrdiff_t(xm.size() - n_), xm.end());
+  }
+
+ private:
+  int merged_tris(size_t i, uint8_t o, std::array<Tri, 4>& t) const {
+    const int c = polygons_.triangles(i, o, t);
+    for (int k = 0; k < c; ++k)
+      for (auto& v : t[k]) v = merged_.mid[v];
+    return c;
+  }
+
+  // How far a vertex may move in one round: a finest cell; in the last resort, 1/8 of its own
+  // cell's side when that is larger (the long triangles of a coarse cell's vertex cross a fine
+  // neighbour's folds by more than a finest cell).
+  double reach(uint32_t v) const {
+    return kMaxPull * (last_resort_ ? std::max(finest_, cells_[v].half / 4) : finest_);
+  }
+  // Moves along a vertex's planes (last resort) may cross its whole cell.
+  double room_of(uint32_t v) const { return last_resort_ ? std::max(reach(v), cells_[v].half) : reach(v); }
+
+  // Every option of polygon i, with its vertices moved by up to kMaxPull finest cells (in one
+  // round), stays inside the box of its vertices and its edge grown by that much. Rebuilt
+  // after a round that moved vertices.
+  void build_tree(double room) {
+    const std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    tbb::parallel_for(size_t{0}, n_, [&](size_t i) {
+      const MeshPolygon& p = polys_[i];
+      Box b{p.e0, p.e0};
+      auto grow = [&](const Vec3& q) {
+        for (int a = 0; a < 3; ++a) {
+          b.lo[a] = std::min(b.lo[a], q[a]);
+          b.hi[a] = std::max(b.hi[a], q[a]);
+        }
+      };
+      grow(p.e1);
+      for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
+      double r = 0;  // room for the vertex pulls below
+      if (room > 0)
+        for (int k = 0; k < p.count; ++k) r = std::max(r, room_of(p.v[k]));
+      for (int a = 0; a < 3; ++a) {
+        b.lo[a] -= r;
+        b.hi[a] += r;
+      }
+      boxes_[i] = b;
+    });
+    // The hierarchy of the first build serves every later one: vertices move by a cell at
+    // most, so refitting the boxes keeps the queries exact and costs no sorting.
+    if (tree_)
+      tree_->refit(boxes_);
+    else
+      tree_ = std::make_unique<BoxTree>(boxes_);
+  }
+
+  // Exact intersections of polygon i's triangles under its current option with its
+  // neighbours' current triangles and with each other; a degenerate triangle rules the
+  // option out. `except`: a neighbour left out (counted once by the caller).
+  size_t cost(uint32_t i, uint32_t except) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    std::array<Tri, 4> t;
+    const int c = merged_tris(i, opt_[i], t);
+    std::array<Box, 4> tb;
+    for (int k = 0; k < c; ++k) {
+      if (projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) < 0) return size_t{1} << 40;
+      tb[k] = box_of(xm, t[k]);
+    }
+    size_t hits = 0;
+    for (int a = 0; a < c; ++a)
+      for (int b = a + 1; b < c; ++b) hits += triangles_intersect(xm, t[a], t[b]);
+    for (int a = 0; a < c; ++a)
+      tree_->query(tb[a], [&](uint32_t j) {
+        if (j == i || j == except) return;
+        std::array<Tri, 4> u;
+        const int cu = merged_tris(j, opt_[j], u);
+        for (int b = 0; b < cu; ++b)
+          if (overlap(tb[a], box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
+      });
+    return hits;
+  }
+
+  // Crossings between polygon i under option oi and polygon j under option oj.
+  size_t mutual(uint32_t i, uint8_t oi, uint32_t j, uint8_t oj) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    std::array<Tri, 4> t, u;
+    const int c = merged_tris(i, oi, t), cu = merged_tris(j, oj, u);
+    size_t hits = 0;
+    for (int a = 0; a < c; ++a) {
+      const Box ta = box_of(xm, t[a]);
+      for (int b = 0; b < cu; ++b)
+        if (overlap(ta, box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
+    }
+    return hits;
+  }
+
+  // The polygons around vertex v, counted together (a crossing between two of them twice).
+  size_t vertex_cost(uint32_t v) const {
+    size_t c = 0;
+    for (uint32_t k = star_.first[v]; k < star_.first[v + 1]; ++k) c += cost(star_.around[k], uint32_t(-1));
+    return c;
+  }
+
+  // Crossings of polygon i with the polygons `keep` accepts (and among its own triangles);
+  // zero-area triangles are skipped, as in the whole-mesh test.
+  template <class Keep>
+  void crossings_of(uint32_t i, Keep&& keep, std::vector<std::pair<uint32_t, uint32_t>>& out, uint32_t& self) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    out.clear();
+    self = 0;
+    std::array<Tri, 4> t;
+    const int c = merged_tris(i, opt_[i], t);
+    std::array<Box, 4> tb;
+    std::array<bool, 4> ok{};
+    for (int k = 0; k < c; ++k) {
+      ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
+      tb[k] = box_of(xm, t[k]);
+    }
+    for (int a = 0; a < c; ++a)
+      for (int b = a + 1; b < c; ++b) self += ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b]);
+    for (int a = 0; a < c; ++a) {
+      if (!ok[a]) continue;
+      tree_->query(tb[a], [&](uint32_t j) {
+        if (j == i || !keep(j)) return;
+        std::array<Tri, 4> u;
+        const int cu = merged_tris(j, opt_[j], u);
+        uint32_t hits = 0;
+        for (int b = 0; b < cu; ++b)
+          if (overlap(tb[a], box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0)
+            hits += triangles_intersect(xm, t[a], u[b]);
+        if (!hits) return;
+        auto it = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == j; });
+        if (it == out.end())
+          out.push_back({j, hits});
+        else
+          it->second += hits;
+      });
+    }
+  }
+
+  // Re-tests the dirty polygons against their neighbours (the first round: every polygon) and
+  // unsettles everything near them.
+  void update_crossings() {
+    std::sort(dirty_.begin(), dirty_.end());
+    dirty_.erase(std::unique(dirty_.begin(), dirty_.end()), dirty_.end());
+    for (uint32_t i : dirty_) is_dirty_[i] = 1;
+    for (uint32_t i : dirty_) {
+      for (const auto& [j, h] : crossing_[i])
+        if (!is_dirty_[j]) std::erase_if(crossing_[j], [&](const auto& e) { return e.first == i; });
+      crossing_[i].clear();
+    }
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> found(dirty_.size());
+    std::vector<uint32_t> found_self(dirty_.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty_.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t k = r.begin(); k < r.end(); ++k) {
+        const uint32_t i = dirty_[k];
+        crossings_of(i, [&](uint32_t j) { return !is_dirty_[j] || j > i; }, found[k], found_self[k]);
+      }
+    });
+    for (size_t k = 0; k < dirty_.size(); ++k) {
+      const uint32_t i = dirty_[k];
+      self_hits_[i] = found_self[k];
+      for (const auto& [j, h] : found[k]) {
+        crossing_[i].push_back({j, h});
+        crossing_[j].push_back({i, h});
+      }
+    }
+    const bool all = dirty_.size() == n_;  // nothing was settled yet
+    for (uint32_t i : dirty_) {
+      is_dirty_[i] = 0;
+      if (!all)
+        tree_->query(boxes_[i], [&](uint32_t j) {
+          settled_[j] = joint_settled_[j] = 0;
+          for (int k = 0; k < polys_[j].count; ++k) vertex_settled_[polys_[j].v[k]] = 0;
+        });
+    }
+    dirty_.clear();
+  }
+
+  std::vector<uint8_t> options(uint32_t i) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    const MeshPolygon& p = polys_[i];
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < p.count; ++k) q[k] = xm[mid[p.v[k]]];
+    return surface_keeping_options(q, p.count, xm[mid[nv_ + i]], other_ok_[i], kMaxDeviation * finest_);
+  }
+
+  // Each crossing polygon not yet settled takes its option with the fewest crossings (ties
+  // keep the current one). Returns how many changed.
+  size_t try_options(const std::vector<uint32_t>& bad) {
+    size_t changed = 0;
+    for (uint32_t i : bad) {
+      if (settled_[i]) continue;
+      settled_[i] = 1;
+      const uint8_t was = opt_[i];
+      uint8_t best = was;
+      size_t best_cost = cost(i, uint32_t(-1));
+      for (uint8_t o : options(i)) {
+        if (o == was || best_cost == 0) continue;
+        opt_[i] = o;
+        const size_t c = cost(i, uint32_t(-1));
+        if (c < best_cost) {
+          best = o;
+          best_cost = c;
+        }
+      }
+      opt_[i] = best;
+      if (best != was) {
+        ++changed;
+        dirty_.push_back(i);
+      }
+    }
+    return changed;
+  }
+
+  // Only a vertex of a crossing triangle can undo the crossing (moving any other leaves both
+  // triangles as they are): the vertices of the bad polygons' crossing triangles, sorted.
+  std::vector<uint32_t> crossing_vertices(const std::vector<uint32_t>& bad) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    std::vector<uint32_t> verts;
+    for (uint32_t i : bad) {
+      std::array<Tri, 4> t, raw;
+      const int c = merged_tris(i, opt_[i], t);
+      polygons_.triangles(i, opt_[i], raw);
+      std::array<bool, 4> ok{}, hit{};
+      for (int k = 0; k < c; ++k) ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
+      for (int a = 0; a < c; ++a)
+        for (int b = a + 1; b < c; ++b)
+          if (ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b])) hit[a] = hit[b] = true;
+      for (const auto& [j, h] : crossing_[i]) {
+        std::array<Tri, 4> u;
+        const int cu = merged_tris(j, opt_[j], u);
+        for (int a = 0; a < c; ++a) {
+          if (!ok[a] || hit[a]) continue;
+          const Box ta = box_of(xm, t[a]);
+          for (int b = 0; b < cu && !hit[a]; ++b)
+            hit[a] = overlap(ta, box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0 &&
+                     triangles_intersect(xm, t[a], u[b]);
+        }
+      }
+      for (int a = 0; a < c; ++a)
+        if (hit[a])
+          for (uint32_t v : raw[a])
+            if (v < nv_) verts.push_back(v);
+    }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    return verts;
+  }
+
+  // No choice of triangulation resolves what is left: the polygons' vertices themselves
+  // cross (a sliver folded over its neighbour, a crease vertex on the wrong side). Move a
+  // vertex of a crossing pair a little — toward its cell's centre or toward the mean of its
+  // polygon neighbours, by 1/16 up to 1 finest cell, staying inside its cell — taking the
+  // least move that removes the most crossings around it. Returns how many moved.
+  size_t move_vertices(const std::vector<uint32_t>& bad) {
+    size_t changed = 0;
+    for (uint32_t v : crossing_vertices(bad)) {
+      // A position shared by two vertices stays put.
+      if (merged_.copies[merged_.mid[v]] != 1 || vertex_settled_[v]) continue;
+      vertex_settled_[v] = 1;
+      if (move_vertex(v)) ++changed;
+    }
+    return changed;
+  }
+
+  // Where vertex v (at `was`) may move: toward its cell's centre and toward the mean of its
+  // polygon neighbours, each by up to reach(v). Moves further than a finest cell (coarse
+  // vertices in the last resort) must keep the surface where it is: they go along the planes
+  // of v's triangles (their common null space: a flat face's plane, a crease's line) and are
+  // taken only if v stays within kFarMoveDeviation of every one of those planes (`normals`).
+  struct MoveTargets {
+    std::vector<Vec3> targets;
+    std::vector<double> scale;  // the largest move toward each target
+    std::vector<Vec3> normals;  // unit normals of v's triangles (last resort only)
+  };
+  MoveTargets move_targets(uint32_t v, const Vec3& was) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    const std::vector<uint32_t>& first = star_.first;
+    const std::vector<uint32_t>& around = star_.around;
+    Vec3 ring{0, 0, 0};
+    double count = 0;
+    for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+      const MeshPolygon& p = polys_[around[k]];
+      for (int j = 0; j < p.count; ++j)
+        if (p.v[j] != v) {
+          for (int a = 0; a < 3; ++a) ring[a] += x_[p.v[j]][a];
+          ++count;
+        }
+    }
+    for (double& r : ring) r /= count > 0 ? count : 1;
+    MoveTargets mt{{cells_[v].center, ring}, {reach(v), reach(v)}, {}};
+    if (!last_resort_) return mt;
+    // Moves along the planes keep the surface where it is, so they may cross the whole cell.
+    const double along_reach = room_of(v);
+    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+    for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+      std::array<Tri, 4> t;
+      const int c = merged_tris(around[k], opt_[around[k]], t);
+      for (int a = 0; a < c; ++a) {
+        if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
+        const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
+        const double l = norm3(nn);
+        if (!(l > 0)) continue;
+        const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
+        mt.normals.push_back({e[0], e[1], e[2]});
+        m += e * e.transpose();
+      }
+    }
+    add_targets_along_planes(m, was, along_reach, mt.targets, mt.scale);
+    return mt;
+  }
+
+  // Moves vertex v to the best of its candidate positions; whether it moved.
+  bool move_vertex(uint32_t v) {
+    std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    const std::vector<uint32_t>& first = star_.first;
+    const std::vector<uint32_t>& around = star_.around;
+    const Vec3 was = xm[mid[v]];
+    const size_t before = vertex_cost(v);
+    if (before == 0) return false;
+    Vec3 best = was;
+    size_t best_cost = before;
+    const MoveTargets mt = move_targets(v, was);
+    const std::vector<Vec3>& targets = mt.targets;
+    const std::vector<double>& scale = mt.scale;
+    const std::vector<Vec3>& normals = mt.normals;
+    double best_deviation = 0;
+    auto deviation = [&](const Vec3& q) {
+      double w = 0;
+      for (const Vec3& nn : normals) w = std::max(w, std::abs(dot3(nn, sub3(q, was))));
+      return w;
+    };
+    for (double step : {kMaxPull / 16, kMaxPull / 8, kMaxPull / 4, kMaxPull / 2, kMaxPull}) {
+      for (size_t ti = 0; ti < targets.size(); ++ti) {
+        const Vec3 d = sub3(targets[ti], was);
+        const double len = norm3(d);
+        if (!(len > 0)) continue;
+        const double f = std::min(1.0, step * scale[ti] / len);
+        Vec3 q;
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) {
+          q[k] = was[k] + f * d[k];
+          inside = inside && std::abs(q[k] - cells_[v].center[k]) <= cells_[v].half;
+        }
+        if (!inside) continue;
+        const double dv = deviation(q);
+        // Stage 1 keeps every far move on the planes; stage 2 still the moves along them
+        // (which may go further than reach(v) only because they keep the surface).
+        const bool far = f * len > (last_resort_ == 1 ? kMaxPull * finest_ : reach(v));
+        if (far && dv > kFarMoveDeviation * finest_) continue;
+        xm[mid[v]] = q;
+        const size_t c = vertex_cost(v);
+        if (c < best_cost || (last_resort_ == 2 && c == best_cost && best != was && dv < best_deviation)) {
+          best = q;
+          best_cost = c;
+          best_deviation = dv;
+        }
+      }
+      if (best_cost == 0 && (last_resort_ < 2 || best_deviation <= kFarMoveDeviation * finest_)) break;
+    }
+    xm[mid[v]] = best;
+    if (best == was) return false;
+    x_[v] = best;
+    for (uint32_t k = first[v]; k < first[v + 1]; ++k) dirty_.push_back(around[k]);
+    ++st_.moved_vertices;
+    return true;
+  }
+
+  // Two polygons that cross may need to change together: try every pair of options with each
+  // partner. Last resort before giving up (after the vertex moves): it costs up to 9
+  // evaluations per partner. Returns how many options changed.
+  size_t try_joint_options(const std::vector<uint32_t>& bad) {
+    size_t changed = 0;
+    // `crossing_` stays as the round began until the next update_crossings, so each bad
+    // polygon's partners are those it crossed then, tried in increasing order.
+    for (uint32_t i : bad) {
+      if (joint_settled_[i]) continue;
+      joint_settled_[i] = 1;
+      std::vector<uint32_t> partners;
+      for (const auto& e : crossing_[i]) partners.push_back(e.first);
+      std::sort(partners.begin(), partners.end());
+      // Options depend on positions only, which the joint pass does not move.
+      const std::vector<uint8_t> opts_i = options(i);
+      // The pair's cost under (oi, oj) is i's crossings with everything but j, j's with
+      // everything but i, and their mutual ones: single costs (each against the other's
+      // current option) corrected by the mutual counts, which need no neighbour search.
+      for (const uint32_t j : partners) {
+        const uint8_t oi0 = opt_[i], oj0 = opt_[j];
+        const std::vector<uint8_t> opts_j = options(j);
+        std::array<size_t, 3> ci{}, cj{};
+        for (uint8_t o : opts_i) {
+          opt_[i] = o;
+          ci[o] = cost(i, j);
+        }
+        opt_[i] = oi0;
+        for (uint8_t o : opts_j) {
+          opt_[j] = o;
+          cj[o] = cost(j, i);
+        }
+        opt_[j] = oj0;
+        auto joint = [&](uint8_t oi, uint8_t oj) { return ci[oi] + cj[oj] + mutual(i, oi, j, oj); };
+        size_t best_joint = joint(oi0, oj0);
+        uint8_t bi = oi0, bj = oj0;
+        for (uint8_t oi : opts_i)
+          for (uint8_t oj : opts_j) {
+            if ((oi == oi0 && oj == oj0) || best_joint == 0) continue;
+            const size_t c = joint(oi, oj);
+            if (c < best_joint) {
+              best_joint = c;
+              bi = oi;
+              bj = oj;
+            }
+          }
+        opt_[i] = bi;
+        opt_[j] = bj;
+        changed += (bi != oi0) + (bj != oj0);
+        if (bi != oi0) dirty_.push_back(i);
+        if (bj != oj0) dirty_.push_back(j);
+      }
+    }
+    return changed;
+  }
+
+  std::vector<Vec3>& x_;
+  const std::vector<VertexCell>& cells_;
+  const std::vector<MeshPolygon>& polys_;
+  const Polygons& polygons_;
+  const double finest_;
+  std::vector<uint8_t>& opt_;  // each polygon's option
+  TriangulationStats& st_;
+  const size_t n_;
+  const uint32_t nv_;
+  MergedPositions merged_;
+  // 0: none yet; 1: far moves that keep v on its triangles' planes; 2: any far move, the one
+  // that leaves those planes least among the ones that remove the most crossings.
+  int last_resort_ = 0;
+  std::unique_ptr<BoxTree> tree_;
+  std::vector<Box> boxes_;
+  std::vector<uint8_t> other_ok_;
+  PolygonsAround star_;
+  // The crossings of the current triangulation, per polygon: partners with the number of
+  // crossing triangle pairs (symmetric), and crossings among its own triangles. Round 0 tests
+  // every polygon; later rounds only the polygons whose triangles changed (`dirty_`), against
+  // their neighbours — the other polygons' pairs are unchanged.
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> crossing_;
+  std::vector<uint32_t> self_hits_;
+  std::vector<uint8_t> is_dirty_;
+  // Polygons and vertices already tried whose neighbourhood has not changed since: trying
+  // them again would give the same answer.
+  std::vector<uint8_t> settled_, joint_settled_, vertex_settled_;
+  std::vector<uint32_t> dirty_;
+};
+
 }  // namespace
 
 std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
@@ -109,535 +785,7 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
   std::vector<uint8_t> opt(n, kPreferred);
   std::vector<Vec3> fans_at;  // each polygon's fan point
   TriangulationStats st;
-
-  if (intersection_free && n > 0) {
-    // Two cells' vertices clamped to the same point (a corner or edge the cells share) are one
-    // vertex to a reader that merges equal positions: a pinch, and neither could move below.
-    // Each is moved a hair (kSeparation finest cells) toward its own cell's centre.
-    {
-      std::vector<uint32_t> perm(nv);
-      std::iota(perm.begin(), perm.end(), 0u);
-      std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
-      std::vector<uint32_t> shared;
-      for (size_t k = 0; k < perm.size(); ++k)
-        if ((k > 0 && x[perm[k]] == x[perm[k - 1]]) || (k + 1 < perm.size() && x[perm[k]] == x[perm[k + 1]]))
-          shared.push_back(perm[k]);
-      for (uint32_t v : shared) {
-        const Vec3 d = sub3(cells[v].center, x[v]);
-        const double len = norm3(d);
-        if (!(len > 0)) continue;
-        const double f = std::min(0.5, kSeparation * finest / len);
-        for (int a = 0; a < 3; ++a) x[v][a] += f * d[a];
-        ++st.moved_vertices;
-      }
-    }
-    // Positions for the test: the vertices (bit-equal ones merged, as a reader of the file sees
-    // them) followed by every polygon's candidate fan point.
-    std::vector<Vec3> xm;
-    std::vector<uint32_t> mid(size_t(nv) + n);
-    {
-      std::vector<uint32_t> perm(nv);
-      std::iota(perm.begin(), perm.end(), 0u);
-      std::sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
-      for (size_t k = 0; k < perm.size(); ++k) {
-        if (k == 0 || x[perm[k]] != x[perm[k - 1]]) xm.push_back(x[perm[k]]);
-        mid[perm[k]] = uint32_t(xm.size() - 1);
-      }
-    }
-    std::vector<uint32_t> copies(xm.size(), 0);  // vertices at each merged position
-    for (uint32_t v = 0; v < nv; ++v) ++copies[mid[v]];
-    for (size_t i = 0; i < n; ++i) {
-      const MeshPolygon& p = polys[i];
-      std::array<Vec3, 4> q;
-      for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
-      mid[nv + i] = uint32_t(xm.size());
-      xm.push_back(fan_point(q, p.count, p.e0, p.e1));
-    }
-    auto merged_tris = [&](size_t i, uint8_t o, std::array<Tri, 4>& t) {
-      const int c = P.triangles(i, o, t);
-      for (int k = 0; k < c; ++k)
-        for (auto& v : t[k]) v = mid[v];
-      return c;
-    };
-    // Every option of polygon i, with its vertices moved by up to kMaxPull finest cells (in one
-    // round), stays inside the box of its vertices and its edge grown by that much. Rebuilt
-    // after a round that moved vertices.
-    // How far a vertex may move in one round: a finest cell; in the last resort, 1/8 of its own
-    // cell's side when that is larger (the long triangles of a coarse cell's vertex cross a fine
-    // neighbour's folds by more than a finest cell).
-    // 0: none yet; 1: far moves that keep v on its triangles' planes; 2: any far move, the one
-    // that leaves those planes least among the ones that remove the most crossings.
-    int last_resort = 0;
-    auto reach = [&](uint32_t v) { return kMaxPull * (last_resort ? std::max(finest, cells[v].half / 4) : finest); };
-    // Moves along a vertex's planes (last resort) may cross its whole cell.
-    auto room_of = [&](uint32_t v) { return last_resort ? std::max(reach(v), cells[v].half) : reach(v); };
-    std::unique_ptr<BoxTree> tree;
-    std::vector<Box> boxes(n);
-    auto build_tree = [&](double room) {
-      tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-        const MeshPolygon& p = polys[i];
-        Box b{p.e0, p.e0};
-        auto grow = [&](const Vec3& q) {
-          for (int a = 0; a < 3; ++a) {
-            b.lo[a] = std::min(b.lo[a], q[a]);
-            b.hi[a] = std::max(b.hi[a], q[a]);
-          }
-        };
-        grow(p.e1);
-        for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
-        double r = 0;  // room for the vertex pulls below
-        if (room > 0)
-          for (int k = 0; k < p.count; ++k) r = std::max(r, room_of(p.v[k]));
-        for (int a = 0; a < 3; ++a) {
-          b.lo[a] -= r;
-          b.hi[a] += r;
-        }
-        boxes[i] = b;
-      });
-      // The hierarchy of the first build serves every later one: vertices move by a cell at
-      // most, so refitting the boxes keeps the queries exact and costs no sorting.
-      if (tree)
-        tree->refit(boxes);
-      else
-        tree = std::make_unique<BoxTree>(boxes);
-    };
-    // The first whole-mesh test needs no room for moves: a tighter tree, 3x fewer candidates.
-    build_tree(0);
-    // The other diagonal must not be an edge the mesh has (or may have) elsewhere: a polygon's
-    // side or another quad's diagonal would become an edge of four triangles.
-    std::vector<uint8_t> other_ok(n, 0);
-    {
-      auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
-      std::vector<uint64_t> pairs_used;
-      for (const auto& p : polys) {
-        for (int k = 0; k < p.count; ++k) pairs_used.push_back(key(p.v[k], p.v[(k + 1) % p.count]));
-        if (p.count == 4) {
-          pairs_used.push_back(key(p.v[0], p.v[2]));
-          pairs_used.push_back(key(p.v[1], p.v[3]));
-        }
-      }
-      std::sort(pairs_used.begin(), pairs_used.end());
-      auto uses = [&](uint64_t k) {
-        return std::upper_bound(pairs_used.begin(), pairs_used.end(), k) - std::lower_bound(pairs_used.begin(), pairs_used.end(), k);
-      };
-      for (size_t i = 0; i < n; ++i)
-        if (polys[i].count == 4) {
-          const auto& v = polys[i].v;
-          other_ok[i] = uses(key(v[0], v[2])) == 1 && uses(key(v[1], v[3])) == 1;
-        }
-    }
-    // Polygons around each vertex.
-    std::vector<uint32_t> first(size_t(nv) + 1, 0), around;
-    for (const auto& p : polys)
-      for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
-    for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
-    around.resize(first[nv]);
-    {
-      std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-      for (uint32_t i = 0; i < n; ++i)
-        for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = i;
-    }
-    // Exact intersections of polygon i's triangles under its current option with its
-    // neighbours' current triangles and with each other; a degenerate triangle rules the
-    // option out. `except`: a neighbour left out (counted once by the caller).
-    auto cost = [&](uint32_t i, uint32_t except) {
-      std::array<Tri, 4> t;
-      const int c = merged_tris(i, opt[i], t);
-      std::array<Box, 4> tb;
-      for (int k = 0; k < c; ++k) {
-        if (projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) < 0) return size_t{1} << 40;
-        tb[k] = box_of(xm, t[k]);
-      }
-      size_t hits = 0;
-      for (int a = 0; a < c; ++a)
-        for (int b = a + 1; b < c; ++b) hits += triangles_intersect(xm, t[a], t[b]);
-      for (int a = 0; a < c; ++a)
-        tree->query(tb[a], [&](uint32_t j) {
-          if (j == i || j == except) return;
-          std::array<Tri, 4> u;
-          const int cu = merged_tris(j, opt[j], u);
-          for (int b = 0; b < cu; ++b)
-            if (overlap(tb[a], box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
-        });
-      return hits;
-    };
-    // Crossings between polygon i under option oi and polygon j under option oj.
-    auto mutual = [&](uint32_t i, uint8_t oi, uint32_t j, uint8_t oj) {
-      std::array<Tri, 4> t, u;
-      const int c = merged_tris(i, oi, t), cu = merged_tris(j, oj, u);
-      size_t hits = 0;
-      for (int a = 0; a < c; ++a) {
-        const Box ta = box_of(xm, t[a]);
-        for (int b = 0; b < cu; ++b)
-          if (overlap(ta, box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
-      }
-      return hits;
-    };
-    // The polygons around vertex v, counted together (a crossing between two of them twice).
-    auto vertex_cost = [&](uint32_t v) {
-      size_t c = 0;
-      for (uint32_t k = first[v]; k < first[v + 1]; ++k) c += cost(around[k], uint32_t(-1));
-      return c;
-    };
-    // The crossings of the current triangulation, per polygon: partners with the number of
-    // crossing triangle pairs (symmetric), and crossings among its own triangles. Round 0 tests
-    // every polygon; later rounds only the polygons whose triangles changed (`dirty`), against
-    // their neighbours — the other polygons' pairs are unchanged.
-    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> crossing(n);
-    std::vector<uint32_t> self_hits(n, 0);
-    std::vector<uint8_t> is_dirty(n, 1);
-    // Polygons and vertices already tried whose neighbourhood has not changed since: trying
-    // them again would give the same answer.
-    std::vector<uint8_t> settled(n, 0), joint_settled(n, 0), vertex_settled(nv, 0);
-    std::vector<uint32_t> dirty(n);
-    std::iota(dirty.begin(), dirty.end(), 0u);
-    // Crossings of polygon i with the polygons `keep` accepts (and among its own triangles);
-    // zero-area triangles are skipped, as in the whole-mesh test.
-    auto crossings_of = [&](uint32_t i, auto&& keep, std::vector<std::pair<uint32_t, uint32_t>>& out, uint32_t& self) {
-      out.clear();
-      self = 0;
-      std::array<Tri, 4> t;
-      const int c = merged_tris(i, opt[i], t);
-      std::array<Box, 4> tb;
-      std::array<bool, 4> ok{};
-      for (int k = 0; k < c; ++k) {
-        ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
-        tb[k] = box_of(xm, t[k]);
-      }
-      for (int a = 0; a < c; ++a)
-        for (int b = a + 1; b < c; ++b) self += ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b]);
-      for (int a = 0; a < c; ++a) {
-        if (!ok[a]) continue;
-        tree->query(tb[a], [&](uint32_t j) {
-          if (j == i || !keep(j)) return;
-          std::array<Tri, 4> u;
-          const int cu = merged_tris(j, opt[j], u);
-          uint32_t hits = 0;
-          for (int b = 0; b < cu; ++b)
-            if (overlap(tb[a], box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0)
-              hits += triangles_intersect(xm, t[a], u[b]);
-          if (!hits) return;
-          auto it = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == j; });
-          if (it == out.end())
-            out.push_back({j, hits});
-          else
-            it->second += hits;
-        });
-      }
-    };
-    auto update_crossings = [&] {
-      std::sort(dirty.begin(), dirty.end());
-      dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
-      for (uint32_t i : dirty) is_dirty[i] = 1;
-      for (uint32_t i : dirty) {
-        for (const auto& [j, h] : crossing[i])
-          if (!is_dirty[j]) std::erase_if(crossing[j], [&](const auto& e) { return e.first == i; });
-        crossing[i].clear();
-      }
-      std::vector<std::vector<std::pair<uint32_t, uint32_t>>> found(dirty.size());
-      std::vector<uint32_t> found_self(dirty.size());
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) {
-          const uint32_t i = dirty[k];
-          crossings_of(i, [&](uint32_t j) { return !is_dirty[j] || j > i; }, found[k], found_self[k]);
-        }
-      });
-      for (size_t k = 0; k < dirty.size(); ++k) {
-        const uint32_t i = dirty[k];
-        self_hits[i] = found_self[k];
-        for (const auto& [j, h] : found[k]) {
-          crossing[i].push_back({j, h});
-          crossing[j].push_back({i, h});
-        }
-      }
-      const bool all = dirty.size() == n;  // nothing was settled yet
-      for (uint32_t i : dirty) {
-        is_dirty[i] = 0;
-        if (!all)
-          tree->query(boxes[i], [&](uint32_t j) {
-            settled[j] = joint_settled[j] = 0;
-            for (int k = 0; k < polys[j].count; ++k) vertex_settled[polys[j].v[k]] = 0;
-          });
-      }
-      dirty.clear();
-    };
-    bool moved = false;
-    for (int round = 0;; ++round) {
-      if (moved) build_tree(kMaxPull * finest);
-      moved = false;
-      update_crossings();
-      if (round == 0) build_tree(kMaxPull * finest);
-      size_t total = 0;
-      std::vector<uint32_t> bad;
-      for (uint32_t i = 0; i < n; ++i) {
-        total += self_hits[i];
-        for (const auto& e : crossing[i]) total += e.first > i ? e.second : 0;
-        if (self_hits[i] || !crossing[i].empty()) bad.push_back(i);
-      }
-      if (round == 0) st.initial_intersections = total;
-      st.remaining_intersections = total;
-      st.rounds = round;
-      if (total == 0 || round == kMaxRounds) break;
-      // Partners: the polygons each bad polygon currently crosses.
-      std::vector<std::pair<uint32_t, uint32_t>> partners;
-      for (uint32_t i : bad)
-        for (const auto& e : crossing[i]) partners.push_back({i, e.first});
-      std::sort(partners.begin(), partners.end());
-      // Options that keep the surface where it is: the other diagonal only of a quad whose two
-      // splits lie within kMaxDeviation of each other (the distance between its diagonals'
-      // lines), the fan only when its point is that close to the current triangles' planes.
-      // A big non-planar quad folded the other way moves the surface by up to its bulge.
-      auto options = [&](uint32_t i) {
-        std::vector<uint8_t> o{kPreferred};
-        const MeshPolygon& p = polys[i];
-        const double limit = kMaxDeviation * finest;
-        const Vec3& f = xm[mid[nv + i]];
-        auto plane_distance = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& q) {
-          const Vec3 n = cross3(sub3(b, a), sub3(c, a));
-          const double l = norm3(n);
-          return l > 0 ? std::abs(dot3(n, sub3(q, a))) / l : 0.0;
-        };
-        std::array<Vec3, 4> q;
-        for (int k = 0; k < p.count; ++k) q[k] = xm[mid[p.v[k]]];
-        if (p.count == 3) {
-          if (plane_distance(q[0], q[1], q[2], f) <= limit) o.push_back(kFan);
-          return o;
-        }
-        const Vec3 n = cross3(sub3(q[2], q[0]), sub3(q[3], q[1]));
-        const double l = norm3(n);
-        const double bulge = l > 0 ? std::abs(dot3(n, sub3(q[1], q[0]))) / l : 0.0;
-        if (bulge <= limit && other_ok[i]) o.push_back(kOtherDiagonal);
-        if (std::min(plane_distance(q[0], q[1], q[2], f), plane_distance(q[0], q[2], q[3], f)) <= limit &&
-            std::min(plane_distance(q[0], q[1], q[3], f), plane_distance(q[1], q[2], q[3], f)) <= limit)
-          o.push_back(kFan);
-        return o;
-      };
-      size_t changed = 0;
-      for (uint32_t i : bad) {
-        if (settled[i]) continue;
-        settled[i] = 1;
-        const uint8_t was = opt[i];
-        uint8_t best = was;
-        size_t best_cost = cost(i, uint32_t(-1));
-        for (uint8_t o : options(i)) {
-          if (o == was || best_cost == 0) continue;
-          opt[i] = o;
-          const size_t c = cost(i, uint32_t(-1));
-          if (c < best_cost) {
-            best = o;
-            best_cost = c;
-          }
-        }
-        opt[i] = best;
-        if (best != was) {
-          ++changed;
-          dirty.push_back(i);
-        }
-      }
-      if (changed) continue;
-      // No choice of triangulation resolves what is left: the polygons' vertices themselves
-      // cross (a sliver folded over its neighbour, a crease vertex on the wrong side). Move a
-      // vertex of a crossing pair a little — toward its cell's centre or toward the mean of its
-      // polygon neighbours, by 1/16 up to 1 finest cell, staying inside its cell — taking the
-      // least move that removes the most crossings around it.
-      // Only a vertex of a crossing triangle can undo the crossing (moving any other leaves
-      // both triangles as they are), so only those are tried.
-      std::vector<uint32_t> verts;
-      for (uint32_t i : bad) {
-        std::array<Tri, 4> t, raw;
-        const int c = merged_tris(i, opt[i], t);
-        P.triangles(i, opt[i], raw);
-        std::array<bool, 4> ok{}, hit{};
-        for (int k = 0; k < c; ++k) ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
-        for (int a = 0; a < c; ++a)
-          for (int b = a + 1; b < c; ++b)
-            if (ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b])) hit[a] = hit[b] = true;
-        for (const auto& [j, h] : crossing[i]) {
-          std::array<Tri, 4> u;
-          const int cu = merged_tris(j, opt[j], u);
-          for (int a = 0; a < c; ++a) {
-            if (!ok[a] || hit[a]) continue;
-            const Box ta = box_of(xm, t[a]);
-            for (int b = 0; b < cu && !hit[a]; ++b)
-              hit[a] = overlap(ta, box_of(xm, u[b])) && projection_axis(xm[u[b][0]], xm[u[b][1]], xm[u[b][2]]) >= 0 &&
-                       triangles_intersect(xm, t[a], u[b]);
-          }
-        }
-        for (int a = 0; a < c; ++a)
-          if (hit[a])
-            for (uint32_t v : raw[a])
-              if (v < nv) verts.push_back(v);
-      }
-      std::sort(verts.begin(), verts.end());
-      verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-      for (uint32_t v : verts) {
-        if (copies[mid[v]] != 1 || vertex_settled[v]) continue;  // a position shared by two vertices stays put
-        vertex_settled[v] = 1;
-        const Vec3 was = xm[mid[v]];
-        const size_t before = vertex_cost(v);
-        if (before == 0) continue;
-        Vec3 best = was;
-        size_t best_cost = before;
-        Vec3 ring{0, 0, 0};
-        double count = 0;
-        for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-          const MeshPolygon& p = polys[around[k]];
-          for (int j = 0; j < p.count; ++j)
-            if (p.v[j] != v) {
-              for (int a = 0; a < 3; ++a) ring[a] += x[p.v[j]][a];
-              ++count;
-            }
-        }
-        for (double& r : ring) r /= count > 0 ? count : 1;
-        // Moves further than a finest cell (coarse vertices in the last resort) must keep the
-        // surface where it is: they go along the planes of v's triangles (their common null
-        // space: a flat face's plane, a crease's line) and are taken only if v stays within
-        // kFarMoveDeviation of every one of those planes.
-        std::vector<Vec3> normals;
-        std::vector<Vec3> targets{cells[v].center, ring};
-        std::vector<double> scale{reach(v), reach(v)};  // the largest move toward each target
-        // Moves along the planes keep the surface where it is, so they may cross the whole cell.
-        const double along_reach = room_of(v);
-        if (last_resort) {
-          Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-          for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-            std::array<Tri, 4> t;
-            const int c = merged_tris(around[k], opt[around[k]], t);
-            for (int a = 0; a < c; ++a) {
-              if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
-              const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
-              const double l = norm3(nn);
-              if (!(l > 0)) continue;
-              const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
-              normals.push_back({e[0], e[1], e[2]});
-              m += e * e.transpose();
-            }
-          }
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
-          const Eigen::Vector3d ev = eig.eigenvalues();
-          for (size_t k = 0, c = targets.size(); k < c; ++k) {
-            const Eigen::Vector3d d(targets[k][0] - was[0], targets[k][1] - was[1], targets[k][2] - was[2]);
-            Eigen::Vector3d along = Eigen::Vector3d::Zero();
-            for (int a = 0; a < 3; ++a)
-              if (ev[a] < kNullCutoff * ev[2]) along += eig.eigenvectors().col(a) * eig.eigenvectors().col(a).dot(d);
-            if (along.norm() > 0) {
-              targets.push_back({was[0] + along[0], was[1] + along[1], was[2] + along[2]});
-              scale.push_back(along_reach);
-            }
-          }
-          // Straight along the planes both ways (an in-plane fold needs a sideways move).
-          for (int a = 0; a < 3; ++a)
-            if (ev[a] < kNullCutoff * ev[2])
-              for (double sgn : {-1.0, 1.0}) {
-                const Eigen::Vector3d e = sgn * along_reach * eig.eigenvectors().col(a);
-                targets.push_back({was[0] + e[0], was[1] + e[1], was[2] + e[2]});
-                scale.push_back(along_reach);
-              }
-        }
-        double best_deviation = 0;
-        auto deviation = [&](const Vec3& q) {
-          double w = 0;
-          for (const Vec3& nn : normals) w = std::max(w, std::abs(dot3(nn, sub3(q, was))));
-          return w;
-        };
-        for (double step : {kMaxPull / 16, kMaxPull / 8, kMaxPull / 4, kMaxPull / 2, kMaxPull}) {
-          for (size_t ti = 0; ti < targets.size(); ++ti) {
-            const Vec3 d = sub3(targets[ti], was);
-            const double len = norm3(d);
-            if (!(len > 0)) continue;
-            const double f = std::min(1.0, step * scale[ti] / len);
-            Vec3 q;
-            bool inside = true;
-            for (int k = 0; k < 3; ++k) {
-              q[k] = was[k] + f * d[k];
-              inside = inside && std::abs(q[k] - cells[v].center[k]) <= cells[v].half;
-            }
-            if (!inside) continue;
-            const double dv = deviation(q);
-            // Stage 1 keeps every far move on the planes; stage 2 still the moves along them
-            // (which may go further than reach(v) only because they keep the surface).
-            const bool far = f * len > (last_resort == 1 ? kMaxPull * finest : reach(v));
-            if (far && dv > kFarMoveDeviation * finest) continue;
-            xm[mid[v]] = q;
-            const size_t c = vertex_cost(v);
-            if (c < best_cost || (last_resort == 2 && c == best_cost && best != was && dv < best_deviation)) {
-              best = q;
-              best_cost = c;
-              best_deviation = dv;
-            }
-          }
-          if (best_cost == 0 && (last_resort < 2 || best_deviation <= kFarMoveDeviation * finest)) break;
-        }
-        xm[mid[v]] = best;
-        if (best != was) {
-          x[v] = best;
-          ++changed;
-          moved = true;
-          for (uint32_t k = first[v]; k < first[v + 1]; ++k) dirty.push_back(around[k]);
-          ++st.moved_vertices;
-        }
-      }
-      if (changed) continue;
-      // Two polygons that cross may need to change together: try every pair of options
-      // with each partner. Last resort before giving up (after the vertex moves): it costs
-      // up to 9 evaluations per partner.
-      for (uint32_t i : bad) {
-        if (joint_settled[i]) continue;
-        joint_settled[i] = 1;
-        if (self_hits[i] == 0 && crossing[i].empty()) continue;
-        // The pair's cost under (oi, oj) is i's crossings with everything but j, j's with
-        // everything but i, and their mutual ones: single costs (each against the other's
-        // current option) corrected by the mutual counts, which need no neighbour search.
-        auto lo = std::lower_bound(partners.begin(), partners.end(), std::pair<uint32_t, uint32_t>{i, 0});
-        for (; lo != partners.end() && lo->first == i; ++lo) {
-          const uint32_t j = lo->second;
-          const uint8_t oi0 = opt[i], oj0 = opt[j];
-          const std::vector<uint8_t> opts_i = options(i), opts_j = options(j);
-          std::array<size_t, 3> ci{}, cj{};
-          for (uint8_t o : opts_i) {
-            opt[i] = o;
-            ci[o] = cost(i, j);
-          }
-          opt[i] = oi0;
-          for (uint8_t o : opts_j) {
-            opt[j] = o;
-            cj[o] = cost(j, i);
-          }
-          opt[j] = oj0;
-          auto joint = [&](uint8_t oi, uint8_t oj) { return ci[oi] + cj[oj] + mutual(i, oi, j, oj); };
-          size_t best_joint = joint(oi0, oj0);
-          uint8_t bi = oi0, bj = oj0;
-          for (uint8_t oi : opts_i)
-            for (uint8_t oj : opts_j) {
-              if ((oi == oi0 && oj == oj0) || best_joint == 0) continue;
-              const size_t c = joint(oi, oj);
-              if (c < best_joint) {
-                best_joint = c;
-                bi = oi;
-                bj = oj;
-              }
-            }
-          opt[i] = bi;
-          opt[j] = bj;
-          changed += (bi != oi0) + (bj != oj0);
-          if (bi != oi0) dirty.push_back(i);
-          if (bj != oj0) dirty.push_back(j);
-        }
-      }
-      if (!changed && last_resort < 2) {
-        // What is left: let the vertices of coarse cells move further, and try everything once
-        // more (only the few polygons still crossing are tried).
-        ++last_resort;
-        moved = true;  // the tree needs the larger room
-        std::fill(settled.begin(), settled.end(), 0);
-        std::fill(joint_settled.begin(), joint_settled.end(), 0);
-        std::fill(vertex_settled.begin(), vertex_settled.end(), 0);
-        continue;
-      }
-      if (!changed) break;
-    }
-    fans_at = std::vector<Vec3>(xm.begin() + ptrdiff_t(xm.size() - n), xm.end());
-  }
+  if (intersection_free && n > 0) fans_at = Untangler(x, cells, P, finest, opt, st).run();
 
   // Output: fan points appended after the vertices, in polygon order.
   std::vector<Tri> tris;
@@ -646,9 +794,6 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
     std::array<Tri, 4> t;
     const int c = P.triangles(i, opt[i], t);
     if (opt[i] == kFan) {
-      const MeshPolygon& p = polys[i];
-      std::array<Vec3, 4> q;
-      for (int k = 0; k < p.count; ++k) q[k] = x[p.v[k]];
       const auto id = static_cast<uint32_t>(x.size());
       x.push_back(fans_at[i]);
       for (int k = 0; k < c; ++k) t[k][0] = id;
