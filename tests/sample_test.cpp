@@ -395,5 +395,12 @@ TEST(Sample, ParallelIsByteIdenticalToSerialFandisk) {
   expect_parallel_equals_serial(read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj"), 12);
 }
 
+// The winding path memoizes decisions and hole crossings per thread and collects the cells it
+// skipped from every thread: none of it may depend on which thread asked first. The teapot has
+// holes, overlapping parts and interior walls.
+TEST(Sample, ParallelIsByteIdenticalToSerialWindingTeapot) {
+  expect_parallel_equals_serial(read_mesh(std::string(PIC_DATA_DIR) + "/teapot.obj"), 10);
+}
+
 }  // namespace
 }  // namespace pic
