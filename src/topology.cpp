@@ -86,6 +86,22 @@ std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uin
 
 bool multi(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
 
+/// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
+/// one when null), depth first.
+template <class F>
+void for_each_gray_leaf(const Octree& t, const std::function<bool(uint32_t)>* active, F&& f) {
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray) {
+      f(node, cell);
+    }
+  };
+  walk(walk, 0, Cell{});
+}
+
 /// The leaf's corner signs as a mask (uniform leaves: all corners alike).
 uint8_t signs_of(const Node& n) {
   if (n.kind == CellKind::Gray) return n.signs;
@@ -474,16 +490,9 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
   for (int pass = 0; pass < 6; ++pass) {
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
     std::vector<LeafRef> bad;
-    std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
-      if (active && !(*active)(node)) return;
-      const Node& n = t.nodes[node];
-      if (n.kind == CellKind::Internal) {
-        for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
-      } else if (n.kind == CellKind::Gray && multi(n.signs)) {
-        bad.push_back({node, cell});
-      }
-    };
-    walk(0, Cell{});
+    for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
+      if (multi(t.nodes[node].signs)) bad.push_back({node, cell});
+    });
     fix.remaining = bad.size();
     if (bad.empty()) break;
     for (const LeafRef& l : bad) {
@@ -520,22 +529,17 @@ namespace {
 /// surfaces passing within a fraction of a cell of each other); bigger regions are features.
 constexpr size_t kMaxSpeckPoints = 4;
 
-/// Corners of active finest-level gray leaves holding the leaf's minority sign (both signs
-/// when tied): where a speck's points must be.
+/// Corners of active gray leaves at `min_level` or finer holding the leaf's minority sign
+/// (both signs when tied): where a speck's points must be.
 std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active, int min_level) {
   std::vector<Lat> out;
-  std::function<void(uint32_t, const Cell&)> collect = [&](uint32_t node, const Cell& cell) {
-    if (active && !(*active)(node)) return;
-    const Node& n = t.nodes[node];
-    if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level >= min_level && n.signs != 0 && n.signs != 0xff) {
-      const int in = std::popcount(n.signs);
-      for (int c = 0; c < 8; ++c)
-        if ((((n.signs >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
-    }
-  };
-  collect(0, Cell{});
+  for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
+    const uint8_t s = t.nodes[node].signs;
+    if (cell.level < min_level || s == 0 || s == 0xff) return;
+    const int in = std::popcount(s);
+    for (int c = 0; c < 8; ++c)
+      if ((((s >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
+  });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
