@@ -130,12 +130,13 @@ WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vec
                              std::vector<Box> cap_boxes)
     : all_(std::move(tris)), mesh_count_(mesh_count), cap_boxes_(cap_boxes), boundary_(std::move(boundary)) {
   tris_ = &all_;
-  bvh_.build(all_);
   if (all_.size() > mesh_count_) caps_.build_triangles({all_.begin() + long(mesh_count_), all_.end()});
 }
 
 int32_t WindingSource::ray_winding(const I3& p) const {
   // w(p) = sum over the triangles the ray p -> +x crosses of sign(n_x): w is 0 beyond the cube.
+  // Only interior walls need rays: most inputs never build the hierarchy.
+  std::call_once(bvh_built_, [&] { bvh_.build(all_); });
   std::vector<uint32_t> hits;
   bvh_.query(all_, p, {kGridMax, p[1], p[2]}, hits);
   int32_t w = 0;
@@ -184,6 +185,16 @@ void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_
 void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind,
                                     const std::vector<uint32_t>& idx, Qef& q) const {
   if (!wind || boundary_.empty()) return;
+  if (!dropped_any_) {
+    // Away from the caps the signs are parity's: every sign change on an edge is a crossing of
+    // the input's surface (all of it in the QEF) — unless a triangle dropped as an interior
+    // wall was not one everywhere.
+    const Vec3 lo = cell.min_unit();
+    const double s = cell.size();
+    bool near_cap = false;
+    cap_boxes_.query({lo, {lo[0] + s, lo[1] + s, lo[2] + s}}, [&](uint32_t) { near_cap = true; });
+    if (!near_cap) return;
+  }
   const i64 len = lattice_to_grid(cell.span());
   for (int e = 0; e < 12; ++e) {
     const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
@@ -301,6 +312,7 @@ size_t WindingSource::drop_interior_triangles() {
     t.use = 0;
     ++dropped;
   });
+  dropped_any_ = dropped > 0;
   return dropped;
 }
 

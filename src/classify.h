@@ -72,7 +72,9 @@ class WindingSource : public SurfaceSource {
  private:
   std::vector<ITri> all_;
   size_t mesh_count_;
-  TriangleBvh bvh_;
+  bool dropped_any_ = false;  // drop_interior_triangles took some out of the surface
+  mutable TriangleBvh bvh_;  // built on the first ray
+  mutable std::once_flag bvh_built_;
   DipoleTree caps_;
   BoxTree cap_boxes_;
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
