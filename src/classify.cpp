@@ -189,10 +189,8 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     // Away from the caps the signs are parity's: every sign change on an edge is a crossing of
     // the input's surface (all of it in the QEF) — unless a triangle dropped as an interior
     // wall was not one everywhere.
-    const Vec3 lo = cell.min_unit();
-    const double s = cell.size();
     bool near_cap = false;
-    cap_boxes_.query({lo, {lo[0] + s, lo[1] + s, lo[2] + s}}, [&](uint32_t) { near_cap = true; });
+    cap_boxes_.query({cell.min_unit(), cell.max_unit()}, [&](uint32_t) { near_cap = true; });
     if (!near_cap) return;
   }
   const i64 len = lattice_to_grid(cell.span());
@@ -258,9 +256,8 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
   bool met = false;
   for (uint32_t k : idx) {
     const ITri& t = all_[k];
-    if (is_degenerate(t)) continue;
+    if (!(t.use & kUseMeets) || is_degenerate(t)) continue;
     // A point of the triangle inside the cell, and one point on each side of it.
-    if (!(t.use & kUseMeets)) continue;
     const std::optional<Vec3> x = point_in_box(t, box);
     if (!x) continue;
     met = true;

@@ -41,6 +41,11 @@ struct Cell {
     constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
     return {lat[0] * k, lat[1] * k, lat[2] * k};
   }
+  Vec3 max_unit() const {
+    const Vec3 lo = min_unit();
+    const double s = size();
+    return {lo[0] + s, lo[1] + s, lo[2] + s};
+  }
 };
 
 /// Nodes and vertices being built; children of a node are 8 consecutive slots.

@@ -380,13 +380,12 @@ std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
   met[0].resize(region.boxes.size());
   std::iota(met[0].begin(), met[0].end(), 0u);
   auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
-    const Vec3 lo = cell.min_unit();
-    const double s = cell.size();
+    const Box box{cell.min_unit(), cell.max_unit()};
     const std::vector<uint32_t>& from = met[cell.level];
     std::vector<uint32_t>& here = met[cell.level + 1];
     here.clear();
     for (uint32_t i : from)
-      if (overlap(region.boxes[i], {lo, {lo[0] + s, lo[1] + s, lo[2] + s}})) here.push_back(i);
+      if (overlap(region.boxes[i], box)) here.push_back(i);
     if (here.empty()) return;
     in[node] = 1;
     const Node& n = t.nodes[node];
