@@ -530,38 +530,34 @@ namespace {
 constexpr size_t kMaxSpeckPoints = 4;
 
 /// Corners of active gray leaves at `min_level` or finer holding the leaf's minority sign
-/// (both signs when tied): where a speck's points must be.
-std::vector<Lat> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active, int min_level) {
-  std::vector<Lat> out;
+/// (both signs when tied), with that sign: where a speck's points must be.
+std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active,
+                                                   int min_level) {
+  std::vector<std::pair<Lat, bool>> out;
   for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
     const uint8_t s = t.nodes[node].signs;
     if (cell.level < min_level || s == 0 || s == 0xff) return;
     const int in = std::popcount(s);
-    for (int c = 0; c < 8; ++c)
-      if ((((s >> c) & 1) != 0) == (in <= 4) || in == 4) out.push_back(cell.corner(c));
+    for (int c = 0; c < 8; ++c) {
+      const bool sign = (s >> c) & 1;
+      if (sign == (in <= 4) || in == 4) out.push_back({cell.corner(c), sign});
+    }
   });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
-/// The region of p's sign connected to p through shared leaves, if it is a speck: every leaf
-/// around its points gray with the point as a corner, one of them at least touched by this
-/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
-/// either way.
+/// The region of p's sign (`inside`) connected to p through shared leaves, if it is a speck:
+/// every leaf around its points gray with the point as a corner (or, with `uniform_rim`,
+/// uniform of the other sign), one of them at least touched by this operation (active), and
+/// at most kMaxSpeckPoints points. `seen` gets the points visited either way.
 std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p,
-                                bool uniform_rim, std::unordered_set<uint64_t>& seen) {
+                                bool inside, bool uniform_rim, std::unordered_set<uint64_t>& seen) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   Speck sp;
-  if (uniform_rim) {
-    // p's sign, from a gray leaf that has it as a corner (the candidate came from one).
-    const std::vector<Around> around = leaves_around(t, p);
-    const auto gray = std::find_if(around.begin(), around.end(),
-                                   [&](const Around& a) { return t.nodes[a.node].kind == CellKind::Gray; });
-    if (gray == around.end()) return std::nullopt;
-    sp.inside = (t.nodes[gray->node].signs >> gray->corner) & 1;
-  }
+  sp.inside = inside;
   std::vector<Lat> queue{p};
   seen.insert(lattice_key(p));
   bool ok = true, touched = false;
@@ -585,7 +581,6 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
       ok = n.kind == CellKind::Gray && k0 >= 0;
       if (!ok) break;
       touched = touched || !active || (*active)(node);
-      if (i == 0 && o == 0 && !uniform_rim) sp.inside = (n.signs >> k0) & 1;
       sp.leaves.push_back(node);
       for (int k = 0; k < 8; ++k) {
         const Lat r = cell.corner(k);
@@ -613,9 +608,9 @@ size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
                      const std::function<bool(const Speck&)>& keep, const SpeckSearch& search) {
   std::unordered_set<uint64_t> seen;
   size_t removed = 0;
-  for (const Lat& p : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
+  for (const auto& [p, inside] : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
     if (seen.count(lattice_key(p))) continue;
-    const std::optional<Speck> sp = grow_speck(t, active, p, search.uniform_rim, seen);
+    const std::optional<Speck> sp = grow_speck(t, active, p, inside, search.uniform_rim, seen);
     if (!sp || keep(*sp)) continue;
     for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
     ++removed;
