@@ -85,14 +85,19 @@ struct CacheEntry {
   uint32_t id = 0;  // 0: empty
   bool inside = false;
 };
-constexpr size_t kCacheBits = 15;
+constexpr int kCacheBits = 15;
 std::atomic<uint32_t> g_next_cache_id{1};
+
+/// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped memo.
+size_t slot_of(const I3& p, uint64_t extra, int bits) {
+  const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                     (uint64_t(p[2]) * 0x165667B19E3779F9ull) ^ extra;
+  return (h ^ (h >> 29)) & ((size_t{1} << bits) - 1);
+}
 
 CacheEntry& cache_slot(const I3& p) {
   thread_local std::vector<CacheEntry> slots(size_t{1} << kCacheBits);
-  const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
-                     (uint64_t(p[2]) * 0x165667B19E3779F9ull);
-  return slots[(h ^ (h >> 29)) & ((size_t{1} << kCacheBits) - 1)];
+  return slots[slot_of(p, 0, kCacheBits)];
 }
 
 /// A crossing found on a cell edge across a hole, with the level set's normal there: up to 4
@@ -106,11 +111,9 @@ struct CrossingEntry {
 };
 
 CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
-  constexpr size_t kBits = 13;
+  constexpr int kBits = 13;
   thread_local std::vector<CrossingEntry> slots(size_t{1} << kBits);
-  const uint64_t h = (uint64_t(a[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(a[1]) * 0xC2B2AE3D27D4EB4Full) ^
-                     (uint64_t(a[2]) * 0x165667B19E3779F9ull) ^ (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis);
-  return slots[(h ^ (h >> 29)) & ((size_t{1} << kBits) - 1)];
+  return slots[slot_of(a, (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis), kBits)];
 }
 
 }  // namespace
@@ -145,15 +148,19 @@ int32_t WindingSource::ray_winding(const I3& p) const {
   return w;
 }
 
+bool WindingSource::near_caps(const Box& box) const {
+  bool near = false;
+  cap_boxes_.query(box, [&](uint32_t) { near = true; });
+  return near;
+}
+
 bool WindingSource::inside(const I3& p, int32_t w) const {
   if (caps_.empty()) return w != 0;
   // Outside a loop's convex hull its cap subtends less than a hemisphere (unless the loop,
   // seen from p, winds twice round some direction), so |w_C| < 1/2 and |w - w_C| >= 1/2
   // exactly when w != 0. Most decisions near the input's surface are settled here.
   const Vec3 u = to_unit(p);
-  bool near_cap = false;
-  cap_boxes_.query({u, u}, [&](uint32_t) { near_cap = true; });
-  if (!near_cap) return w != 0;
+  if (!near_caps({u, u})) return w != 0;
   if (const auto far = caps_.inside_far(u, w)) return *far;
   if (const int known = cache_.find(p); known >= 0) return known;
   const bool in = caps_.inside(u, &p, w, kCapTolerance);
@@ -189,9 +196,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     // Away from the caps the signs are parity's: every sign change on an edge is a crossing of
     // the input's surface (all of it in the QEF) — unless a triangle dropped as an interior
     // wall was not one everywhere.
-    bool near_cap = false;
-    cap_boxes_.query({cell.min_unit(), cell.max_unit()}, [&](uint32_t) { near_cap = true; });
-    if (!near_cap) return;
+    if (!near_caps({cell.min_unit(), cell.max_unit()})) return;
   }
   const i64 len = lattice_to_grid(cell.span());
   for (int e = 0; e < 12; ++e) {

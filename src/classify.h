@@ -70,6 +70,9 @@ class WindingSource : public SurfaceSource {
   size_t drop_interior_triangles();
 
  private:
+  /// Whether `box` (unit space) meets a boundary loop's box: only there do the caps decide.
+  bool near_caps(const Box& box) const;
+
   std::vector<ITri> all_;
   size_t mesh_count_;
   bool dropped_any_ = false;  // drop_interior_triangles took some out of the surface
