@@ -148,6 +148,29 @@ int32_t WindingSource::ray_winding(const I3& p) const {
   return w;
 }
 
+int32_t WindingSource::winding_from(const I3& a, int32_t w, const I3& b) const {
+  // Along the axes from a to b through the few triangles near both: one long ray is enough
+  // for the two sides of a triangle (the integer winding number is path-independent, the
+  // input and its cones being a closed chain).
+  std::call_once(bvh_built_, [&] { bvh_.build(all_); });
+  I3 lo, hi;
+  for (int k = 0; k < 3; ++k) lo[k] = std::min(a[k], b[k]), hi[k] = std::max(a[k], b[k]);
+  std::vector<uint32_t> near;
+  bvh_.query(all_, lo, hi, near);
+  I3 p = a;
+  for (int axis = 0; axis < 3; ++axis) {
+    const i64 len = b[axis] - p[axis];
+    if (len == 0) continue;
+    I3 from = p;
+    if (len < 0) from[axis] = b[axis];
+    // Crossing a triangle along +axis changes w by -sign(n_axis), along -axis by +sign(n_axis).
+    for (uint32_t k : near)
+      if (crosses(all_[k], from, axis, std::abs(len))) w -= len > 0 ? sgn(all_[k].n[axis]) : -sgn(all_[k].n[axis]);
+    p[axis] = b[axis];
+  }
+  return w;
+}
+
 bool WindingSource::near_caps(const Box& box) const {
   bool near = false;
   cap_boxes_.query(box, [&](uint32_t) { near = true; });
@@ -309,7 +332,8 @@ size_t WindingSource::drop_interior_triangles() {
         const double o = k ? -delta : delta;
         side[k] = to_grid({p[0] + o * t.unit_normal[0], p[1] + o * t.unit_normal[1], p[2] + o * t.unit_normal[2]});
       }
-      if (inside(side[0], ray_winding(side[0])) != inside(side[1], ray_winding(side[1]))) return;
+      const int32_t w0 = ray_winding(side[0]);
+      if (inside(side[0], w0) != inside(side[1], winding_from(side[0], w0, side[1]))) return;
     }
     t.use = 0;
     ++dropped;

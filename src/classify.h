@@ -56,6 +56,8 @@ class WindingSource : public SurfaceSource {
 
   /// Integer winding number of input + cones at a grid point (a ray to the cube's boundary).
   int32_t ray_winding(const I3& p) const;
+  /// Integer winding number at grid point b, given w at a nearby point a (after ray_winding).
+  int32_t winding_from(const I3& a, int32_t w, const I3& b) const;
   /// The sign at grid point p whose integer winding number is w.
   bool inside(const I3& p, int32_t w) const;
   /// Integer winding number at grid point p of `cell` (corner windings `wind`), by a path

@@ -80,6 +80,20 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi);
 struct IBox {
   I3 lo, hi;
 };
+
+/// edges_may_touch_box for the 8 children of one box (split_tris asks it for several): the
+/// triangle's projections on the 9 axes are taken once about the box's centre and shifted to
+/// each child's, with the margin widened by the shift.
+class ChildEdgeTest {
+ public:
+  ChildEdgeTest(const ITri& t, const IBox& parent);
+  /// Child c (bit k: high half along axis k).
+  bool may_touch(int c) const;
+
+ private:
+  double pmin_[9], pmax_[9], mag_[9], fi_[9], fj_[9];
+  double quarter_;  // a child's half size
+};
 inline IBox cell_box(int level, const std::array<int64_t, 3>& lat) {
   const int64_t s = int64_t{1} << (kMaxLevel - level);
   return {lattice_to_grid(lat), lattice_to_grid({lat[0] + s, lat[1] + s, lat[2] + s})};

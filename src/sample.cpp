@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -114,6 +115,7 @@ void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
     std::array<unsigned, 3> halves{};
     for (int a = 0; a < 3; ++a)
       halves[a] = unsigned(t.lo[a] <= mid[a] && t.hi[a] >= b.lo[a]) | unsigned(t.hi[a] >= mid[a] && t.lo[a] <= b.hi[a]) << 1;
+    std::optional<ChildEdgeTest> edges;  // built for the first child that needs it
     for (int c = 0; c < 8; ++c) {
       if (!((halves[0] >> (c & 1)) & 1) || !((halves[1] >> ((c >> 1) & 1)) & 1) || !((halves[2] >> ((c >> 2) & 1)) & 1))
         continue;
@@ -121,7 +123,12 @@ void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
       // A triangle inside the child's box meets it; otherwise the exact plane test decides.
       const bool inside = t.lo[0] >= cb.lo[0] && t.lo[1] >= cb.lo[1] && t.lo[2] >= cb.lo[2] && t.hi[0] <= cb.hi[0] &&
                           t.hi[1] <= cb.hi[1] && t.hi[2] <= cb.hi[2];
-      if (inside || (overlaps_box(t, cb.lo, cb.hi) && edges_may_touch_box(t, cb.lo, cb.hi))) out[c].push_back(k);
+      if (!inside) {
+        if (!overlaps_box(t, cb.lo, cb.hi)) continue;
+        if (!edges) edges.emplace(t, b);
+        if (!edges->may_touch(c)) continue;
+      }
+      out[c].push_back(k);
     }
   }
 }
