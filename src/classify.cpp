@@ -86,18 +86,10 @@ struct CacheEntry {
   bool inside = false;
 };
 constexpr int kCacheBits = 15;
-std::atomic<uint32_t> g_next_cache_id{1};
-
-/// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped memo.
-size_t slot_of(const I3& p, uint64_t extra, int bits) {
-  const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
-                     (uint64_t(p[2]) * 0x165667B19E3779F9ull) ^ extra;
-  return (h ^ (h >> 29)) & ((size_t{1} << bits) - 1);
-}
 
 CacheEntry& cache_slot(const I3& p) {
   thread_local std::vector<CacheEntry> slots(size_t{1} << kCacheBits);
-  return slots[slot_of(p, 0, kCacheBits)];
+  return slots[memo_slot(p, 0, kCacheBits)];
 }
 
 /// A crossing found on a cell edge across a hole, with the level set's normal there: up to 4
@@ -113,12 +105,12 @@ struct CrossingEntry {
 CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
   constexpr int kBits = 13;
   thread_local std::vector<CrossingEntry> slots(size_t{1} << kBits);
-  return slots[slot_of(a, (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis), kBits)];
+  return slots[edge_memo_slot(a, axis, len, kBits)];
 }
 
 }  // namespace
 
-DecisionCache::DecisionCache() : id_(g_next_cache_id++) {}
+DecisionCache::DecisionCache() : id_(new_memo_id()) {}
 
 int DecisionCache::find(const I3& p) const {
   const CacheEntry& e = cache_slot(p);
@@ -137,14 +129,26 @@ WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vec
 }
 
 int32_t WindingSource::ray_winding(const I3& p) const {
-  // w(p) = sum over the triangles the ray p -> +x crosses of sign(n_x): w is 0 beyond the cube.
+  // w(p) = sum over the triangles a ray from p out of the cube crosses of the sign of their
+  // normal along it: w is 0 beyond the cube.
   // Only interior walls need rays: most inputs never build the hierarchy.
   std::call_once(bvh_built_, [&] { bvh_.build(all_); });
-  std::vector<uint32_t> hits;
-  bvh_.query(all_, p, {kGridMax, p[1], p[2]}, hits);
+  // The shortest way out of the cube along an axis: fewer triangles to test.
+  int axis = 0;
+  bool up = true;
+  i64 best = kGridMax;
+  for (int k = 0; k < 3; ++k) {
+    if (kGridMax - p[k] < best) axis = k, up = true, best = kGridMax - p[k];
+    if (p[k] < best) axis = k, up = false, best = p[k];
+  }
+  I3 from = p, to = p;
+  (up ? to : from)[axis] = up ? kGridMax : 0;
+  thread_local std::vector<uint32_t> hits;
+  hits.clear();
+  bvh_.query(all_, from, to, hits);
   int32_t w = 0;
   for (uint32_t k : hits)
-    if (crosses(all_[k], p, 0, kGridMax - p[0])) w += sgn(all_[k].n[0]);
+    if (crosses(all_[k], from, axis, to[axis] - from[axis])) w += up ? sgn(all_[k].n[axis]) : -sgn(all_[k].n[axis]);
   return w;
 }
 

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -17,6 +18,17 @@
 #include <unordered_map>
 
 namespace pic::detail {
+
+size_t memo_slot(const I3& p, uint64_t extra, int bits) {
+  const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                     (uint64_t(p[2]) * 0x165667B19E3779F9ull) ^ extra;
+  return (h ^ (h >> 29)) & ((size_t{1} << bits) - 1);
+}
+
+uint32_t new_memo_id() {
+  static std::atomic<uint32_t> next{1};
+  return next++;
+}
 
 LineMask line_mask(const ITri& t, const I3& base, i64 step, int count) {
   LineMask m;
@@ -183,8 +195,29 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
 
 namespace {
 
+/// Crossings of a cell edge, memoized per thread: up to 4 cells of a level share an edge, and
+/// the count is the edge's own (every cell's list holds each triangle crossing its edges).
+struct EdgeCount {
+  I3 a;
+  i64 len = 0;
+  int axis = 0;
+  uint32_t id = 0;  // 0: empty
+  int count = 0;
+};
+
+int edge_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a, int axis,
+                   i64 len, uint32_t memo_id) {
+  if (memo_id == 0) return count_crossings(tris, idx, a, axis, len);
+  constexpr int kBits = 13;
+  thread_local std::vector<EdgeCount> slots(size_t{1} << kBits);
+  EdgeCount& e = slots[edge_memo_slot(a, axis, len, kBits)];
+  if (e.id != memo_id || e.a != a || e.axis != axis || e.len != len)
+    e = {a, len, axis, memo_id, count_crossings(tris, idx, a, axis, len)};
+  return e.count;
+}
+
 bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
-                         const Cell& cell, uint8_t signs) {
+                         const Cell& cell, uint8_t signs, uint32_t memo_id) {
   const I3 lo = lattice_to_grid(cell.lat);
   const int64_t s = lattice_to_grid(cell.span());
   // Bounding boxes first: an edge needs 2 (3 with a sign change) triangles whose boxes reach
@@ -205,7 +238,7 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
     const int needed = change ? 3 : 2;
     if (candidates[e] < needed) continue;
     const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
-    if (count_crossings(tris, idx, a, edge_axis(e), s) >= needed) return true;
+    if (edge_crossings(tris, idx, a, edge_axis(e), s, memo_id) >= needed) return true;
   }
   return false;
 }
@@ -239,7 +272,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
-                    !has_double_crossing(src.tris(), idx, cell, signs);
+                    !has_double_crossing(src.tris(), idx, cell, signs, p.memo_id);
     if (ok || at_cap) {
       if (!ok) ++capped;
       out.set_gray(slot, cell, written, sol.position, ok ? 0 : kFlagCapped);
@@ -365,6 +398,7 @@ std::vector<I3> to_grid_inside(const Cube& cube, const std::vector<Vec3>& points
 
 SampleParams params_of(const SampleOptions& options) {
   SampleParams p;
+  p.memo_id = new_memo_id();
   p.max_depth = options.depth;
   p.error = options.error;
   p.parallel_levels = options.parallel ? 2 : 0;

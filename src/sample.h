@@ -90,7 +90,18 @@ struct SampleParams {
   double error = 1e-8;
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
+  uint32_t memo_id = 0;    // nonzero: one triangle set, whose edge crossing counts may be memoized
 };
+
+/// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped,
+/// per-thread memo.
+size_t memo_slot(const I3& p, uint64_t extra, int bits);
+/// The same for a cell edge: from `a`, `len` along `axis`.
+inline size_t edge_memo_slot(const I3& a, int axis, i64 len, int bits) {
+  return memo_slot(a, (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis), bits);
+}
+/// A fresh nonzero id for a memo (SampleParams::memo_id, a decision cache).
+uint32_t new_memo_id();
 
 /// QEF of the triangles meeting `cell` (weights: clipped area / cell face area + a floor, so
 /// planes that touch the cell only along its boundary still count — box corners on octree
