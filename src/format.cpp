@@ -24,29 +24,38 @@ constexpr size_t kCrcBytes = 4;
 /// cell_size / 2^(q+1) is at most 2^-25 ~ 3e-8 of the root cube from level 2 on.
 int quant_bits(int level) { return std::min(22, 24 - level); }
 
+// Bits are packed least-significant first; whole bytes go through a 64-bit accumulator.
 class BitWriter {
  public:
-  void put(uint32_t v, int bits) {
-    for (int b = 0; b < bits; ++b) {
-      if (pos_ % 8 == 0) bytes_.push_back(0);
-      if ((v >> b) & 1) bytes_.back() |= uint8_t(1u << (pos_ % 8));
-      ++pos_;
-    }
+  void put(uint32_t v, int bits) {  // bits <= 32
+    acc_ |= uint64_t(v & uint32_t((uint64_t{1} << bits) - 1)) << fill_;
+    fill_ += bits;
+    for (; fill_ >= 8; fill_ -= 8, acc_ >>= 8) bytes_.push_back(uint8_t(acc_));
   }
-  std::vector<uint8_t>& bytes() { return bytes_; }
+  /// The bytes written, the last one padded with zero bits.
+  std::vector<uint8_t>& bytes() {
+    if (fill_ > 0) bytes_.push_back(uint8_t(acc_)), acc_ = 0, fill_ = 0;
+    return bytes_;
+  }
 
  private:
   std::vector<uint8_t> bytes_;
-  size_t pos_ = 0;
+  uint64_t acc_ = 0;
+  int fill_ = 0;  // bits in acc_ (< 8 between calls)
 };
 
 class BitReader {
  public:
   BitReader(const uint8_t* data, size_t size) : data_(data), bits_(size * 8) {}
-  uint32_t get(int bits) {
+  uint32_t get(int bits) {  // bits <= 32
     if (pos_ + size_t(bits) > bits_) throw IoError("corrupted .pic file: tree data ends early");
-    uint32_t v = 0;
-    for (int b = 0; b < bits; ++b, ++pos_) v |= uint32_t((data_[pos_ / 8] >> (pos_ % 8)) & 1) << b;
+    if (bits == 0) return 0;
+    // Up to 5 bytes hold the field; bytes past the end are never read.
+    const size_t first = pos_ / 8, last = (pos_ + size_t(bits) - 1) / 8;
+    uint64_t word = 0;
+    for (size_t k = first; k <= last; ++k) word |= uint64_t(data_[k]) << (8 * (k - first));
+    const uint32_t v = uint32_t((word >> (pos_ % 8)) & ((uint64_t{1} << bits) - 1));
+    pos_ += size_t(bits);
     return v;
   }
 
