@@ -207,7 +207,9 @@ struct EdgeCount {
 
 int edge_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a, int axis,
                    i64 len, uint32_t memo_id) {
-  if (memo_id == 0) return count_crossings(tris, idx, a, axis, len);
+  // A short list is counted faster than the memo's slot is fetched from memory.
+  constexpr size_t kMemoFrom = 8;
+  if (memo_id == 0 || idx.size() < kMemoFrom) return count_crossings(tris, idx, a, axis, len);
   constexpr int kBits = 13;
   thread_local std::vector<EdgeCount> slots(size_t{1} << kBits);
   EdgeCount& e = slots[edge_memo_slot(a, axis, len, kBits)];
