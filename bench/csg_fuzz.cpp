@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
       i += 3;
     }
     else {
-      std::fprintf(stderr, "usage: pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR] | --case SEED\n");
+      std::fprintf(stderr, "usage: pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR] | --case SEED [--resampled]\n");
       return 1;
     }
   }
