@@ -6,6 +6,7 @@
 //
 //   pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR]
 //   pic_csg_fuzz --case SEED [--out DIR]     one case, its meshes written to DIR
+//   ... --resampled                          also the exact result sampled on the same lattice
 //   pic_csg_fuzz --pair A.obj OP B.obj [--depth D] [--out DIR]
 //                                            two meshes sampled in the cube around both
 #include <algorithm>
@@ -67,6 +68,18 @@ void write_meshes(const std::string& out_dir, const std::string& prefix,
   if (exact) write_mesh(*exact, base + "exact.obj");
 }
 
+bool g_resampled = false;  // --resampled: also compare the exact result sampled by PIC
+
+/// The exact result itself sampled on the same lattice: how close PIC can get to it at all.
+/// A CSG distance about this large is the resolution limit, one much larger is an error.
+void print_resampled(const TriMesh& exact, const SampleOptions& so, double cell) {
+  const CsgComparison r = compare_to_exact(written(sample(exact, so)), exact, cell);
+  std::printf("exact sampled: components %zu/%zu, pic->exact %.2f, exact->pic %.2f at (%.4f %.4f %.4f), thick %.2f at "
+              "(%.4f %.4f %.4f)\n",
+              r.pic_components, r.exact_components, r.pic_to_exact, r.exact_to_pic, r.worst_exact[0], r.worst_exact[1],
+              r.worst_exact[2], r.exact_to_pic_thick, r.worst_thick[0], r.worst_thick[1], r.worst_thick[2]);
+}
+
 CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) {
   CaseResult res;
   res.seed = seed;
@@ -84,9 +97,19 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
   std::vector<Octree> trees;
   for (const TriMesh& m : inputs) trees.push_back(sample(m, so));
   Octree acc = trees[0];
-  for (size_t i = 1; i < trees.size(); ++i) acc = csg(acc, trees[i], ops[i - 1]);
+  std::vector<Octree> steps;  // the result after each operation, saved with --out
+  for (size_t i = 1; i < trees.size(); ++i) {
+    acc = csg(acc, trees[i], ops[i - 1]);
+    if (!out_dir.empty()) steps.push_back(acc);
+  }
   const TriMesh pic_mesh = written(acc);
   res.pic_seconds = since(t0);
+  if (!out_dir.empty()) {
+    std::filesystem::create_directories(out_dir);
+    const std::string base = out_dir + "/case" + std::to_string(seed) + "_";
+    for (size_t i = 0; i < trees.size(); ++i) save(trees[i], base + "op" + std::to_string(i) + ".pic");
+    for (size_t i = 0; i < steps.size(); ++i) save(steps[i], base + "step" + std::to_string(i + 1) + ".pic");
+  }
   t0 = Clock::now();
   std::optional<TriMesh> exact = written(trees[0]);
   for (size_t i = 1; i < trees.size() && exact; ++i) exact = exact_boolean(*exact, written(trees[i]), ops[i - 1]);
@@ -103,6 +126,7 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
   }
   res.cmp = compare_to_exact(pic_mesh, *exact, 1.0 / double(1 << res.depth));
   if (!out_dir.empty()) print_components(pic_mesh, *exact, 1.0 / double(1 << res.depth));
+  if (g_resampled) print_resampled(*exact, so, 1.0 / double(1 << res.depth));
   return res;
 }
 
@@ -174,12 +198,13 @@ int main(int argc, char** argv) {
     else if (arg("--top")) top = std::stoi(argv[++i]);
     else if (arg("--out")) out_dir = argv[++i];
     else if (arg("--case")) single = std::stoull(argv[++i]), one = true;
+    else if (std::strcmp(argv[i], "--resampled") == 0) g_resampled = true;
     else if (std::strcmp(argv[i], "--pair") == 0 && i + 3 < argc) {
       pair = {argv[i + 1], argv[i + 2], argv[i + 3]};
       i += 3;
     }
     else {
-      std::fprintf(stderr, "usage: pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR] | --case SEED\n");
+      std::fprintf(stderr, "usage: pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR] | --case SEED [--resampled]\n");
       return 1;
     }
   }
