@@ -209,36 +209,37 @@ ChildEdgeTest::ChildEdgeTest(const ITri& t, const IBox& parent) {
     const double c = (double(parent.lo[k]) + double(parent.hi[k])) / 2;
     for (int i = 0; i < 3; ++i) v[i][k] = double(t.v[i][k]) - c;
   }
-  quarter_ = (double(parent.hi[0]) - double(parent.lo[0])) / 4;
+  const double q = (double(parent.hi[0]) - double(parent.lo[0])) / 4;  // a child's half size
   for (int e = 0; e < 3; ++e) {
     const double* a = v[e];
     const double* b = v[(e + 1) % 3];
     const double f[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     for (int k = 0; k < 3; ++k) {
       const int i = (k + 1) % 3, j = (k + 2) % 3, x = 3 * e + k;
-      fi_[x] = f[i];
-      fj_[x] = f[j];
-      pmin_[x] = 1e300, pmax_[x] = -1e300, mag_[x] = 0;
+      double mag = 0;
+      pmin_[x] = 1e300, pmax_[x] = -1e300;
       for (const auto& w : v) {
         const double p = -f[j] * w[i] + f[i] * w[j];
         pmin_[x] = std::min(pmin_[x], p);
         pmax_[x] = std::max(pmax_[x], p);
-        mag_[x] = std::max(mag_[x], std::abs(f[j] * w[i]) + std::abs(f[i] * w[j]));
+        mag = std::max(mag, std::abs(f[j] * w[i]) + std::abs(f[i] * w[j]));
       }
+      // q is a power of two: the shift's terms are exact.
+      a_[x] = f[j] * q;
+      b_[x] = f[i] * q;
+      const double r = q * (std::abs(f[j]) + std::abs(f[i]));
+      // About the child's centre the vertices' terms grow by at most r: edges_may_touch_box's margin.
+      reach_[x] = r + (1e-12 * (mag + 2 * r) + 1);
     }
   }
 }
 
 bool ChildEdgeTest::may_touch(int c) const {
-  const double q = quarter_;
-  const double dc[3] = {(c & 1) ? q : -q, (c & 2) ? q : -q, (c & 4) ? q : -q};
   for (int x = 0; x < 9; ++x) {
     const int k = x % 3, i = (k + 1) % 3, j = (k + 2) % 3;
-    const double shift = -fj_[x] * dc[i] + fi_[x] * dc[j];
-    const double r = q * (std::abs(fj_[x]) + std::abs(fi_[x]));
-    // About the child's centre the vertices' terms grow by at most r: edges_may_touch_box's margin.
-    const double slack = 1e-12 * (mag_[x] + 2 * r) + 1;
-    if (pmin_[x] - shift > r + slack || pmax_[x] - shift < -r - slack) return false;
+    // The axis (-f_j, f_i) at the child's centre offset (+-q, +-q).
+    const double shift = ((c >> i) & 1 ? -a_[x] : a_[x]) + ((c >> j) & 1 ? b_[x] : -b_[x]);
+    if (pmin_[x] - shift > reach_[x] || pmax_[x] - shift < -reach_[x]) return false;
   }
   return true;
 }

@@ -91,8 +91,9 @@ class ChildEdgeTest {
   bool may_touch(int c) const;
 
  private:
-  double pmin_[9], pmax_[9], mag_[9], fi_[9], fj_[9];
-  double quarter_;  // a child's half size
+  // Per axis x = 3 * edge + k: the projections' range about the parent's centre, the shift
+  // to a child's centre as +-a_ +-b_, and the child's half width on the axis plus the margin.
+  double pmin_[9], pmax_[9], a_[9], b_[9], reach_[9];
 };
 inline IBox cell_box(int level, const std::array<int64_t, 3>& lat) {
   const int64_t s = int64_t{1} << (kMaxLevel - level);
