@@ -108,6 +108,23 @@ CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
   return slots[edge_memo_slot(a, axis, len, kBits)];
 }
 
+/// Integer winding number at b from w at a, along the axes in turn (x, then y, then z) through
+/// the triangles `near` (all those the path can cross). Crossing a triangle along +axis changes
+/// w by -sign(n_axis), along -axis by +sign(n_axis).
+int32_t winding_along_axes(const std::vector<ITri>& tris, const std::vector<uint32_t>& near, I3 a, int32_t w,
+                           const I3& b) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const i64 len = b[axis] - a[axis];
+    if (len == 0) continue;
+    I3 from = a;
+    if (len < 0) from[axis] = b[axis];
+    for (uint32_t k : near)
+      if (crosses(tris[k], from, axis, std::abs(len))) w -= len > 0 ? sgn(tris[k].n[axis]) : -sgn(tris[k].n[axis]);
+    a[axis] = b[axis];
+  }
+  return w;
+}
+
 }  // namespace
 
 DecisionCache::DecisionCache() : id_(new_memo_id()) {}
@@ -153,26 +170,16 @@ int32_t WindingSource::ray_winding(const I3& p) const {
 }
 
 int32_t WindingSource::winding_from(const I3& a, int32_t w, const I3& b) const {
-  // Along the axes from a to b through the few triangles near both: one long ray is enough
-  // for the two sides of a triangle (the integer winding number is path-independent, the
-  // input and its cones being a closed chain).
+  // Through the few triangles near both: one long ray is enough for the two sides of a
+  // triangle (the integer winding number is path-independent, the input and its cones being
+  // a closed chain).
   std::call_once(bvh_built_, [&] { bvh_.build(all_); });
   I3 lo, hi;
   for (int k = 0; k < 3; ++k) lo[k] = std::min(a[k], b[k]), hi[k] = std::max(a[k], b[k]);
-  std::vector<uint32_t> near;
+  thread_local std::vector<uint32_t> near;
+  near.clear();
   bvh_.query(all_, lo, hi, near);
-  I3 p = a;
-  for (int axis = 0; axis < 3; ++axis) {
-    const i64 len = b[axis] - p[axis];
-    if (len == 0) continue;
-    I3 from = p;
-    if (len < 0) from[axis] = b[axis];
-    // Crossing a triangle along +axis changes w by -sign(n_axis), along -axis by +sign(n_axis).
-    for (uint32_t k : near)
-      if (crosses(all_[k], from, axis, std::abs(len))) w -= len > 0 ? sgn(all_[k].n[axis]) : -sgn(all_[k].n[axis]);
-    p[axis] = b[axis];
-  }
-  return w;
+  return winding_along_axes(all_, near, a, w, b);
 }
 
 bool WindingSource::near_caps(const Box& box) const {
@@ -266,16 +273,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
 
 int32_t WindingSource::winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx,
                                        const I3& p) const {
-  I3 a = lattice_to_grid(cell.lat);
-  int32_t w = wind[0];
-  for (int axis = 0; axis < 3; ++axis) {
-    const i64 len = p[axis] - a[axis];
-    if (len > 0)
-      for (uint32_t k : idx)
-        if (crosses(all_[k], a, axis, len)) w -= sgn(all_[k].n[axis]);
-    a[axis] = p[axis];
-  }
-  return w;
+  return winding_along_axes(all_, idx, lattice_to_grid(cell.lat), wind[0], p);
 }
 
 bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind,

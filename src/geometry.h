@@ -73,7 +73,8 @@ bool overlaps_box(const ITri& t, const I3& lo, const I3& hi);
 /// False only when one of the 9 axes (box axis x triangle edge) clearly separates t from the
 /// closed box (floating point with a safety margin: "true" may still be apart). With
 /// overlaps_box it makes the separating-axis test complete, which long slivers need: their
-/// boxes and planes reach many cells their edges pass far from.
+/// boxes and planes reach many cells their edges pass far from. Sampling asks ChildEdgeTest
+/// (the same test for a box's 8 children at once); this one-box form is its reference.
 bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi);
 
 /// Cell box in grid units.
