@@ -1212,7 +1212,9 @@ void clean_up(Octree& a, const Octree& b, const PartialContour& pb, CsgOp op, ui
     const std::function<bool(const Lat&)> sign_b = [&](const Lat& p) { return ob.sign(p); };
     // Specks the Boolean made (where the two operands' surfaces pass within a fraction of a
     // cell of each other); one operand's own small components stay.
-    remove_specks(a, &stamped, [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); });
+    SpeckSearch search;
+    search.coarse_rim = true;
+    remove_specks(a, &stamped, [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); }, search);
   }
   stats.repaired = repair_cracks(a, &stamped);
 }

@@ -4,6 +4,8 @@
 #include "sample.h"
 #include "union_find.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -529,6 +531,31 @@ namespace {
 /// surfaces passing within a fraction of a cell of each other); bigger regions are features.
 constexpr size_t kMaxSpeckPoints = 4;
 
+/// How thin, in finest cells, a speck that reaches a coarser leaf must be to be removed: two
+/// surfaces passing within a fraction of a cell of each other (harness seed 300: a void a
+/// quarter cell thick) are; a piece a cell thick is a feature.
+constexpr double kMaxSpeckThickness = 0.5;
+
+/// The extent of points across their flattest direction (the smallest principal axis).
+double thickness(const std::vector<Vec3>& pts) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Vec3& p : pts) mean += Eigen::Vector3d(p[0], p[1], p[2]);
+  mean /= double(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) {
+    const Eigen::Vector3d d = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
+    cov += d * d.transpose();
+  }
+  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  double lo = 0, hi = 0;
+  for (const Vec3& p : pts) {
+    const double x = (Eigen::Vector3d(p[0], p[1], p[2]) - mean).dot(axis);
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return hi - lo;
+}
+
 /// Corners of active gray leaves at `min_level` or finer holding the leaf's minority sign
 /// (both signs when tied), with that sign: where a speck's points must be.
 std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active,
@@ -553,14 +580,15 @@ std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::f
 /// uniform of the other sign), one of them at least touched by this operation (active), and
 /// at most kMaxSpeckPoints points. `seen` gets the points visited either way.
 std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p,
-                                bool inside, bool uniform_rim, std::unordered_set<uint64_t>& seen) {
+                                bool inside, bool uniform_rim, bool coarse_rim, std::unordered_set<uint64_t>& seen) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   Speck sp;
   sp.inside = inside;
   std::vector<Lat> queue{p};
   seen.insert(lattice_key(p));
-  bool ok = true, touched = false;
+  bool ok = true, touched = false, coarse = false;
+  std::vector<Vec3> vertices;  // of the speck's leaves: its surface
   for (size_t i = 0; i < queue.size() && ok; ++i) {
     const Lat q = queue[i];
     for (int o = 0; o < 8 && ok; ++o) {
@@ -577,11 +605,16 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
         ok = (n.kind == CellKind::Black) != sp.inside;
         continue;
       }
-      const int k0 = cell.corner_index(q);
-      ok = n.kind == CellKind::Gray && k0 >= 0;
+      // A point is on the boundary of every leaf around it; with coarse_rim it need not be
+      // a corner of a leaf one level coarser (its sign then is the finer side's alone). Not
+      // of coarser ones: the speck's leaves become uniform, and a big leaf's surface is no speck.
+      const bool corner = cell.corner_index(q) >= 0;
+      ok = n.kind == CellKind::Gray && (corner || (coarse_rim && cell.level >= t.max_depth - 1));
       if (!ok) break;
+      coarse = coarse || !corner;
       touched = touched || !active || (*active)(node);
       sp.leaves.push_back(node);
+      vertices.push_back(vertex_unit(cell, t.vertices[n.index]));
       for (int k = 0; k < 8; ++k) {
         const Lat r = cell.corner(k);
         const bool in = (n.signs >> k) & 1;
@@ -596,6 +629,9 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
     }
   }
   if (!ok || !touched) return std::nullopt;
+  // Beside a coarser leaf the region may be a small real piece (harness seed 43: 4 cells
+  // across, a component of the exact result too); only a flat one is the Boolean's noise.
+  if (coarse && thickness(vertices) * double(int64_t{1} << t.max_depth) >= kMaxSpeckThickness) return std::nullopt;
   sp.points = std::move(queue);
   std::sort(sp.leaves.begin(), sp.leaves.end());
   sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
@@ -610,7 +646,7 @@ size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
   size_t removed = 0;
   for (const auto& [p, inside] : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
     if (seen.count(lattice_key(p))) continue;
-    const std::optional<Speck> sp = grow_speck(t, active, p, inside, search.uniform_rim, seen);
+    const std::optional<Speck> sp = grow_speck(t, active, p, inside, search.uniform_rim, search.coarse_rim, seen);
     if (!sp || keep(*sp)) continue;
     for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
     ++removed;

@@ -62,6 +62,10 @@ struct Speck {
 struct SpeckSearch {
   int min_level = -1;        ///< the coarsest gray leaves whose corners may be specks (-1: finest)
   bool uniform_rim = false;  ///< uniform leaves of the other sign may surround the speck too
+  /// Gray leaves one level coarser than the finest may have a speck point on a face or edge
+  /// instead of a corner (a leaf copied whole from one operand beside finest ones the
+  /// Boolean made).
+  bool coarse_rim = false;
 };
 /// Removes the specks with a leaf for which `active` is true (all when null) unless `keep`
 /// says otherwise: the speck's points take their neighbours' sign (its leaves become uniform).

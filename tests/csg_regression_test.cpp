@@ -46,6 +46,10 @@ constexpr Kept kKept[] = {
     // A box's coarse leaf took points inside the box for outside: its partial contour lacked
     // a finer neighbour's polygon cutting through the cell (PIC->exact was 3.8 cells).
     {81, 1.0, 2.0, "cone subtract box: 2 components, 1 exact (a stray shell at the cone's tip)"},
+    // A flat void a quarter cell thick where spot's top nearly touches the cylinder's base:
+    // a speck, but one of its points lies on an edge of a coarser leaf copied whole from spot,
+    // which the speck search used to refuse (SpeckSearch::coarse_rim).
+    {300, 1.5, 3.0, "spot union cylinder subtract teapot: 2 components, 1 exact (a void beside a coarse leaf)", 1.0},
 };
 
 class HarnessCase : public ::testing::TestWithParam<Kept> {};
