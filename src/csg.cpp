@@ -1124,7 +1124,13 @@ std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialC
   for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
   a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
   a.stamps.resize(a.nodes.size(), stamp);
-  for (const auto& [slot, n] : f.pending) a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+  // A slot written here is part of the result this operation made, even where the tag step
+  // left it unstamped (A uniform there, B's subtree copied in): the clean-up must see it, or
+  // B's own defects there (an island a sampled tool carries) pass into the result unchecked.
+  for (const auto& [slot, n] : f.pending) {
+    a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+    a.stamps[slot] = stamp;
+  }
   a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
   return std::move(f.hints);
 }
@@ -1205,7 +1211,7 @@ void clean_up(Octree& a, const Octree& b, const PartialContour& pb, CsgOp op, ui
   apply_sign_hints(a, hints, stamped, pinned);
   for (int round = 0; round < 4; ++round) {
     const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
-    if (enforce_one_component(a, &stamped, &stamp_it, &pinned).flipped == 0 && (islands == 0 || round > 0)) break;
+    if (enforce_one_component(a, &stamped, &stamp_it, &pinned, true).flipped == 0 && (islands == 0 || round > 0)) break;
   }
   {
     Operand ob(b, pb, stamp);

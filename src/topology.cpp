@@ -486,8 +486,21 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
   return flipped;
 }
 
+namespace {
+
+/// Whether a flip leaves a coarser gray leaf without a sign change: its surface is gone and
+/// only a crack repair's vertex is left, whose faces the island pass then clears of the finer
+/// side's sign changes too. At the thin end of a wedge that erodes the wedge by a cell or two
+/// (harness seeds 263, 265: 1.5 and 1.9 finest cells where the exact solid is a cell thick).
+bool emptied_coarse_leaf(const Octree& t, const Around& a, uint8_t flipped) {
+  return a.cell.level < t.max_depth && t.nodes[a.node].kind == CellKind::Gray && (flipped == 0 || flipped == 0xff);
+}
+
+}  // namespace
+
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned) {
+                                  const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned,
+                                  bool spare_coarse) {
   TopologyFix fix;
   for (int pass = 0; pass < 6; ++pass) {
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
@@ -508,7 +521,11 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         if (multi(uint8_t(s ^ (1 << k)))) continue;
         const auto around = leaves_around(t, l.cell.corner(k));
         int cost = 0;
-        for (const auto& a : around) cost += 2 * multi(uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner)));
+        for (const auto& a : around) {
+          const uint8_t flipped = uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner));
+          cost += 2 * multi(flipped);
+          cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
+        }
         cost += (((s >> k) & 1) != 0) != minority_inside;
         // Undoing what remove_islands just set would bring its defect back.
         if (pinned && pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;

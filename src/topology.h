@@ -38,9 +38,11 @@ struct TopologyFix {
 
 /// Works on the leaves for which `active` is true (all leaves when null); `touched` is called
 /// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
+/// With `spare_coarse` (CSG), a flip that leaves a coarser gray leaf without a sign change
+/// costs more: another flip usually does, and the coarse leaf keeps its surface.
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
                                   const std::function<void(uint32_t)>* touched = nullptr,
-                                  const PinnedPoints* pinned = nullptr);
+                                  const PinnedPoints* pinned = nullptr, bool spare_coarse = false);
 
 /// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
 /// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring

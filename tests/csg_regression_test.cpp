@@ -46,6 +46,14 @@ constexpr Kept kKept[] = {
     // A box's coarse leaf took points inside the box for outside: its partial contour lacked
     // a finer neighbour's polygon cutting through the cell (PIC->exact was 3.8 cells).
     {81, 1.0, 2.0, "cone subtract box: 2 components, 1 exact (a stray shell at the cone's tip)"},
+    // At the thin end of a wedge the one-component pass used to flip the corner of a coarser
+    // leaf, leaving it without a sign change; the island pass then cleared its faces of the
+    // wedge's finer points too, cutting the wedge 1.5-1.9 cells short where the exact solid is a
+    // cell thick (seeds 263, 265), or splitting a body (seed 43: 3 components, 2 exact).
+    // enforce_one_component now spares such leaves when another flip will do (spare_coarse).
+    {43, 1.5, 7.0, "box union cad_part union box subtract sphere: 3 components, 2 exact", 1.0},
+    {263, 1.5, 2.5, "cad_part subtract sphere: a wedge cut 1.5 cells short", 1.0},
+    {265, 1.0, 2.5, "cone intersect cylinder subtract cylinder: a wedge's tip cut 1.9 cells short", 1.0},
     // A flat void a quarter cell thick where spot's top nearly touches the cylinder's base:
     // a speck, but one of its points lies on an edge of a coarser leaf copied whole from spot,
     // which the speck search used to refuse (SpeckSearch::coarse_rim).
