@@ -750,7 +750,7 @@ class Untangler {
         const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
         if (a == b || (opt_[i] == kSplitFan && polygons_.split_at[i][k] != kNoSplit)) continue;
         Vec3 f;
-        if (!face_point(a, b, f)) continue;
+        if (!face_point(a, b, third_corner(i, k), f)) continue;
         const auto id = static_cast<uint32_t>(mid.size());
         merged_.mid.push_back(static_cast<uint32_t>(xm.size()));
         xm.push_back(f);
@@ -773,10 +773,23 @@ class Untangler {
     return !changed.empty();
   }
 
+  // The corner of polygon i's current triangle on side k that is not on the side.
+  Vec3 third_corner(uint32_t i, int k) const {
+    const MeshPolygon& p = polys_[i];
+    const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
+    Tris t;
+    const int c = polygons_.triangles(i, opt_[i], t);
+    for (int m = 0; m < c; ++m)
+      for (int e = 0; e < 3; ++e)
+        if ((t[m][e] == a && t[m][(e + 1) % 3] == b) || (t[m][e] == b && t[m][(e + 1) % 3] == a))
+          return merged_.xm[merged_.mid[t[m][(e + 2) % 3]]];
+    return merged_.xm[merged_.mid[polygons_.fan_base + i]];
+  }
+
   // The point where segment a b crosses the common face of a's and b's cells, moved inside
   // that face (kFanEdgeMargin of its side from the border); false when the segment already
   // crosses the face inside it (nothing to split) or the cells share no face.
-  bool face_point(uint32_t a, uint32_t b, Vec3& f) const {
+  bool face_point(uint32_t a, uint32_t b, const Vec3& c, Vec3& f) const {
     const VertexCell& ca = cells_[a];
     const VertexCell& cb = cells_[b];
     const Vec3& xa = merged_.xm[merged_.mid[a]];
@@ -796,20 +809,36 @@ class Untangler {
     const double den = xb[axis] - xa[axis];
     const double t = den != 0 ? std::clamp((plane - xa[axis]) / den, 0.0, 1.0) : 0.5;
     bool inside = true;
+    Vec3 lo, hi;
     for (int d = 0; d < 3; ++d) {
-      if (d == axis) {
-        f[d] = plane;
-        continue;
-      }
-      const double lo = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
-      const double hi = std::min(ca.center[d] + ca.half, cb.center[d] + cb.half);
-      if (!(hi > lo)) return false;  // the cells touch along an edge only
-      const double q = xa[d] + t * (xb[d] - xa[d]);
-      inside = inside && q > lo && q < hi;
-      const double margin = kFanEdgeMargin * (hi - lo);
-      f[d] = std::clamp(q, lo + margin, hi - margin);
+      f[d] = xa[d] + t * (xb[d] - xa[d]);
+      if (d == axis) continue;
+      lo[d] = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
+      hi[d] = std::min(ca.center[d] + ca.half, cb.center[d] + cb.half);
+      if (!(hi[d] > lo[d])) return false;  // the cells touch along an edge only
+      inside = inside && f[d] > lo[d] && f[d] < hi[d];
     }
-    return !inside;
+    if (inside) return false;
+    f[axis] = plane;
+    // Off the face: slide along the line where the plane of the side's triangle (a, b, c)
+    // meets the face's plane (which the side's crossing is on), toward the face, so the
+    // point stays on the surface as far as the face allows; then into the face.
+    const Vec3 n = cross3(sub3(xb, xa), sub3(c, xa));
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    const double nn = n[u] * n[u] + n[w] * n[w];
+    if (nn > 0) {
+      Vec3 mid = f;
+      for (int d : {u, w}) mid[d] = std::clamp(f[d], lo[d], hi[d]);
+      // Nearest point to the clamped one on the line n_u (x_u - f_u) + n_w (x_w - f_w) = 0.
+      const double s = (n[u] * (mid[u] - f[u]) + n[w] * (mid[w] - f[w])) / nn;
+      f[u] = mid[u] - s * n[u];
+      f[w] = mid[w] - s * n[w];
+    }
+    for (int d : {u, w}) {
+      const double margin = kFanEdgeMargin * (hi[d] - lo[d]);
+      f[d] = std::clamp(f[d], lo[d] + margin, hi[d] - margin);
+    }
+    return true;
   }
 
   // Two polygons that cross may need to change together: try every pair of options with each
