@@ -13,7 +13,10 @@
 // split, every polygon that has a triangle in an intersecting pair takes the option with the
 // fewest exact intersections against its neighbours (ties keep the current, then the cheaper
 // option), and this repeats until no pair is left or nothing changes. Only polygons near a
-// crossing change, so the triangle count grows by a few percent at most.
+// crossing change, so the triangle count grows by a few percent at most. What options cannot
+// resolve, vertex moves try (within a finest cell, then along the vertex's own planes); then the
+// sides where the containment fails are split at a point of their cells' common face
+// (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come last.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -786,9 +789,9 @@ class Untangler {
     return merged_.xm[merged_.mid[polygons_.fan_base + i]];
   }
 
-  // The point where segment a b crosses the common face of a's and b's cells, moved inside
-  // that face (kFanEdgeMargin of its side from the border); false when the segment already
-  // crosses the face inside it (nothing to split) or the cells share no face.
+  // A point f of the common face of a's and b's cells for side a b (c: the third corner of the
+  // side's triangle), kFanEdgeMargin of the face's side inside its border; false when the
+  // segment already crosses the face inside it (nothing to split) or the cells share no face.
   bool face_point(uint32_t a, uint32_t b, const Vec3& c, Vec3& f) const {
     const VertexCell& ca = cells_[a];
     const VertexCell& cb = cells_[b];
