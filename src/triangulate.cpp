@@ -13,7 +13,10 @@
 // split, every polygon that has a triangle in an intersecting pair takes the option with the
 // fewest exact intersections against its neighbours (ties keep the current, then the cheaper
 // option), and this repeats until no pair is left or nothing changes. Only polygons near a
-// crossing change, so the triangle count grows by a few percent at most.
+// crossing change, so the triangle count grows by a few percent at most. What options cannot
+// resolve, vertex moves try (within a finest cell, then along the vertex's own planes); then the
+// sides where the containment fails are split at a point of their cells' common face
+// (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come last.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -33,6 +36,10 @@ namespace pic::detail {
 namespace {
 
 using Tri = std::array<uint32_t, 3>;
+/// A polygon's triangles: a fan over a quad with its 4 sides split has 8.
+constexpr int kMaxTris = 8;
+using Tris = std::array<Tri, kMaxTris>;
+constexpr uint32_t kNoSplit = UINT32_MAX;
 
 /// Rounds of re-triangulation; each starts by re-testing the polygons the previous one changed.
 /// A round changes options, or moves vertices, or changes pairs of polygons jointly.
@@ -52,20 +59,38 @@ constexpr double kFarMoveDeviation = 0.25;
 /// eigenvalue of the sum of their normals' outer products) count as lying in all of them.
 constexpr double kNullCutoff = 0.05;
 
-enum Option : uint8_t { kPreferred = 0, kOtherDiagonal = 1, kFan = 2 };
+// kSplitFan: the fan with some sides split at a point on their cells' common face (see
+// Untangler::split_sides).
+enum Option : uint8_t { kPreferred = 0, kOtherDiagonal = 1, kFan = 2, kSplitFan = 3 };
 
 struct Polygons {
   const std::vector<MeshPolygon>& polys;
   std::vector<uint8_t> preferred_a;  // quads: split_quad chose diagonal v0 v2
   uint32_t fan_base;                 // vertex id of polygon i's fan point: fan_base + i
+  // Sides split at a face point (vertex id; kNoSplit: not split): side k runs from v[k] to
+  // v[k + 1]. Empty until a side is split.
+  std::vector<std::array<uint32_t, 4>> split_at;
 
   /// The triangles of polygon i under option o, as vertex ids (fan point: fan_base + i).
-  int triangles(size_t i, uint8_t o, std::array<Tri, 4>& out) const {
+  int triangles(size_t i, uint8_t o, Tris& out) const {
     const MeshPolygon& p = polys[i];
     const auto& v = p.v;
     if (o == kFan) {
       for (int k = 0; k < p.count; ++k) out[k] = {fan_base + uint32_t(i), v[k], v[(k + 1) % p.count]};
       return p.count;
+    }
+    if (o == kSplitFan) {
+      int c = 0;
+      for (int k = 0; k < p.count; ++k) {
+        const uint32_t next = v[(k + 1) % p.count], mid = split_at[i][k];
+        if (mid == kNoSplit) {
+          out[c++] = {fan_base + uint32_t(i), v[k], next};
+        } else {
+          out[c++] = {fan_base + uint32_t(i), v[k], mid};
+          out[c++] = {fan_base + uint32_t(i), mid, next};
+        }
+      }
+      return c;
     }
     if (p.count == 3) {
       out[0] = {v[0], v[1], v[2]};
@@ -258,7 +283,7 @@ PolygonsAround polygons_around(const std::vector<MeshPolygon>& polys, uint32_t n
 /// sees them (bit-equal vertices merged); `x` receives every vertex move.
 class Untangler {
  public:
-  Untangler(std::vector<Vec3>& x, const std::vector<VertexCell>& cells, const Polygons& polygons, double finest,
+  Untangler(std::vector<Vec3>& x, const std::vector<VertexCell>& cells, Polygons& polygons, double finest,
             std::vector<uint8_t>& opt, TriangulationStats& st)
       : x_(x), cells_(cells), polys_(polygons.polys), polygons_(polygons), finest_(finest), opt_(opt), st_(st),
         n_(polys_.size()), nv_(static_cast<uint32_t>(x.size())) {
@@ -305,6 +330,16 @@ class Untangler {
         continue;
       }
       if (try_joint_options(bad)) continue;
+      if (last_resort_ == 1 && !split_tried_) {
+        split_tried_ = true;
+        if (split_sides(bad)) {
+          moved = true;  // the polygons' boxes grow by their face points
+          std::fill(settled_.begin(), settled_.end(), 0);
+          std::fill(joint_settled_.begin(), joint_settled_.end(), 0);
+          std::fill(vertex_settled_.begin(), vertex_settled_.end(), 0);
+          continue;
+        }
+      }
       if (last_resort_ == 2) break;
       // What is left: let the vertices of coarse cells move further, and try everything once
       // more (only the few polygons still crossing are tried).
@@ -314,11 +349,19 @@ class Untangler {
       std::fill(joint_settled_.begin(), joint_settled_.end(), 0);
       std::fill(vertex_settled_.begin(), vertex_settled_.end(), 0);
     }
-    return std::vector<Vec3>(xm.begin() + ptrdiff_t(xm.size() - n_), xm.end());
+    const ptrdiff_t fans = merged_.mid[nv_];  // the fan points follow the vertices in xm
+    return std::vector<Vec3>(xm.begin() + fans, xm.begin() + fans + ptrdiff_t(n_));
+  }
+
+  /// Positions of the face points (vertex ids fan_base + n + k), in order.
+  std::vector<Vec3> face_points() const {
+    std::vector<Vec3> r;
+    for (size_t k = size_t(nv_) + n_; k < merged_.mid.size(); ++k) r.push_back(merged_.xm[merged_.mid[k]]);
+    return r;
   }
 
  private:
-  int merged_tris(size_t i, uint8_t o, std::array<Tri, 4>& t) const {
+  int merged_tris(size_t i, uint8_t o, Tris& t) const {
     const int c = polygons_.triangles(i, o, t);
     for (int k = 0; k < c; ++k)
       for (auto& v : t[k]) v = merged_.mid[v];
@@ -351,6 +394,9 @@ class Untangler {
       };
       grow(p.e1);
       for (int k = 0; k < p.count; ++k) grow(xm[mid[p.v[k]]]);
+      if (opt_[i] == kSplitFan)
+        for (int k = 0; k < p.count; ++k)
+          if (polygons_.split_at[i][k] != kNoSplit) grow(xm[mid[polygons_.split_at[i][k]]]);
       double r = 0;  // room for the vertex pulls below
       if (room > 0)
         for (int k = 0; k < p.count; ++k) r = std::max(r, room_of(p.v[k]));
@@ -373,9 +419,9 @@ class Untangler {
   // option out. `except`: a neighbour left out (counted once by the caller).
   size_t cost(uint32_t i, uint32_t except) const {
     const std::vector<Vec3>& xm = merged_.xm;
-    std::array<Tri, 4> t;
+    Tris t;
     const int c = merged_tris(i, opt_[i], t);
-    std::array<Box, 4> tb;
+    std::array<Box, kMaxTris> tb;
     for (int k = 0; k < c; ++k) {
       if (projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) < 0) return size_t{1} << 40;
       tb[k] = box_of(xm, t[k]);
@@ -386,7 +432,7 @@ class Untangler {
     for (int a = 0; a < c; ++a)
       tree_->query(tb[a], [&](uint32_t j) {
         if (j == i || j == except) return;
-        std::array<Tri, 4> u;
+        Tris u;
         const int cu = merged_tris(j, opt_[j], u);
         for (int b = 0; b < cu; ++b)
           if (overlap(tb[a], box_of(xm, u[b]))) hits += triangles_intersect(xm, t[a], u[b]);
@@ -397,7 +443,7 @@ class Untangler {
   // Crossings between polygon i under option oi and polygon j under option oj.
   size_t mutual(uint32_t i, uint8_t oi, uint32_t j, uint8_t oj) const {
     const std::vector<Vec3>& xm = merged_.xm;
-    std::array<Tri, 4> t, u;
+    Tris t, u;
     const int c = merged_tris(i, oi, t), cu = merged_tris(j, oj, u);
     size_t hits = 0;
     for (int a = 0; a < c; ++a) {
@@ -422,10 +468,10 @@ class Untangler {
     const std::vector<Vec3>& xm = merged_.xm;
     out.clear();
     self = 0;
-    std::array<Tri, 4> t;
+    Tris t;
     const int c = merged_tris(i, opt_[i], t);
-    std::array<Box, 4> tb;
-    std::array<bool, 4> ok{};
+    std::array<Box, kMaxTris> tb;
+    std::array<bool, kMaxTris> ok{};
     for (int k = 0; k < c; ++k) {
       ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
       tb[k] = box_of(xm, t[k]);
@@ -436,7 +482,7 @@ class Untangler {
       if (!ok[a]) continue;
       tree_->query(tb[a], [&](uint32_t j) {
         if (j == i || !keep(j)) return;
-        std::array<Tri, 4> u;
+        Tris u;
         const int cu = merged_tris(j, opt_[j], u);
         uint32_t hits = 0;
         for (int b = 0; b < cu; ++b)
@@ -495,6 +541,7 @@ class Untangler {
     const std::vector<Vec3>& xm = merged_.xm;
     const std::vector<uint32_t>& mid = merged_.mid;
     const MeshPolygon& p = polys_[i];
+    if (opt_[i] == kSplitFan) return {kSplitFan};
     std::array<Vec3, 4> q;
     for (int k = 0; k < p.count; ++k) q[k] = xm[mid[p.v[k]]];
     return surface_keeping_options(q, p.count, xm[mid[nv_ + i]], other_ok_[i], kMaxDeviation * finest_);
@@ -534,16 +581,16 @@ class Untangler {
     const std::vector<Vec3>& xm = merged_.xm;
     std::vector<uint32_t> verts;
     for (uint32_t i : bad) {
-      std::array<Tri, 4> t, raw;
+      Tris t, raw;
       const int c = merged_tris(i, opt_[i], t);
       polygons_.triangles(i, opt_[i], raw);
-      std::array<bool, 4> ok{}, hit{};
+      std::array<bool, kMaxTris> ok{}, hit{};
       for (int k = 0; k < c; ++k) ok[k] = projection_axis(xm[t[k][0]], xm[t[k][1]], xm[t[k][2]]) >= 0;
       for (int a = 0; a < c; ++a)
         for (int b = a + 1; b < c; ++b)
           if (ok[a] && ok[b] && triangles_intersect(xm, t[a], t[b])) hit[a] = hit[b] = true;
       for (const auto& [j, h] : crossing_[i]) {
-        std::array<Tri, 4> u;
+        Tris u;
         const int cu = merged_tris(j, opt_[j], u);
         for (int a = 0; a < c; ++a) {
           if (!ok[a] || hit[a]) continue;
@@ -611,7 +658,7 @@ class Untangler {
     const double along_reach = room_of(v);
     Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
     for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-      std::array<Tri, 4> t;
+      Tris t;
       const int c = merged_tris(around[k], opt_[around[k]], t);
       for (int a = 0; a < c; ++a) {
         if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
@@ -684,6 +731,119 @@ class Untangler {
     return true;
   }
 
+  // Ju and Udeshi's fan keeps each triangle (x, v_k, v_k+1) inside the cells of v_k and
+  // v_k+1 when the segment v_k v_k+1 crosses their common face. Beside a much smaller cell it
+  // need not: a coarse vertex near one corner of its cell reaches a fine neighbour at the other
+  // end of its face through the cells between (suzanne at depth 12: a 32-cell leaf's vertex
+  // and 4- and 8-cell neighbours 16 cells away, whose segments cross the face inside a 16-cell
+  // neighbour, through that neighbour's fan). Splitting such a side at a point of the common
+  // face restores the containment: (x, v_k, p) lies in v_k's cell and (x, p, v_k+1) in
+  // v_k+1's, so they cannot cross triangles that stay in other cells. The side is split in
+  // both polygons that share it, and each polygon with a split side becomes a fan around its
+  // edge point over its corners and face points. Only sides of polygons still crossing are
+  // split. Returns whether any was.
+  bool split_sides(const std::vector<uint32_t>& bad) {
+    std::vector<Vec3>& xm = merged_.xm;
+    const std::vector<uint32_t>& mid = merged_.mid;
+    if (polygons_.split_at.empty()) polygons_.split_at.resize(n_);
+    std::vector<uint32_t> changed;
+    for (uint32_t i : bad) {
+      const MeshPolygon& p = polys_[i];
+      for (int k = 0; k < p.count; ++k) {
+        const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
+        if (a == b || (opt_[i] == kSplitFan && polygons_.split_at[i][k] != kNoSplit)) continue;
+        Vec3 f;
+        if (!face_point(a, b, third_corner(i, k), f)) continue;
+        const auto id = static_cast<uint32_t>(mid.size());
+        merged_.mid.push_back(static_cast<uint32_t>(xm.size()));
+        xm.push_back(f);
+        // Every polygon with side (a, b) or (b, a): two on a manifold.
+        for (uint32_t s = star_.first[a]; s < star_.first[a + 1]; ++s) {
+          const uint32_t j = star_.around[s];
+          const MeshPolygon& q = polys_[j];
+          for (int m = 0; m < q.count; ++m) {
+            const uint32_t u = q.v[m], w = q.v[(m + 1) % q.count];
+            if (!((u == a && w == b) || (u == b && w == a))) continue;
+            if (opt_[j] != kSplitFan) polygons_.split_at[j].fill(kNoSplit);
+            polygons_.split_at[j][m] = id;
+            opt_[j] = kSplitFan;
+            changed.push_back(j);
+          }
+        }
+      }
+    }
+    dirty_.insert(dirty_.end(), changed.begin(), changed.end());
+    return !changed.empty();
+  }
+
+  // The corner of polygon i's current triangle on side k that is not on the side.
+  Vec3 third_corner(uint32_t i, int k) const {
+    const MeshPolygon& p = polys_[i];
+    const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
+    Tris t;
+    const int c = polygons_.triangles(i, opt_[i], t);
+    for (int m = 0; m < c; ++m)
+      for (int e = 0; e < 3; ++e)
+        if ((t[m][e] == a && t[m][(e + 1) % 3] == b) || (t[m][e] == b && t[m][(e + 1) % 3] == a))
+          return merged_.xm[merged_.mid[t[m][(e + 2) % 3]]];
+    return merged_.xm[merged_.mid[polygons_.fan_base + i]];
+  }
+
+  // A point f of the common face of a's and b's cells for side a b (c: the third corner of the
+  // side's triangle), kFanEdgeMargin of the face's side inside its border; false when the
+  // segment already crosses the face inside it (nothing to split) or the cells share no face.
+  bool face_point(uint32_t a, uint32_t b, const Vec3& c, Vec3& f) const {
+    const VertexCell& ca = cells_[a];
+    const VertexCell& cb = cells_[b];
+    const Vec3& xa = merged_.xm[merged_.mid[a]];
+    const Vec3& xb = merged_.xm[merged_.mid[b]];
+    // The axis across the face: where the cells touch (centres half + half apart).
+    int axis = 0;
+    double best = -1e300;
+    for (int d = 0; d < 3; ++d) {
+      const double gap = std::abs(cb.center[d] - ca.center[d]) - (ca.half + cb.half);
+      if (gap > best) {
+        best = gap;
+        axis = d;
+      }
+    }
+    if (std::abs(best) > 1e-9 * (ca.half + cb.half)) return false;
+    const double plane = ca.center[axis] + (cb.center[axis] > ca.center[axis] ? ca.half : -ca.half);
+    const double den = xb[axis] - xa[axis];
+    const double t = den != 0 ? std::clamp((plane - xa[axis]) / den, 0.0, 1.0) : 0.5;
+    bool inside = true;
+    Vec3 lo, hi;
+    for (int d = 0; d < 3; ++d) {
+      f[d] = xa[d] + t * (xb[d] - xa[d]);
+      if (d == axis) continue;
+      lo[d] = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
+      hi[d] = std::min(ca.center[d] + ca.half, cb.center[d] + cb.half);
+      if (!(hi[d] > lo[d])) return false;  // the cells touch along an edge only
+      inside = inside && f[d] > lo[d] && f[d] < hi[d];
+    }
+    if (inside) return false;
+    f[axis] = plane;
+    // Off the face: slide along the line where the plane of the side's triangle (a, b, c)
+    // meets the face's plane (which the side's crossing is on), toward the face, so the
+    // point stays on the surface as far as the face allows; then into the face.
+    const Vec3 n = cross3(sub3(xb, xa), sub3(c, xa));
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    const double nn = n[u] * n[u] + n[w] * n[w];
+    if (nn > 0) {
+      Vec3 mid = f;
+      for (int d : {u, w}) mid[d] = std::clamp(f[d], lo[d], hi[d]);
+      // Nearest point to the clamped one on the line n_u (x_u - f_u) + n_w (x_w - f_w) = 0.
+      const double s = (n[u] * (mid[u] - f[u]) + n[w] * (mid[w] - f[w])) / nn;
+      f[u] = mid[u] - s * n[u];
+      f[w] = mid[w] - s * n[w];
+    }
+    for (int d : {u, w}) {
+      const double margin = kFanEdgeMargin * (hi[d] - lo[d]);
+      f[d] = std::clamp(f[d], lo[d] + margin, hi[d] - margin);
+    }
+    return true;
+  }
+
   // Two polygons that cross may need to change together: try every pair of options with each
   // partner. Last resort before giving up (after the vertex moves): it costs up to 9
   // evaluations per partner. Returns how many options changed.
@@ -705,7 +865,7 @@ class Untangler {
       for (const uint32_t j : partners) {
         const uint8_t oi0 = opt_[i], oj0 = opt_[j];
         const std::vector<uint8_t> opts_j = options(j);
-        std::array<size_t, 3> ci{}, cj{};
+        std::array<size_t, 4> ci{}, cj{};
         for (uint8_t o : opts_i) {
           opt_[i] = o;
           ci[o] = cost(i, j);
@@ -742,7 +902,7 @@ class Untangler {
   std::vector<Vec3>& x_;
   const std::vector<VertexCell>& cells_;
   const std::vector<MeshPolygon>& polys_;
-  const Polygons& polygons_;
+  Polygons& polygons_;
   const double finest_;
   std::vector<uint8_t>& opt_;  // each polygon's option
   TriangulationStats& st_;
@@ -752,6 +912,7 @@ class Untangler {
   // 0: none yet; 1: far moves that keep v on its triangles' planes; 2: any far move, the one
   // that leaves those planes least among the ones that remove the most crossings.
   int last_resort_ = 0;
+  bool split_tried_ = false;
   std::unique_ptr<BoxTree> tree_;
   std::vector<Box> boxes_;
   std::vector<uint8_t> other_ok_;
@@ -776,27 +937,46 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
                                                           bool intersection_free, TriangulationStats* stats) {
   const size_t n = polys.size();
   const auto nv = static_cast<uint32_t>(x.size());
-  Polygons P{polys, std::vector<uint8_t>(n, 1), nv};
+  Polygons P{polys, std::vector<uint8_t>(n, 1), nv, {}};
   for (size_t i = 0; i < n; ++i)
     if (polys[i].count == 4) {
       const auto& v = polys[i].v;
       P.preferred_a[i] = split_quad({x[v[0]], x[v[1]], x[v[2]], x[v[3]]})[0][2] == 2;
     }
   std::vector<uint8_t> opt(n, kPreferred);
-  std::vector<Vec3> fans_at;  // each polygon's fan point
+  std::vector<Vec3> fans_at;     // each polygon's fan point
+  std::vector<Vec3> face_at;     // each split side's face point
   TriangulationStats st;
-  if (intersection_free && n > 0) fans_at = Untangler(x, cells, P, finest, opt, st).run();
+  if (intersection_free && n > 0) {
+    Untangler u(x, cells, P, finest, opt, st);
+    fans_at = u.run();
+    face_at = u.face_points();
+  }
 
-  // Output: fan points appended after the vertices, in polygon order.
+  // Output: fan points and face points appended after the vertices, in polygon order (a face
+  // point where the first of its two polygons needs it).
+  std::vector<uint32_t> face_id(face_at.size(), kNoSplit);
+  const uint32_t face_base = nv + static_cast<uint32_t>(n);
   std::vector<Tri> tris;
   tris.reserve(n * 2);
   for (size_t i = 0; i < n; ++i) {
-    std::array<Tri, 4> t;
+    Tris t;
     const int c = P.triangles(i, opt[i], t);
-    if (opt[i] == kFan) {
+    if (opt[i] == kFan || opt[i] == kSplitFan) {
       const auto id = static_cast<uint32_t>(x.size());
       x.push_back(fans_at[i]);
-      for (int k = 0; k < c; ++k) t[k][0] = id;
+      for (int k = 0; k < c; ++k) {
+        t[k][0] = id;
+        for (int m = 1; m < 3; ++m) {
+          if (t[k][m] < face_base) continue;
+          uint32_t& f = face_id[t[k][m] - face_base];
+          if (f == kNoSplit) {
+            f = static_cast<uint32_t>(x.size());
+            x.push_back(face_at[t[k][m] - face_base]);
+          }
+          t[k][m] = f;
+        }
+      }
       ++st.fans;
     } else if (opt[i] == kOtherDiagonal) {
       ++st.other_diagonal;

@@ -3,6 +3,7 @@
 // self-intersecting triangle pair and no non-manifold vertex or edge.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
@@ -226,6 +227,46 @@ TEST(Validity, LastResortMovesKeepTheSurface) {
   std::printf("  [measure] Thingi A depth 11: %zu moved vertices, largest move off the plain planes %.3f cells\n",
               st.moved_vertices, off);
   EXPECT_LE(off, 1.0 + 1e-6);
+}
+
+// Suzanne at depth 12 (as `pic mesh` sees it after `pic sample`; depths 10 and 11 do not show
+// it): a level-7 leaf's vertex, in a corner of its 32-cell leaf at one of the model's creases,
+// has long triangles to 4- and 8-cell neighbours 16 cells away along its face; those sides cross
+// the face inside a 16-cell neighbour, through that neighbour's fan. No triangulation option
+// and no move of the neighbours within their cells removed the crossings, and stage 2 moved
+// the coarse vertex 4.3 finest cells off the plain contour's planes. The sides are now split
+// at a point of their cells' common face (Ju and Udeshi's containment), and no vertex needs to
+// leave the plain planes by more than the accumulated ordinary moves (1.8 cells). Also
+// asserted: no moved vertex is more than one finest cell (an ordinary move) further from the
+// input than in the plain contour, and the contour is no further from the input.
+TEST(Validity, CoarseSidesAreSplitAtTheirFace) {
+  const TriMesh input = read_mesh(std::string(PIC_DATA_DIR) + "/suzanne.obj");
+  SampleOptions o;
+  o.depth = 12;
+  const Octree t = deserialize(serialize(sample(input, o)));
+  const auto [plain, clean, st] = fast_and_default(t);
+  EXPECT_EQ(count_self_intersections(clean), 0u);
+  const double finest = t.cube.size / 4096;
+  std::vector<uint32_t> moved;
+  for (uint32_t v = 0; v < plain.positions.size(); ++v)
+    if (plain.positions[v] != clean.positions[v]) moved.push_back(v);
+  ASSERT_FALSE(moved.empty());
+  std::vector<Vec3> before, after;
+  for (uint32_t v : moved) {
+    before.push_back(plain.positions[v]);
+    after.push_back(clean.positions[v]);
+  }
+  const std::vector<double> d0 = distance_to_mesh(input, before), d1 = distance_to_mesh(input, after);
+  double growth = 0;
+  for (size_t k = 0; k < moved.size(); ++k) growth = std::max(growth, (d1[k] - d0[k]) / finest);
+  const double plain_to_input = one_sided_distance(plain, input) / finest;
+  const double clean_to_input = one_sided_distance(clean, input) / finest;
+  std::printf("  [measure] suzanne depth 12: %zu moved vertices, largest move off the plain planes %.2f cells, "
+              "at most %.2f cells further from the input; contour to input %.2f cells (plain %.2f)\n",
+              moved.size(), largest_move_off_planes(plain, clean, finest), growth, clean_to_input, plain_to_input);
+  EXPECT_LE(largest_move_off_planes(plain, clean, finest), 2.0);
+  EXPECT_LE(growth, 1.0 + 1e-6);
+  EXPECT_LE(clean_to_input, plain_to_input + 1e-6);
 }
 
 // The Thingi10K difference pair of issue 10 (1706459 − 1514499, both sampled in one cube). The
