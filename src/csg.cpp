@@ -1108,17 +1108,10 @@ void stamp_overlap(Octree& a, const Octree& b, uint32_t stamp, PartialContour& p
   stats.contour_b_seconds = since(tc);
 }
 
-/// What the combine hands to the clean-up: the sign hints, and A's slots it wrote that the tag
-/// step had left unstamped (A uniform there: B's subtree copied in).
-struct Combined {
-  std::vector<SignHint> hints;
-  std::vector<uint32_t> copied;
-};
-
 /// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
 /// A's, and A's own slots are written only once all tasks are done.
-Combined combine_stamped(Octree& a, const Octree& b, const PartialContour& pa, const PartialContour& pb, CsgOp op,
-                         const CsgOptions& options, int depth, uint32_t stamp, CsgStats& stats) {
+std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialContour& pa, const PartialContour& pb,
+                                      CsgOp op, const CsgOptions& options, int depth, uint32_t stamp, CsgStats& stats) {
   Fragment f;
   Operand oa(a, pa, stamp), ob(b, pb, stamp);
   CombineCounts counts;
@@ -1131,14 +1124,17 @@ Combined combine_stamped(Octree& a, const Octree& b, const PartialContour& pa, c
   for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
   a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
   a.stamps.resize(a.nodes.size(), stamp);
-  Combined out;
+  // A slot written here is part of the result this operation made, even where the tag step
+  // left it unstamped (A uniform there, B's subtree copied in): the clean-up must see it, or
+  // B's own defects there pass into the result unchecked (an island a sampled tool carries —
+  // a small sphere's pole piercing a lattice plane beside a coarse leaf — became a sculpting
+  // stroke's pinched vertex). Cleaning these parts too costs sculpting about 2-3 ms a stroke.
   for (const auto& [slot, n] : f.pending) {
     a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
-    if (a.stamps[slot] != stamp) out.copied.push_back(slot);
+    a.stamps[slot] = stamp;
   }
   a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
-  out.hints = std::move(f.hints);
-  return out;
+  return std::move(f.hints);
 }
 
 /// What setting a hinted sign would do: the leaves around the point (each has it as a corner)
@@ -1205,7 +1201,7 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
 /// Clean-up of the stamped part of the result: crack repairs withdrawn and redone, islands,
 /// cells of more than one component and specks the Boolean made removed.
 void clean_up(Octree& a, const Octree& b, const PartialContour& pb, CsgOp op, uint32_t stamp,
-              const std::vector<SignHint>& hints, const std::vector<uint32_t>& copied, CsgStats& stats) {
+              const std::vector<SignHint>& hints, CsgStats& stats) {
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
@@ -1215,17 +1211,8 @@ void clean_up(Octree& a, const Octree& b, const PartialContour& pb, CsgOp op, ui
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
   apply_sign_hints(a, hints, stamped, pinned);
-  // The island pass also looks into B's subtrees copied where A was uniform: an island a
-  // sampled operand carries there (a small sphere tool whose pole pierces a lattice plane
-  // beside a coarse leaf) would pass into the result as a pinched vertex. The other passes
-  // keep to the stamped cells (their defects come from the combine), which keeps a sculpting
-  // stroke's clean-up cost near what it was.
-  const std::unordered_set<uint32_t> copied_slots(copied.begin(), copied.end());
-  const std::function<bool(uint32_t)> island_scope = [&](uint32_t n) {
-    return a.stamps[n] == stamp || copied_slots.count(n) != 0;
-  };
   for (int round = 0; round < 4; ++round) {
-    const size_t islands = remove_islands(a, &island_scope, &stamp_it, &pinned);
+    const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
     if (enforce_one_component(a, &stamped, &stamp_it, &pinned, true).flipped == 0 && (islands == 0 || round > 0)) break;
   }
   {
@@ -1270,10 +1257,10 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
 
   const auto tc = Clock::now();
   const size_t before = a.nodes.size();
-  const Combined combined = combine_stamped(a, b, pa, pb, op, options, depth, stamp, stats);
+  const std::vector<SignHint> hints = combine_stamped(a, b, pa, pb, op, options, depth, stamp, stats);
   a.max_depth = depth;
   const auto tclean = Clock::now();
-  clean_up(a, b, pb, op, stamp, combined.hints, combined.copied, stats);
+  clean_up(a, b, pb, op, stamp, hints, stats);
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);
   // Amortized garbage collection of replaced subtrees.
