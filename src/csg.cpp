@@ -1147,13 +1147,6 @@ struct HintedFlip {
   bool needed = false;    // the point's sign differs from the hint's
 };
 
-uint8_t leaf_signs(const Node& n) {
-  if (n.kind == CellKind::Gray) return n.signs;
-  return n.kind == CellKind::Black ? 0xff : 0;
-}
-
-bool is_multi(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
-
 HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<bool(uint32_t)>& stamped) {
   HintedFlip f;
   for (int o = 0; o < 8; ++o) {
@@ -1161,26 +1154,15 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
     const LeafRef r = leaf_at(t, q);
     const int k = r.cell.corner_index(h.point);
     if (k < 0 || !stamped(r.node) || t.nodes[r.node].kind == CellKind::Internal) return f;
-    const uint8_t s = leaf_signs(t.nodes[r.node]);
+    const uint8_t s = signs_of(t.nodes[r.node]);
     f.needed = bool((s >> k) & 1) != h.inside;
-    f.before += is_multi(s);
-    f.after += is_multi(uint8_t(s ^ (1 << k)));
+    f.before += multi_component(s);
+    f.after += multi_component(uint8_t(s ^ (1 << k)));
     f.around[f.count] = r;
     f.corner[f.count++] = k;
   }
   f.possible = true;
   return f;
-}
-
-/// Flips the point in every leaf around it; a uniform leaf becomes gray with its vertex next
-/// to that corner (as enforce_one_component does).
-void flip_hinted(Octree& t, const HintedFlip& f) {
-  for (int i = 0; i < f.count; ++i) {
-    Node& m = t.nodes[f.around[i].node];
-    const uint8_t s = uint8_t(leaf_signs(m) ^ (1 << f.corner[i]));
-    if (m.kind == CellKind::Gray) m.signs = s;
-    else m = add_gray(t.vertices, f.around[i].cell, s, cell_vertex(Qef{}, f.around[i].cell, s).position);
-  }
 }
 
 /// Sets the hinted signs (sign_hint) where every leaf around the point is stamped and has it
@@ -1193,7 +1175,7 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
   for (const SignHint& h : hints) {
     const HintedFlip f = examine_hint(t, h, stamped);
     if (!f.possible || !f.needed || f.after >= f.before) continue;
-    flip_hinted(t, f);
+    for (int i = 0; i < f.count; ++i) flip_corner(t, f.around[i].node, f.corner[i], f.around[i].cell);
     pinned.insert(lattice_key(h.point));
   }
 }

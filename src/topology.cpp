@@ -86,7 +86,6 @@ std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uin
   return out;
 }
 
-bool multi(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
 
 /// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
 /// one when null), depth first.
@@ -104,14 +103,15 @@ void for_each_gray_leaf(const Octree& t, const std::function<bool(uint32_t)>* ac
   walk(walk, 0, Cell{});
 }
 
-/// The leaf's corner signs as a mask (uniform leaves: all corners alike).
+}  // namespace
+
 uint8_t signs_of(const Node& n) {
   if (n.kind == CellKind::Gray) return n.signs;
   return n.kind == CellKind::Black ? 0xff : 0;
 }
 
-/// Flips corner c of a leaf. A uniform leaf becomes gray with its vertex right next to that
-/// corner (the only place its surface can be).
+bool multi_component(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
+
 void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
   Node& n = t.nodes[node];
   if (n.kind == CellKind::Gray) {
@@ -121,8 +121,6 @@ void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
   const uint8_t s = uint8_t(signs_of(n) ^ (1 << c));
   n = add_gray(t.vertices, cell, s, cell_vertex(Qef{}, cell, s).position);
 }
-
-}  // namespace
 
 LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path) {
   return node_at(t, Cell{kMaxLevel, q}, path);
@@ -506,24 +504,24 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
     std::vector<LeafRef> bad;
     for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
-      if (multi(t.nodes[node].signs)) bad.push_back({node, cell});
+      if (multi_component(t.nodes[node].signs)) bad.push_back({node, cell});
     });
     fix.remaining = bad.size();
     if (bad.empty()) break;
     for (const LeafRef& l : bad) {
       const uint8_t s = t.nodes[l.node].signs;
-      if (!multi(s)) continue;  // fixed by an earlier flip
+      if (!multi_component(s)) continue;  // fixed by an earlier flip
       // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
       // preferring to flip the minority sign (removing the thinner feature).
       int best = -1, best_cost = 1 << 30;
       const bool minority_inside = __builtin_popcount(s) <= 4;
       for (int k = 0; k < 8; ++k) {
-        if (multi(uint8_t(s ^ (1 << k)))) continue;
+        if (multi_component(uint8_t(s ^ (1 << k)))) continue;
         const auto around = leaves_around(t, l.cell.corner(k));
         int cost = 0;
         for (const auto& a : around) {
           const uint8_t flipped = uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner));
-          cost += 2 * multi(flipped);
+          cost += 2 * multi_component(flipped);
           cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
         }
         cost += (((s >> k) & 1) != 0) != minority_inside;
@@ -605,7 +603,7 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
   std::vector<Lat> queue{p};
   seen.insert(lattice_key(p));
   bool ok = true, touched = false, coarse = false;
-  std::vector<Vec3> vertices;  // of the speck's leaves: its surface
+  std::vector<Vec3> vertices;  // of the speck's leaves, its surface (with coarse_rim)
   for (size_t i = 0; i < queue.size() && ok; ++i) {
     const Lat q = queue[i];
     for (int o = 0; o < 8 && ok; ++o) {
@@ -631,7 +629,7 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
       coarse = coarse || !corner;
       touched = touched || !active || (*active)(node);
       sp.leaves.push_back(node);
-      vertices.push_back(vertex_unit(cell, t.vertices[n.index]));
+      if (coarse_rim) vertices.push_back(vertex_unit(cell, t.vertices[n.index]));
       for (int k = 0; k < 8; ++k) {
         const Lat r = cell.corner(k);
         const bool in = (n.signs >> k) & 1;

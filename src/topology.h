@@ -31,6 +31,14 @@ inline uint64_t lattice_key(const std::array<int64_t, 3>& p) {
   return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42;
 }
 
+/// A leaf's corner signs as a mask (uniform leaves: all corners alike).
+uint8_t signs_of(const Node& n);
+/// Whether corner signs make more than one surface component in a cell.
+bool multi_component(uint8_t signs);
+/// Flips corner c of a leaf (its cell `cell`). A uniform leaf becomes gray with its vertex
+/// right next to that corner (the only place its surface can be).
+void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell);
+
 struct TopologyFix {
   size_t flipped = 0;    // lattice points whose sign changed
   size_t remaining = 0;  // leaves still holding more than one component
