@@ -1147,6 +1147,61 @@ struct HintedFlip {
   bool needed = false;    // the point's sign differs from the hint's
 };
 
+/// The sign of lattice point p where a leaf has it as a corner; nothing where none has.
+std::optional<bool> corner_sign(const Octree& t, const Lat& p) {
+  for (int o = 0; o < 8; ++o) {
+    const Lat q{p[0] - (o & 1), p[1] - ((o >> 1) & 1), p[2] - ((o >> 2) & 1)};
+    if (q[0] < 0 || q[1] < 0 || q[2] < 0) continue;
+    const LeafRef r = leaf_at(t, q);
+    const int k = r.cell.corner_index(p);
+    if (k >= 0 && t.nodes[r.node].kind != CellKind::Internal) return bool((signs_of(t.nodes[r.node]) >> k) & 1);
+  }
+  return std::nullopt;
+}
+
+/// Whether setting corner k of a coarser leaf to `inside` would strand a finer point on one of
+/// its edges or faces through that corner: a point of the other sign on an edge or face whose
+/// corners all have this sign is an island, which the island pass then flips too, carrying
+/// the hint along the whole edge or face (seed 56: 3 points along a 4-cell leaf's edge, the
+/// surface 1.41 cells out). Faces wider than kMaxCheckedFace finest cells are not searched.
+bool strands_finer_points(const Octree& t, const LeafRef& big, int k, bool inside) {
+  constexpr int64_t kMaxCheckedFace = 32;
+  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
+  const int64_t n = big.cell.span() / step;
+  const uint8_t s = uint8_t(signs_of(t.nodes[big.node]) & ~(1 << k)) | uint8_t(inside << k);
+  const Lat lo = big.cell.lat;
+  auto stranded = [&](const Lat& q) {
+    const std::optional<bool> sq = corner_sign(t, q);
+    return sq && *sq != inside;
+  };
+  for (int a = 0; a < 3; ++a) {
+    // The edge along axis a through corner k.
+    if (bool((s >> (k ^ (1 << a))) & 1) != inside) continue;
+    Lat q = big.cell.corner(k);
+    for (int64_t i = 1; i < n; ++i) {
+      q[a] = lo[a] + i * step;
+      if (stranded(q)) return true;
+    }
+  }
+  if (n > kMaxCheckedFace) return false;
+  for (int a = 0; a < 3; ++a) {
+    // The face across axis a through corner k: its corners share bit a with k.
+    bool uniform = true;
+    for (int c = 0; c < 8; ++c)
+      if (((c ^ k) >> a & 1) == 0) uniform = uniform && bool((s >> c) & 1) == inside;
+    if (!uniform) continue;
+    const int u = (a + 1) % 3, w = (a + 2) % 3;
+    Lat q = big.cell.corner(k);
+    for (int64_t i = 1; i < n; ++i)
+      for (int64_t j = 1; j < n; ++j) {
+        q[u] = lo[u] + i * step;
+        q[w] = lo[w] + j * step;
+        if (stranded(q)) return true;
+      }
+  }
+  return false;
+}
+
 HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<bool(uint32_t)>& stamped) {
   HintedFlip f;
   for (int o = 0; o < 8; ++o) {
@@ -1154,6 +1209,7 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
     const LeafRef r = leaf_at(t, q);
     const int k = r.cell.corner_index(h.point);
     if (k < 0 || !stamped(r.node) || t.nodes[r.node].kind == CellKind::Internal) return f;
+    if (r.cell.level < t.max_depth && strands_finer_points(t, r, k, h.inside)) return f;
     const uint8_t s = signs_of(t.nodes[r.node]);
     f.needed = bool((s >> k) & 1) != h.inside;
     f.before += multi_component(s);

@@ -63,6 +63,12 @@ constexpr Kept kKept[] = {
     // a speck, but one of its points lies on an edge of a coarser leaf copied whole from spot,
     // which the speck search used to refuse (SpeckSearch::coarse_rim).
     {300, 1.5, 3.0, "spot union cylinder subtract teapot: 2 components, 1 exact (a void beside a coarse leaf)", 1.0},
+    // A sign hint (a finest cell's corner the operands say joins a slab) set the corner of a
+    // 4-cell leaf copied whole; the finer points along that leaf's edges then read as islands
+    // and followed, moving the surface 1.41 cells (56) and 1.21 cells on the intersection
+    // curve (117). Hints now set only points whose leaves around are all finest.
+    {56, 1.0, 1.5, "sphere subtract cylinder: a coarse leaf's edge filled by a hint (PIC->exact 1.41)", 1.0},
+    {117, 1.0, 3.0, "torus subtract fandisk: a tooth on the intersection curve (PIC->exact 1.21)", 1.0},
 };
 
 class HarnessCase : public ::testing::TestWithParam<Kept> {};
