@@ -1,0 +1,31 @@
+// The CSG clean-up (paper section 5 leaves it open): after the combine, the stamped part of
+// the result may hold what no single PIC leaf can represent — islands of finer points on a
+// coarse leaf's faces, finest leaves whose corners make two components, specks where the two
+// operands' surfaces pass within a fraction of a cell — and operands' crack repairs that the
+// passes would take for real coarse leaves. This stage makes it a valid PIC again, guided by
+// the combine's sign hints. See docs/algorithms.md, "CSG", step 6.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "pic/pic.h"
+
+namespace pic::detail {
+
+/// A lattice point whose sign the clean-up should set to `inside` (see sign_hint in csg.cpp).
+struct SignHint {
+  std::array<int64_t, 3> point;
+  bool inside;
+};
+
+/// Clean-up of the leaves whose stamp is `stamp` after `a op b` was combined into `a`: crack
+/// repairs withdrawn and redone, sign hints applied, islands and leaves of more than one
+/// component removed, and specks the Boolean made absorbed (`sign_b`: B's sign at a lattice
+/// point, to tell those from B's own small components). Sets stats.repaired.
+void clean_up(Octree& a, CsgOp op, uint32_t stamp, const std::vector<SignHint>& hints,
+              const std::function<bool(const std::array<int64_t, 3>&)>& sign_b, CsgStats& stats);
+
+}  // namespace pic::detail
