@@ -229,107 +229,105 @@ struct IslandSearch {
 
 namespace {
 
-/// Face `f` (axis f / 2, high side if f % 2) of a coarse gray leaf, as the finer leaves
-/// across it see it. Dual contouring gives the coarse leaf one vertex, so what those leaves
-/// show on the face must look like a face of one cell:
-/// - along each edge of the face the sign changes at most once (never when its ends agree),
-///   else the edge gets several dual polygons through the same coarse vertices (a doubled
-///   sheet, non-manifold edges);
-/// - every connected region of one sign on the face reaches a corner of the face with that
-///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
-///   vertex).
-/// Returns the lattice points to flip (as few as possible along edges; whole stray regions
-/// on the face).
+/// The face's plane, its in-face axes u and v, and its rectangle [lo, hi] (lo[d] = hi[d] =
+/// plane); points on it are keyed by their in-face coordinates.
+struct FaceFrame {
+  int d, side, u, v;
+  Lat lo, hi;
+  uint8_t signs;  // the coarse leaf's corner signs
+
+  FaceFrame(const LeafRef& big, int f, uint8_t leaf_signs)
+      : d(f / 2), side(f % 2), u(d == 0 ? 1 : 0), v(d == 2 ? 1 : 2), lo(big.cell.lat), hi(big.cell.corner(7)),
+        signs(leaf_signs) {
+    lo[d] = hi[d] = big.cell.lat[d] + side * big.cell.span();
+  }
+  uint64_t key(const Lat& q) const { return uint64_t(q[u]) << 32 | uint64_t(q[v]); }
+  Lat lat_of(uint64_t k) const {
+    Lat q;
+    q[d] = lo[d];
+    q[u] = int64_t(k >> 32);
+    q[v] = int64_t(k & 0xffffffffu);
+    return q;
+  }
+  /// The coarse leaf's sign at the face's corner (cu, cv).
+  bool corner_sign(int cu, int cv) const { return ((signs >> ((side << d) | (cu << u) | (cv << v))) & 1) != 0; }
+};
+
 /// Buffers face_flips reuses from face to face.
 struct FaceScratch {
   std::vector<LeafRef> leaves;
-  std::vector<std::pair<uint64_t, bool>> pts;
+  std::vector<std::pair<uint64_t, bool>> pts;  // sorted by key
   std::vector<std::pair<uint64_t, uint64_t>> links;
   std::vector<size_t> run;
   std::vector<char> flipped, anchored;
   UnionFind regions{0};
   std::vector<Lat> flips;
+
+  size_t index_of(uint64_t k) const {
+    return size_t(std::lower_bound(pts.begin(), pts.end(), std::pair{k, false}) - pts.begin());
+  }
 };
 
-const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
-  s.flips.clear();
-  const int d = f / 2, side = f % 2;
-  const int u = d == 0 ? 1 : 0, v = d == 2 ? 1 : 2;  // in-face axes
+/// The points the finer leaves across the face show on it, with their signs, and links along
+/// the edges of those leaves' faces (which join a region once the edge pass has set signs).
+/// False when the node across the face is not subdivided (nothing finer to see).
+bool collect_face_points(const Octree& t, const LeafRef& big, const FaceFrame& fr, FaceScratch& s) {
+  const int d = fr.d, u = fr.u, v = fr.v;
   const int64_t span = big.cell.span();
-  Lat lo = big.cell.lat, hi = big.cell.corner(7);
-  lo[d] = hi[d] = big.cell.lat[d] + side * span;
-  const int64_t plane = lo[d];
-  // The finer leaves are below the node across the face, if that node is subdivided.
   Cell across = big.cell;
-  across.lat[d] += side ? span : -span;
-  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return s.flips;
+  across.lat[d] += fr.side ? span : -span;
+  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return false;
   const LeafRef n = node_at(t, across);
-  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return s.flips;
-  std::vector<LeafRef>& scratch = s.leaves;
-  scratch.clear();
-  leaves_touching(t, n.node, n.cell, lo, hi, kMaxLevel, scratch);
-  // Points on the face (key: in-face coordinates) with their signs, and links along the edges
-  // of the finer leaves' faces (which join a region once the edge pass below has set signs).
-  auto& pts = s.pts;
-  auto& links = s.links;
-  pts.clear();
-  links.clear();
-  auto key = [&](const Lat& q) { return uint64_t(q[u]) << 32 | uint64_t(q[v]); };
-  for (const LeafRef& l : scratch) {
+  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return false;
+  s.leaves.clear();
+  leaves_touching(t, n.node, n.cell, fr.lo, fr.hi, kMaxLevel, s.leaves);
+  s.pts.clear();
+  s.links.clear();
+  for (const LeafRef& l : s.leaves) {
     if (l.cell.level <= big.cell.level) continue;
     // On the far side of the plane, with a face inside the rectangle.
-    const int64_t s = l.cell.span();
-    const int touching = side ? 0 : 1;  // which of its own sides lies on the plane
-    if (l.cell.lat[d] + touching * s != plane) continue;
-    if (l.cell.lat[u] < lo[u] || l.cell.lat[u] + s > hi[u] || l.cell.lat[v] < lo[v] || l.cell.lat[v] + s > hi[v])
+    const int64_t ls = l.cell.span();
+    const int touching = fr.side ? 0 : 1;  // which of its own sides lies on the plane
+    if (l.cell.lat[d] + touching * ls != fr.lo[d]) continue;
+    if (l.cell.lat[u] < fr.lo[u] || l.cell.lat[u] + ls > fr.hi[u] || l.cell.lat[v] < fr.lo[v] ||
+        l.cell.lat[v] + ls > fr.hi[v])
       continue;
     const uint8_t sg = signs_of(t.nodes[l.node]);
     std::array<std::pair<uint64_t, bool>, 4> c4;
     for (int k = 0; k < 4; ++k) {
       const int c = (touching << d) | ((k & 1) << u) | ((k >> 1) << v);
-      c4[k] = {key(l.cell.corner(c)), ((sg >> c) & 1) != 0};
-      pts.push_back(c4[k]);
+      c4[k] = {fr.key(l.cell.corner(c)), ((sg >> c) & 1) != 0};
+      s.pts.push_back(c4[k]);
     }
     for (const auto& [a, b] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
-      links.push_back({c4[a].first, c4[b].first});
+      s.links.push_back({c4[a].first, c4[b].first});
   }
-  if (pts.empty()) return s.flips;
-  std::sort(pts.begin(), pts.end());
-  pts.erase(std::unique(pts.begin(), pts.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-            pts.end());
-  auto index_of = [&](uint64_t k) {
-    return size_t(std::lower_bound(pts.begin(), pts.end(), std::pair{k, false}) - pts.begin());
-  };
-  auto lat_of = [&](uint64_t k) {
-    Lat q;
-    q[d] = plane;
-    q[u] = int64_t(k >> 32);
-    q[v] = int64_t(k & 0xffffffffu);
-    return q;
-  };
-  const uint8_t sb = signs_of(t.nodes[big.node]);
-  auto corner_sign = [&](int cu, int cv) {
-    const int c = (side << d) | (cu << u) | (cv << v);
-    return ((sb >> c) & 1) != 0;
-  };
-  std::vector<char>& flipped = s.flipped;
-  flipped.assign(pts.size(), 0);
-  // Edges of the face: points in order along each, ends from the coarse leaf.
+  std::sort(s.pts.begin(), s.pts.end());
+  s.pts.erase(std::unique(s.pts.begin(), s.pts.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+              s.pts.end());
+  return !s.pts.empty();
+}
+
+/// Along each edge of the face, the points in order between the coarse leaf's two corners
+/// take the first corner's sign before one cut and the second's after it, at the cut needing
+/// the fewest flips (marked in s.flipped).
+void settle_face_edges(const FaceFrame& fr, FaceScratch& s) {
+  auto& pts = s.pts;
   for (int e = 0; e < 4; ++e) {
-    const int along = e < 2 ? u : v, across = along == u ? v : u;
-    const int64_t fixed = (e & 1) ? hi[across] : lo[across];
+    const int along = e < 2 ? fr.u : fr.v, across = along == fr.u ? fr.v : fr.u;
+    const int64_t fixed = (e & 1) ? fr.hi[across] : fr.lo[across];
     std::vector<size_t>& run = s.run;
     run.clear();
     for (size_t i = 0; i < pts.size(); ++i) {
-      const Lat q = lat_of(pts[i].first);
-      if (q[across] == fixed && q[along] > lo[along] && q[along] < hi[along]) run.push_back(i);
+      const Lat q = fr.lat_of(pts[i].first);
+      if (q[across] == fixed && q[along] > fr.lo[along] && q[along] < fr.hi[along]) run.push_back(i);
     }
     if (run.empty()) continue;
-    std::sort(run.begin(), run.end(), [&](size_t x, size_t y) { return lat_of(pts[x].first)[along] < lat_of(pts[y].first)[along]; });
-    const int fa = across == u ? int(e & 1) : 0, fb = across == v ? int(e & 1) : 0;
-    const bool s0 = corner_sign(fa, fb);
-    const bool s1 = corner_sign(along == u ? 1 : fa, along == v ? 1 : fb);
-    // Points before the cut take s0, the rest s1: the cut needing the fewest flips.
+    std::sort(run.begin(), run.end(),
+              [&](size_t x, size_t y) { return fr.lat_of(pts[x].first)[along] < fr.lat_of(pts[y].first)[along]; });
+    const int fa = across == fr.u ? int(e & 1) : 0, fb = across == fr.v ? int(e & 1) : 0;
+    const bool s0 = fr.corner_sign(fa, fb);
+    const bool s1 = fr.corner_sign(along == fr.u ? 1 : fa, along == fr.v ? 1 : fb);
     size_t best_cut = 0, best = SIZE_MAX, before = 0, after = 0;
     for (size_t i : run) after += pts[i].second != s1;
     for (size_t cut = 0; cut <= run.size(); ++cut) {
@@ -346,30 +344,56 @@ const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, F
       const bool want = r < best_cut ? s0 : s1;
       if (pts[run[r]].second != want) {
         pts[run[r]].second = want;
-        flipped[run[r]] = 1;
+        s.flipped[run[r]] = 1;
       }
     }
   }
-  // Regions of one sign (union-find over same-sign links, with the edge flips applied).
+}
+
+/// Regions of one sign on the face (union-find over same-sign links, edge flips applied)
+/// that reach no face corner of their sign are flipped whole (marked in s.flipped).
+void flip_stray_regions(const FaceFrame& fr, FaceScratch& s) {
+  const auto& pts = s.pts;
   UnionFind& regions = s.regions;
   regions.reset(pts.size());
-  for (const auto& [a, b] : links) {
-    const size_t ia = index_of(a), ib = index_of(b);
+  for (const auto& [a, b] : s.links) {
+    const size_t ia = s.index_of(a), ib = s.index_of(b);
     if (pts[ia].second == pts[ib].second) regions.join(ia, ib);
   }
   std::vector<char>& anchored = s.anchored;
   anchored.assign(pts.size(), 0);
   for (int c = 0; c < 4; ++c) {
-    Lat q = lo;
-    if (c & 1) q[u] = hi[u];
-    if (c & 2) q[v] = hi[v];
-    const size_t i = index_of(key(q));
-    if (i < pts.size() && pts[i].first == key(q) && pts[i].second == corner_sign(c & 1, c >> 1)) anchored[regions.root(i)] = 1;
+    Lat q = fr.lo;
+    if (c & 1) q[fr.u] = fr.hi[fr.u];
+    if (c & 2) q[fr.v] = fr.hi[fr.v];
+    const size_t i = s.index_of(fr.key(q));
+    if (i < pts.size() && pts[i].first == fr.key(q) && pts[i].second == fr.corner_sign(c & 1, c >> 1))
+      anchored[regions.root(i)] = 1;
   }
   for (size_t i = 0; i < pts.size(); ++i)
-    if (!anchored[regions.root(i)]) flipped[i] ^= 1;
-  for (size_t i = 0; i < pts.size(); ++i)
-    if (flipped[i]) s.flips.push_back(lat_of(pts[i].first));
+    if (!anchored[regions.root(i)]) s.flipped[i] ^= 1;
+}
+
+/// Face `f` (axis f / 2, high side if f % 2) of a coarse gray leaf, as the finer leaves
+/// across it see it. Dual contouring gives the coarse leaf one vertex, so what those leaves
+/// show on the face must look like a face of one cell:
+/// - along each edge of the face the sign changes at most once (never when its ends agree),
+///   else the edge gets several dual polygons through the same coarse vertices (a doubled
+///   sheet, non-manifold edges);
+/// - every connected region of one sign on the face reaches a corner of the face with that
+///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
+///   vertex).
+/// Returns the lattice points to flip (as few as possible along edges; whole stray regions
+/// on the face).
+const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
+  s.flips.clear();
+  const FaceFrame fr(big, f, signs_of(t.nodes[big.node]));
+  if (!collect_face_points(t, big, fr, s)) return s.flips;
+  s.flipped.assign(s.pts.size(), 0);
+  settle_face_edges(fr, s);
+  flip_stray_regions(fr, s);
+  for (size_t i = 0; i < s.pts.size(); ++i)
+    if (s.flipped[i]) s.flips.push_back(fr.lat_of(s.pts[i].first));
   return s.flips;
 }
 
