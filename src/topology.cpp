@@ -397,6 +397,94 @@ const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, F
   return s.flips;
 }
 
+/// A face of a coarse gray leaf to check with face_flips once the point islands are gone.
+using CoarseFace = std::pair<LeafRef, int>;
+
+/// Faces of `big` that meet the box [lo, hi].
+void faces_meeting(const LeafRef& big, const Lat& lo, const Lat& hi, std::vector<CoarseFace>& faces) {
+  const int64_t s = big.cell.span();
+  for (int f = 0; f < 6; ++f) {
+    const int d = f / 2;
+    const int64_t plane = big.cell.lat[d] + (f % 2) * s;
+    bool meets = lo[d] <= plane && plane <= hi[d];
+    for (int k = 0; k < 3 && meets; ++k)
+      if (k != d) meets = big.cell.lat[k] < hi[k] && lo[k] < big.cell.lat[k] + s;
+    if (meets) faces.push_back({big, f});
+  }
+}
+
+/// A fine active leaf's corners against the coarser gray leaves around them (an old coarse
+/// leaf next to new fine ones): a corner that is an island on one of them is flipped. The
+/// coarse leaves' faces are queued.
+template <class Flip>
+void fine_corners_on_coarse_leaves(const Octree& t, const IslandSearch& search, const PathLeaf& l, Flip&& flip,
+                                   std::vector<LeafRef>& near, std::vector<CoarseFace>& faces) {
+  const Cell& cell = l.cell;
+  // The coarser leaves around its corners (a leaf as fine or finer touching a corner has it
+  // as a corner too): one descent for the cell's closed box, from the nearest ancestor that
+  // holds it.
+  near.clear();
+  const Lat lo = cell.lat, hi = cell.corner(7);
+  const LeafRef from = search.start_for(l, lo, hi, true);
+  leaves_touching(t, from.node, from.cell, lo, hi, cell.level - 1, near);
+  for (const LeafRef& big : near)
+    if (t.nodes[big.node].kind == CellKind::Gray) faces_meeting(big, lo, hi, faces);
+  for (int k = 0; k < 8; ++k) {
+    const Lat p = cell.corner(k);
+    const bool sp = (signs_of(t.nodes[l.node]) >> k) & 1;
+    for (const LeafRef& big : near) {
+      if (t.nodes[big.node].kind != CellKind::Gray || big.cell.corner_index(p) >= 0) continue;
+      bool touches = true;
+      for (int a = 0; a < 3 && touches; ++a)
+        touches = p[a] >= big.cell.lat[a] && p[a] <= big.cell.lat[a] + big.cell.span();
+      if (!touches || !is_island(t.nodes[big.node], big.cell, p, sp)) continue;
+      flip(p);
+      break;
+    }
+  }
+}
+
+/// An active coarse leaf against the finer leaves across its faces (a new coarse leaf next to
+/// old fine ones): their corners on the shared face that are islands on it are flipped. The
+/// leaf's faces with finer leaves across are queued.
+template <class Flip>
+void finer_corners_on_coarse_leaf(const Octree& t, const IslandSearch& search, const PathLeaf& l, Flip&& flip,
+                                  std::vector<CoarseFace>& faces) {
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  const uint32_t big = l.node;
+  const Cell& cell = l.cell;
+  const int64_t sz = cell.span();
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      Cell across = cell;
+      across.lat[d] += side ? sz : -sz;
+      if (across.lat[d] < 0 || across.lat[d] >= kLimit) continue;
+      const Lat across_hi = across.corner(7);
+      const LeafRef n = search.node_below(search.start_for(l, across.lat, across_hi, false), across);
+      if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
+      if (t.nodes[big].kind == CellKind::Gray) faces.push_back({{big, cell}, 2 * d + side});
+      const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
+      // Leaves of the finer side touching the shared face, and their corners on it.
+      std::function<void(uint32_t, const Cell&)> visit = [&](uint32_t node, const Cell& c) {
+        const Node& m = t.nodes[node];
+        if (m.kind == CellKind::Internal) {
+          for (int k = 0; k < 8; ++k) {
+            const Cell ch = c.child(k);
+            if (ch.lat[d] <= plane && ch.lat[d] + ch.span() >= plane) visit(m.index + k, ch);
+          }
+          return;
+        }
+        for (int k = 0; k < 8; ++k) {
+          const Lat p = c.corner(k);
+          if (p[d] != plane || cell.corner_index(p) >= 0) continue;
+          const bool sp = (signs_of(m) >> k) & 1;
+          if (is_island(t.nodes[big], cell, p, sp)) flip(p);
+        }
+      };
+      visit(n.node, n.cell);
+    }
+}
+
 }  // namespace
 
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
@@ -412,88 +500,14 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
   };
-  // Faces of coarse gray leaves with finer leaves across them, checked at the end.
-  std::vector<std::pair<LeafRef, int>> faces;
-  auto queue_faces = [&](const LeafRef& big, const Lat& lo, const Lat& hi) {
-    const int64_t s = big.cell.span();
-    for (int f = 0; f < 6; ++f) {
-      const int d = f / 2;
-      const int64_t plane = big.cell.lat[d] + (f % 2) * s;
-      bool meets = lo[d] <= plane && plane <= hi[d];
-      for (int k = 0; k < 3 && meets; ++k)
-        if (k != d) meets = big.cell.lat[k] < hi[k] && lo[k] < big.cell.lat[k] + s;
-      if (meets) faces.push_back({big, f});
-    }
-  };
-  // A fine active leaf's corners against the coarser leaves around them (an old coarse
-  // leaf next to new fine ones)...
+  std::vector<CoarseFace> faces;
   std::vector<LeafRef> near;
-  for (const PathLeaf& l : search.leaves) {
-    const uint32_t node = l.node;
-    const Cell& cell = l.cell;
-    if (cell.level < t.max_depth - 1) continue;  // the finest leaves carry the islands
-    // The coarser leaves around its corners (a leaf as fine or finer touching a corner has it
-    // as a corner too): one descent for the cell's closed box, from the nearest ancestor that
-    // holds it.
-    near.clear();
-    const Lat lo = cell.lat, hi = cell.corner(7);
-    const LeafRef from = search.start_for(l, lo, hi, true);
-    leaves_touching(t, from.node, from.cell, lo, hi, cell.level - 1, near);
-    for (const LeafRef& big : near)
-      if (t.nodes[big.node].kind == CellKind::Gray) queue_faces(big, lo, hi);
-    for (int k = 0; k < 8; ++k) {
-      const Lat p = cell.corner(k);
-      const bool sp = (signs_of(t.nodes[node]) >> k) & 1;
-      for (const LeafRef& big : near) {
-        if (t.nodes[big.node].kind != CellKind::Gray || big.cell.corner_index(p) >= 0) continue;
-        bool touches = true;
-        for (int a = 0; a < 3 && touches; ++a)
-          touches = p[a] >= big.cell.lat[a] && p[a] <= big.cell.lat[a] + big.cell.span();
-        if (!touches || !is_island(t.nodes[big.node], big.cell, p, sp)) continue;
-        flip(p);
-        break;
-      }
-    }
-  }
-  // ... and an active coarse leaf against the finer leaves across its faces (a new coarse
-  // leaf next to old fine ones).
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  for (const PathLeaf& l : search.leaves) {
-    const uint32_t big = l.node;
-    const Cell& cell = l.cell;
-    if (cell.level >= t.max_depth) continue;
-    const int64_t sz = cell.span();
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        Cell across = cell;
-        across.lat[d] += side ? sz : -sz;
-        if (across.lat[d] < 0 || across.lat[d] >= kLimit) continue;
-        const Lat across_hi = across.corner(7);
-        const LeafRef n = search.node_below(search.start_for(l, across.lat, across_hi, false), across);
-        if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
-        if (t.nodes[big].kind == CellKind::Gray) faces.push_back({{big, cell}, 2 * d + side});
-        const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
-        // Leaves of the finer side touching the shared face, and their corners on it.
-        std::function<void(uint32_t, const Cell&)> visit = [&](uint32_t node, const Cell& c) {
-          const Node& m = t.nodes[node];
-          if (m.kind == CellKind::Internal) {
-            for (int k = 0; k < 8; ++k) {
-              const Cell ch = c.child(k);
-              if (ch.lat[d] <= plane && ch.lat[d] + ch.span() >= plane) visit(m.index + k, ch);
-            }
-            return;
-          }
-          for (int k = 0; k < 8; ++k) {
-            const Lat p = c.corner(k);
-            if (p[d] != plane || cell.corner_index(p) >= 0) continue;
-            const bool sp = (signs_of(m) >> k) & 1;
-            if (is_island(t.nodes[big], cell, p, sp)) flip(p);
-          }
-        };
-        visit(n.node, n.cell);
-      }
-  }
-  // ... and what the finer side shows on each coarse face (edges, stray regions).
+  for (const PathLeaf& l : search.leaves)
+    if (l.cell.level >= t.max_depth - 1)  // the finest leaves carry the islands
+      fine_corners_on_coarse_leaves(t, search, l, flip, near, faces);
+  for (const PathLeaf& l : search.leaves)
+    if (l.cell.level < t.max_depth) finer_corners_on_coarse_leaf(t, search, l, flip, faces);
+  // What the finer side shows on each coarse face (edges, stray regions), each face once.
   FaceScratch face_scratch;
   std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
     return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
