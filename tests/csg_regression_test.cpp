@@ -89,7 +89,13 @@ TEST_P(HarnessCase, MatchesTheExactBoolean) {
     exact = exact_boolean(*exact, written(trees[i]), k.ops[i - 1]);
     ASSERT_TRUE(exact) << "CGAL refused case " << kept.seed;
   }
-  const CsgComparison c = compare_to_exact(written(acc), *exact, 1.0 / double(1 << k.depth));
+  const TriMesh result = written(acc);
+  // A valid solid: closed, 2-manifold, no self-intersections (exact test).
+  const MeshValidity v = check_validity(result);
+  EXPECT_TRUE(v.valid()) << k.text << ": " << v.self_intersections << " self-intersections, " << v.nonmanifold_vertices
+                         << " non-manifold vertices, " << v.nonmanifold_edges << " non-manifold edges, "
+                         << v.boundary_edges << " boundary edges";
+  const CsgComparison c = compare_to_exact(result, *exact, 1.0 / double(1 << k.depth));
   EXPECT_EQ(c.pic_components, c.exact_components) << k.text << " (" << kept.what << ")";
   EXPECT_LE(c.pic_to_exact, kept.pic_to_exact) << k.text;
   EXPECT_LE(c.exact_to_pic, kept.exact_to_pic) << k.text;
@@ -122,6 +128,7 @@ TEST(CsgRegression, ThingiPairHasNoSlitAndNoSpecks) {
   // The slit was 8.3 cells deep. Below 3 cells before the intersection-free contour's last
   // resort (a coarse cell's vertex may move 1/8 of its cell, up to ~1.5 finest cells here).
   EXPECT_LT(worst, 4.5) << "a point of A − B's surface is " << worst << " cells from both operands";
+  EXPECT_TRUE(check_validity(r).valid());
   EXPECT_EQ(check_validity(r, false).components, 4u);
   std::printf("  [measure] Thingi A - B: %.2f cells from the operands at most, %zu components\n", worst,
               check_validity(r, false).components);
