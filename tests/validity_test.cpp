@@ -196,6 +196,28 @@ TEST(Validity, SculptingRunStaysValid) {
   EXPECT_TRUE(IsValidSolid(written(clay)));
 }
 
+// Issue 10's sculpting criterion: 300 strokes, then the written mesh is a valid solid. Strokes
+// carve (3 in 4) and add (1 in 4) small spheres of random radius, centred on the clay's surface:
+// every 25 strokes the centres are re-picked from the plain contour's vertices, so later
+// strokes land on earlier bites, where coarse old leaves meet fine new ones.
+TEST(Validity, ThreeHundredStrokesStayValid) {
+  const int depth = 9;
+  Octree clay = sample_in(make_box({0.2, 0.3, 0.35}, {0.8, 0.7, 0.65}), depth);
+  std::mt19937_64 rng(11);
+  ContourOptions plain;
+  plain.intersection_free = false;
+  std::vector<Vec3> surface;
+  for (int stroke = 0; stroke < 300; ++stroke) {
+    if (stroke % 25 == 0) surface = contour(clay, plain).positions;
+    const Vec3 c = surface[std::uniform_int_distribution<size_t>(0, surface.size() - 1)(rng)];
+    const double r = std::uniform_real_distribution<double>(0.015, 0.04)(rng);
+    const CsgOp op = stroke % 4 == 3 ? CsgOp::Union : CsgOp::Subtract;
+    csg_inplace(clay, sample_in(make_sphere(c, r, 16), depth), op);
+  }
+  EXPECT_TRUE(IsValidSolid(written(clay)));
+  EXPECT_GT(volume(written(clay)), 0.0);
+}
+
 // How far the default contour moved a vertex off the surface of the plain split, in finest
 // cells: the largest distance of a moved vertex from the planes of its triangles in `plain`
 // (both contours number the tree's vertices alike; the default appends its fan points).
