@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Issue 10's validity table at the current build: every bundled model (and the Thingi10K pair
+# and its difference, when THINGI_DIR holds them) sampled at DEPTH, written by `pic mesh` /
+# `pic csg --mesh`, with the exact checks PIC reports itself (self-intersections, non-manifold
+# vertices and edges, components). With MESHCHECK set to the shared tools' meshcheck, also the
+# two-sided Hausdorff distance to the input mesh.
+#   scripts/validity_sweep.sh [BUILD_DIR] [OUT_DIR]
+set -euo pipefail
+BUILD=${1:-build}
+OUT=${2:-out/validity}
+DEPTH=${DEPTH:-12}
+THINGI_DIR=${THINGI_DIR:-/work/shared/data}
+MESHCHECK=${MESHCHECK:-}
+PIC="$BUILD/pic"
+mkdir -p "$OUT"
+json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
+
+row() {  # name, json file, input mesh (or "")
+  local fields haus=""
+  fields=$(json "'%d | %d | %d | %d | {:,}'.format(d['triangles']) % (d['self_intersections'], d['nonmanifold_vertices'], d['nonmanifold_edges'], d['components'])" < "$2")
+  if [[ -n "$MESHCHECK" && -n "$3" ]]; then
+    haus=$("$MESHCHECK" "$OUT/$1.obj" "$3" --no-si --samples 100000 | json "'%.3g' % max(d['hausdorff_ab'], d['hausdorff_ba'])")
+  fi
+  echo "| $1 | $fields | $haus | $(json "'%.2f' % d['seconds']" < "$2") |"
+}
+
+echo "| mesh | self-intersecting pairs | non-manifold vertices | non-manifold edges | components | triangles | Hausdorff | seconds |"
+echo "|---|---|---|---|---|---|---|---|"
+inputs=()
+for m in data/*.obj; do inputs+=("$m"); done
+[[ -f "$THINGI_DIR/thingi10k-1706459.obj" ]] && inputs+=("$THINGI_DIR/thingi10k-1706459.obj" "$THINGI_DIR/thingi10k-1514499.obj")
+for m in "${inputs[@]}"; do
+  name=$(basename "$m" .obj)
+  "$PIC" sample "$m" -o "$OUT/$name.pic" --depth "$DEPTH" > /dev/null
+  "$PIC" mesh "$OUT/$name.pic" -o "$OUT/$name.obj" --json > "$OUT/$name.json"
+  row "$name" "$OUT/$name.json" "$m"
+done
+if [[ -f "$THINGI_DIR/thingi10k-1706459.obj" ]]; then
+  # The pair in one cube (the cube around both), then A - B.
+  cube=$(python3 - "$THINGI_DIR/thingi10k-1706459.obj" "$THINGI_DIR/thingi10k-1514499.obj" <<'EOF'
+import sys
+lo = [1e300] * 3; hi = [-1e300] * 3
+for f in sys.argv[1:]:
+    for l in open(f):
+        if l.startswith('v '):
+            p = list(map(float, l.split()[1:4]))
+            lo = [min(a, b) for a, b in zip(lo, p)]; hi = [max(a, b) for a, b in zip(hi, p)]
+side = max(h - l for h, l in zip(hi, lo)) * (1 + 2 / 16)
+print(','.join('%.9g' % ((l + h) / 2 - side / 2) for l, h in zip(lo, hi)) + ',%.9g' % side)
+EOF
+)
+  "$PIC" sample "$THINGI_DIR/thingi10k-1706459.obj" -o "$OUT/pair_a.pic" --depth "$DEPTH" --cube "$cube" > /dev/null
+  "$PIC" sample "$THINGI_DIR/thingi10k-1514499.obj" -o "$OUT/pair_b.pic" --depth "$DEPTH" --cube "$cube" > /dev/null
+  "$PIC" csg "$OUT/pair_a.pic" subtract "$OUT/pair_b.pic" -o "$OUT/thingi_a_minus_b.pic" --mesh "$OUT/thingi_a_minus_b.obj" \
+    --json > "$OUT/thingi_a_minus_b.json"
+  row thingi_a_minus_b "$OUT/thingi_a_minus_b.json" ""
+fi
