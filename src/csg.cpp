@@ -41,7 +41,6 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 std::atomic<uint32_t> g_timestamp{0};
 
-
 bool apply(CsgOp op, bool a, bool b) {
   switch (op) {
     case CsgOp::Union: return a || b;
@@ -977,8 +976,6 @@ void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
   x.parity_bvh.build(x.parity_tris);
 }
 
-
-
 /// Drops unreachable nodes and vertices (left behind by in-place replacement).
 void compact(Octree& t) {
   Octree c;
@@ -1099,7 +1096,6 @@ std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialC
   a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
   return std::move(f.hints);
 }
-
 
 }  // namespace
 

@@ -36,7 +36,6 @@ LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path
   return {node, cell};
 }
 
-
 /// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
 /// in depth-first order.
 void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
@@ -85,7 +84,6 @@ std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uin
   }
   return out;
 }
-
 
 /// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
 /// one when null), depth first.
@@ -156,7 +154,6 @@ bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
   }
   return seen > 0 && seen < 8 && all_differ;
 }
-
 
 }  // namespace
 
