@@ -14,7 +14,8 @@
 // fewest exact intersections against its neighbours (ties keep the current, then the cheaper
 // option), and this repeats until no pair is left or nothing changes. Only polygons near a
 // crossing change, so the triangle count grows by a few percent at most. What options cannot
-// resolve, vertex moves try (within a finest cell, then along the vertex's own planes); then the
+// resolve, vertex moves try (within a finest cell, then along the vertex's own planes; a corner,
+// whose every move leaves some of its planes, by one finest cell in all rounds together); then the
 // sides where the containment fails are split at a point of their cells' common face
 // (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come last.
 #include <algorithm>
@@ -685,8 +686,8 @@ class Untangler {
     return m;
   }
 
-  // Where corner v started (see kCornerSpread), or null if v is no corner; decided at v's
-  // first move, before which v has not moved.
+  // Where corner v started (see kCornerSpread), or null if v is no corner; decided when v is
+  // first tried (nothing has moved it before).
   const Vec3* corner_start(uint32_t v, const Vec3& was) {
     auto [it, first] = corner_start_.try_emplace(v);
     if (first) {
@@ -713,9 +714,9 @@ class Untangler {
     const std::vector<double>& scale = mt.scale;
     const std::vector<Vec3>& normals = mt.normals;
     // A corner's ordinary moves add up to at most kMaxPull in all rounds (each round could
-    // take another cell: the apex of seed 250's cone, a 128-cell leaf's vertex, went 2 cells
-    // into the cone in two rounds and cut its tip). Its neighbours' moves or the last resort
-    // take what that leaves; only the last resort's second stage may move it further.
+    // take another cell: the apex of the CSG harness case 250's cone, a 128-cell leaf's vertex,
+    // went 2 cells into the cone in two rounds and cut its tip). Its neighbours' moves or the
+    // last resort take what that leaves; only the last resort's second stage may move it further.
     const Vec3* start = last_resort_ < 2 ? corner_start(v, was) : nullptr;
     double best_deviation = 0;
     auto deviation = [&](const Vec3& q) {
