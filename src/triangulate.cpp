@@ -14,7 +14,8 @@
 // fewest exact intersections against its neighbours (ties keep the current, then the cheaper
 // option), and this repeats until no pair is left or nothing changes. Only polygons near a
 // crossing change, so the triangle count grows by a few percent at most. What options cannot
-// resolve, vertex moves try (within a finest cell, then along the vertex's own planes); then the
+// resolve, vertex moves try (within a finest cell, then along the vertex's own planes; a corner,
+// whose every move leaves some of its planes, by one finest cell in all rounds together); then the
 // sides where the containment fails are split at a point of their cells' common face
 // (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come last.
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -58,6 +60,11 @@ constexpr double kFarMoveDeviation = 0.25;
 /// Directions along which the planes of a vertex's triangles vary less than this (relative
 /// eigenvalue of the sum of their normals' outer products) count as lying in all of them.
 constexpr double kNullCutoff = 0.05;
+/// A vertex whose triangles' planes spread in every direction (the least eigenvalue of the
+/// same sum above this fraction of the largest) is a corner: a cone's apex, a box's corner.
+/// Every move takes a corner off some of its planes by the whole move, so ordinary moves may
+/// take it at most kMaxPull from where it started, in all rounds together (see move_vertex).
+constexpr double kCornerSpread = 0.2;
 
 // kSplitFan: the fan with some sides split at a point on their cells' common face (see
 // Untangler::split_sides).
@@ -637,8 +644,6 @@ class Untangler {
     std::vector<Vec3> normals;  // unit normals of v's triangles (last resort only)
   };
   MoveTargets move_targets(uint32_t v, const Vec3& was) const {
-    const std::vector<Vec3>& xm = merged_.xm;
-    const std::vector<uint32_t>& mid = merged_.mid;
     const std::vector<uint32_t>& first = star_.first;
     const std::vector<uint32_t>& around = star_.around;
     Vec3 ring{0, 0, 0};
@@ -655,23 +660,42 @@ class Untangler {
     MoveTargets mt{{cells_[v].center, ring}, {reach(v), reach(v)}, {}};
     if (!last_resort_) return mt;
     // Moves along the planes keep the surface where it is, so they may cross the whole cell.
-    const double along_reach = room_of(v);
+    add_targets_along_planes(plane_spread(v, &mt.normals), was, room_of(v), mt.targets, mt.scale);
+    return mt;
+  }
+
+  // The sum of the outer products of the unit normals of v's triangles (its planes' spread:
+  // null directions lie in all of them); `normals` (if given) receives the normals.
+  Eigen::Matrix3d plane_spread(uint32_t v, std::vector<Vec3>* normals) const {
+    const std::vector<Vec3>& xm = merged_.xm;
+    const uint32_t at = merged_.mid[v];
     Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-    for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+    for (uint32_t k = star_.first[v]; k < star_.first[v + 1]; ++k) {
       Tris t;
-      const int c = merged_tris(around[k], opt_[around[k]], t);
+      const int c = merged_tris(star_.around[k], opt_[star_.around[k]], t);
       for (int a = 0; a < c; ++a) {
-        if (t[a][0] != mid[v] && t[a][1] != mid[v] && t[a][2] != mid[v]) continue;
+        if (t[a][0] != at && t[a][1] != at && t[a][2] != at) continue;
         const Vec3 nn = cross3(sub3(xm[t[a][1]], xm[t[a][0]]), sub3(xm[t[a][2]], xm[t[a][0]]));
         const double l = norm3(nn);
         if (!(l > 0)) continue;
         const Eigen::Vector3d e(nn[0] / l, nn[1] / l, nn[2] / l);
-        mt.normals.push_back({e[0], e[1], e[2]});
+        if (normals) normals->push_back({e[0], e[1], e[2]});
         m += e * e.transpose();
       }
     }
-    add_targets_along_planes(m, was, along_reach, mt.targets, mt.scale);
-    return mt;
+    return m;
+  }
+
+  // Where corner v started (see kCornerSpread), or null if v is no corner; decided when v is
+  // first tried (nothing has moved it before).
+  const Vec3* corner_start(uint32_t v, const Vec3& was) {
+    auto [it, first] = corner_start_.try_emplace(v);
+    if (first) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(plane_spread(v, nullptr), Eigen::EigenvaluesOnly);
+      const Eigen::Vector3d ev = eig.eigenvalues();
+      it->second = {was, ev[2] > 0 && ev[0] > kCornerSpread * ev[2]};
+    }
+    return it->second.second ? &it->second.first : nullptr;
   }
 
   // Moves vertex v to the best of its candidate positions; whether it moved.
@@ -689,6 +713,11 @@ class Untangler {
     const std::vector<Vec3>& targets = mt.targets;
     const std::vector<double>& scale = mt.scale;
     const std::vector<Vec3>& normals = mt.normals;
+    // A corner's ordinary moves add up to at most kMaxPull in all rounds (each round could
+    // take another cell: the apex of the CSG harness case 250's cone, a 128-cell leaf's vertex,
+    // went 2 cells into the cone in two rounds and cut its tip). Its neighbours' moves or the
+    // last resort take what that leaves; only the last resort's second stage may move it further.
+    const Vec3* start = last_resort_ < 2 ? corner_start(v, was) : nullptr;
     double best_deviation = 0;
     auto deviation = [&](const Vec3& q) {
       double w = 0;
@@ -707,7 +736,7 @@ class Untangler {
           q[k] = was[k] + f * d[k];
           inside = inside && std::abs(q[k] - cells_[v].center[k]) <= cells_[v].half;
         }
-        if (!inside) continue;
+        if (!inside || (start && norm3(sub3(q, *start)) > kMaxPull * finest_)) continue;
         const double dv = deviation(q);
         // Stage 1 keeps every far move on the planes; stage 2 still the moves along them
         // (which may go further than reach(v) only because they keep the surface).
@@ -927,6 +956,8 @@ class Untangler {
   // Polygons and vertices already tried whose neighbourhood has not changed since: trying
   // them again would give the same answer.
   std::vector<uint8_t> settled_, joint_settled_, vertex_settled_;
+  // Vertices tried for a move: where each started and whether it is a corner.
+  std::unordered_map<uint32_t, std::pair<Vec3, bool>> corner_start_;
   std::vector<uint32_t> dirty_;
 };
 

@@ -11,6 +11,7 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
+#include "support/csg_cases.h"
 #include "support/mesh_checks.h"
 #include "support/thingi_pair.h"
 
@@ -249,6 +250,28 @@ TEST(Validity, LastResortMovesKeepTheSurface) {
   std::printf("  [measure] Thingi A depth 11: %zu moved vertices, largest move off the plain planes %.3f cells\n",
               st.moved_vertices, off);
   EXPECT_LE(off, 1.0 + 1e-6);
+}
+
+// The first operand of the CSG harness's case 250 (tests/support/csg_cases.h; it draws no
+// data mesh), a cone sampled at depth 8: its apex is the vertex of a 128-cell leaf, with a fan
+// of long slivers to the fine cells where the cone's top grazes the leaf's face, and the plain
+// split's slivers cross each other and those cells' triangles. Ordinary moves took the apex
+// one finest cell into the cone in each of two rounds, cutting the tip 2 cells short. A
+// corner's ordinary moves now add up to one cell at most; the apex's neighbours do the rest.
+TEST(Validity, ConeApexMovesAtMostOneCell) {
+  const CsgCase k = make_case(250, 0, {});
+  ASSERT_EQ(k.depth, 8);
+  const Octree t = sample_in(k.inputs[0], k.depth);
+  const auto [plain, clean, st] = fast_and_default(t);
+  EXPECT_GT(count_self_intersections(plain), 0u);
+  EXPECT_EQ(count_self_intersections(clean), 0u);
+  const double off = largest_move_off_planes(plain, clean, 1.0 / 256);
+  std::printf("  [measure] cone apex (case 250, depth 8): largest move off the plain planes %.2f cells\n", off);
+  EXPECT_LE(off, 1.0 + 1e-6);
+  // The apex itself (the plain contour's lowest vertex in y) is where it was, within a cell.
+  const auto apex = std::min_element(plain.positions.begin(), plain.positions.end(),
+                                     [](const Vec3& a, const Vec3& b) { return a[1] < b[1]; }) - plain.positions.begin();
+  EXPECT_LE(norm3(sub3(clean.positions[apex], plain.positions[apex])), 1.0 / 256 + 1e-12);
 }
 
 // Suzanne at depth 12 (as `pic mesh` sees it after `pic sample`; depths 10 and 11 do not show
