@@ -2,7 +2,8 @@
 // data/, random operations and chains of them; each PIC result is compared with CGAL's exact
 // Boolean of the operands' own contours (tests/support/exact_csg.h): component counts, the two
 // one-sided distances in finest cells, volumes. Prints one line per case and the worst cases
-// with their seeds; every case is replayable alone from its seed.
+// with their seeds; every case is replayable alone from its seed. Each result is also checked
+// for validity (closed, 2-manifold, no self-intersections: check_validity).
 //
 //   pic_csg_fuzz [--seed S] [--cases N] [--depth D] [--top K] [--out DIR]
 //   pic_csg_fuzz --case SEED [--out DIR]     one case, its meshes written to DIR
@@ -44,6 +45,7 @@ struct CaseResult {
   std::string why;
   CsgComparison cmp;
   double pic_seconds = 0, exact_seconds = 0;
+  MeshValidity validity;  // of PIC's written result (exact self-intersection test)
 };
 
 using Clock = std::chrono::steady_clock;
@@ -104,6 +106,7 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
   }
   const TriMesh pic_mesh = written(acc);
   res.pic_seconds = since(t0);
+  res.validity = check_validity(pic_mesh);
   if (!out_dir.empty()) {
     std::filesystem::create_directories(out_dir);
     const std::string base = out_dir + "/case" + std::to_string(seed) + "_";
@@ -147,6 +150,7 @@ CaseResult run_pair(const std::string& pa, CsgOp op, const std::string& pb, int 
   const Octree ta = sample(a, so), tb = sample(b, so);
   const TriMesh pic_mesh = written(csg(ta, tb, op));
   res.pic_seconds = since(t0);
+  res.validity = check_validity(pic_mesh);
   t0 = Clock::now();
   const TriMesh ca = written(ta), cb = written(tb);
   std::printf("operand contours: %zu and %zu self-intersecting pairs\n", count_self_intersections(ca),
@@ -165,6 +169,15 @@ CaseResult run_pair(const std::string& pa, CsgOp op, const std::string& pb, int 
   return res;
 }
 
+/// "valid", or what makes PIC's result not a valid solid.
+std::string validity_text(const MeshValidity& v) {
+  if (v.valid()) return "valid";
+  return "NOT VALID: " + std::to_string(v.self_intersections) + " self-intersections, " +
+         std::to_string(v.nonmanifold_vertices) + " non-manifold vertices, " + std::to_string(v.nonmanifold_edges) +
+         " non-manifold edges, " + std::to_string(v.boundary_edges) + " boundary edges, " +
+         std::to_string(v.collinear_triangles) + " zero-area triangles";
+}
+
 void print(const CaseResult& c) {
   if (c.skipped) {
     std::printf("seed %llu depth %d: %s: skipped (%s)\n", (unsigned long long)c.seed, c.depth, c.text.c_str(),
@@ -174,11 +187,11 @@ void print(const CaseResult& c) {
   const CsgComparison& m = c.cmp;
   std::printf(
       "seed %llu depth %d: %s: components %zu/%zu, pic->exact %.2f cells at (%.4f %.4f %.4f), exact->pic %.2f cells at "
-      "(%.4f %.4f %.4f), volume %+.2e, %.2f s / %.2f s, thick %.2f at (%.4f %.4f %.4f)\n",
+      "(%.4f %.4f %.4f), volume %+.2e, %.2f s / %.2f s, thick %.2f at (%.4f %.4f %.4f), %s\n",
       (unsigned long long)c.seed, c.depth, c.text.c_str(), m.pic_components, m.exact_components, m.pic_to_exact,
       m.worst_pic[0], m.worst_pic[1], m.worst_pic[2], m.exact_to_pic, m.worst_exact[0], m.worst_exact[1],
       m.worst_exact[2], m.volume_rel, c.pic_seconds, c.exact_seconds, m.exact_to_pic_thick, m.worst_thick[0],
-      m.worst_thick[1], m.worst_thick[2]);
+      m.worst_thick[1], m.worst_thick[2], validity_text(c.validity).c_str());
   std::fflush(stdout);
 }
 
@@ -227,10 +240,15 @@ int main(int argc, char** argv) {
     skipped += all.back().skipped;
   }
   std::erase_if(all, [](const CaseResult& c) { return c.skipped; });
-  size_t mismatched = 0;
-  for (const auto& c : all) mismatched += c.cmp.pic_components != c.cmp.exact_components;
-  std::printf("\n%zu cases (seeds %llu..%llu), %zu skipped, %zu with a component count different from the exact one\n",
-              size_t(cases), (unsigned long long)seed, (unsigned long long)(seed + cases - 1), skipped, mismatched);
+  size_t mismatched = 0, invalid = 0;
+  for (const auto& c : all) {
+    mismatched += c.cmp.pic_components != c.cmp.exact_components;
+    invalid += !c.validity.valid();
+  }
+  std::printf("\n%zu cases (seeds %llu..%llu), %zu skipped, %zu with a component count different from the exact one, "
+              "%zu not a valid solid\n",
+              size_t(cases), (unsigned long long)seed, (unsigned long long)(seed + cases - 1), skipped, mismatched,
+              invalid);
   auto worst = [&](const char* title, auto key) {
     std::sort(all.begin(), all.end(), [&](const CaseResult& a, const CaseResult& b) { return key(a) > key(b); });
     std::printf("\nworst by %s:\n", title);
