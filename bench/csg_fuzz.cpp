@@ -180,8 +180,8 @@ std::string validity_text(const MeshValidity& v) {
 
 void print(const CaseResult& c) {
   if (c.skipped) {
-    std::printf("seed %llu depth %d: %s: skipped (%s)\n", (unsigned long long)c.seed, c.depth, c.text.c_str(),
-                c.why.c_str());
+    std::printf("seed %llu depth %d: %s: skipped (%s), %s\n", (unsigned long long)c.seed, c.depth, c.text.c_str(),
+                c.why.c_str(), validity_text(c.validity).c_str());
     return;
   }
   const CsgComparison& m = c.cmp;
@@ -233,18 +233,16 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::vector<CaseResult> all;
-  size_t skipped = 0;
+  size_t skipped = 0, invalid = 0;  // invalid: also among the skipped (PIC's result is checked first)
   for (int k = 0; k < cases; ++k) {
     all.push_back(run_case(seed + uint64_t(k), depth, out_dir));
     print(all.back());
     skipped += all.back().skipped;
+    invalid += !all.back().validity.valid();
   }
   std::erase_if(all, [](const CaseResult& c) { return c.skipped; });
-  size_t mismatched = 0, invalid = 0;
-  for (const auto& c : all) {
-    mismatched += c.cmp.pic_components != c.cmp.exact_components;
-    invalid += !c.validity.valid();
-  }
+  size_t mismatched = 0;
+  for (const auto& c : all) mismatched += c.cmp.pic_components != c.cmp.exact_components;
   std::printf("\n%zu cases (seeds %llu..%llu), %zu skipped, %zu with a component count different from the exact one, "
               "%zu not a valid solid\n",
               size_t(cases), (unsigned long long)seed, (unsigned long long)(seed + cases - 1), skipped, mismatched,

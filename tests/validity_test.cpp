@@ -274,6 +274,24 @@ TEST(Validity, ConeApexMovesAtMostOneCell) {
   EXPECT_LE(norm3(sub3(clean.positions[apex], plain.positions[apex])), 1.0 / 256 + 1e-12);
 }
 
+// The first operand of the CSG harness's case 74, a rotated box sampled at depth 7 and
+// contoured in memory (as `pic csg --mesh` does; its saved `.pic` contours cleanly): where a
+// crease's finest triangles meet two 8-cell leaves' long ones, 2-3 pairs crossed that no
+// option, split or move within 1/8 of a cell undid, and the written mesh kept 3 crossings. The
+// last stage may move those vertices anywhere in their cells (here one 8-cell vertex about 3
+// finest cells off its planes), bounded by the cell.
+TEST(Validity, LastStageLeavesNoCrossing) {
+  const CsgCase k = make_case(74, 0, {});
+  ASSERT_EQ(k.depth, 7);
+  const Octree t = sample_in(k.inputs[0], k.depth);
+  const auto [plain, clean, st] = fast_and_default(t);
+  EXPECT_EQ(st.remaining_intersections, 0u);
+  EXPECT_TRUE(IsValidSolid(written(t)));
+  const double off = largest_move_off_planes(plain, clean, 1.0 / 128);
+  std::printf("  [measure] box (case 74, depth 7): largest move off the plain planes %.2f cells\n", off);
+  EXPECT_LE(off, 4.0);  // half of the 8-cell leaf's side
+}
+
 // Suzanne at depth 12 (as `pic mesh` sees it after `pic sample`; depths 10 and 11 do not show
 // it): a level-7 leaf's vertex, in a corner of its 32-cell leaf at one of the model's creases,
 // has long triangles to 4- and 8-cell neighbours 16 cells away along its face; those sides cross
