@@ -17,7 +17,8 @@
 // resolve, vertex moves try (within a finest cell, then along the vertex's own planes; a corner,
 // whose every move leaves some of its planes, by one finest cell in all rounds together); then the
 // sides where the containment fails are split at a point of their cells' common face
-// (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come last.
+// (Untangler::split_sides); moves off the planes, up to 1/8 of the vertex's cell, come next,
+// and anywhere in the vertex's cell last (kLastStage).
 #include <algorithm>
 #include <array>
 #include <cmath>
