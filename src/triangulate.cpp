@@ -723,7 +723,7 @@ class Untangler {
     // A corner's ordinary moves add up to at most kMaxPull in all rounds (each round could
     // take another cell: the apex of the CSG harness case 250's cone, a 128-cell leaf's vertex,
     // went 2 cells into the cone in two rounds and cut its tip). Its neighbours' moves or the
-    // last resort take what that leaves; only the last resort's second stage may move it further.
+    // last resort take what that leaves; only the last resort's later stages may move it further.
     const Vec3* start = last_resort_ < 2 ? corner_start(v, was) : nullptr;
     double best_deviation = 0;
     auto deviation = [&](const Vec3& q) {
