@@ -1,8 +1,6 @@
 // The CSG clean-up: see csg_cleanup.h.
 #include "csg_cleanup.h"
 
-#include <optional>
-
 #include "topology.h"
 
 namespace pic::detail {
@@ -55,18 +53,6 @@ struct HintedFlip {
   bool needed = false;    // the point's sign differs from the hint's
 };
 
-/// The sign of lattice point p where a leaf has it as a corner; nothing where none has.
-std::optional<bool> corner_sign(const Octree& t, const Lat& p) {
-  for (int o = 0; o < 8; ++o) {
-    const Lat q{p[0] - (o & 1), p[1] - ((o >> 1) & 1), p[2] - ((o >> 2) & 1)};
-    if (q[0] < 0 || q[1] < 0 || q[2] < 0) continue;
-    const LeafRef r = leaf_at(t, q);
-    const int k = r.cell.corner_index(p);
-    if (k >= 0 && t.nodes[r.node].kind != CellKind::Internal) return bool((signs_of(t.nodes[r.node]) >> k) & 1);
-  }
-  return std::nullopt;
-}
-
 /// Whether setting corner k of a coarser leaf to `inside` would strand a finer point on one of
 /// its edges or faces through that corner: a point of the other sign on an edge or face whose
 /// corners all have this sign is an island, which the island pass then flips too, carrying
@@ -79,7 +65,7 @@ bool strands_finer_points(const Octree& t, const LeafRef& big, int k, bool insid
   const uint8_t s = uint8_t(signs_of(t.nodes[big.node]) & ~(1 << k)) | uint8_t(inside << k);
   const Lat lo = big.cell.lat;
   auto stranded = [&](const Lat& q) {
-    const std::optional<bool> sq = corner_sign(t, q);
+    const std::optional<bool> sq = point_sign(t, q);
     return sq && *sq != inside;
   };
   for (int a = 0; a < 3; ++a) {

@@ -124,6 +124,16 @@ LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path) {
   return node_at(t, Cell{kMaxLevel, q}, path);
 }
 
+std::optional<bool> point_sign(const Octree& t, const Lat& p) {
+  for (int o = 0; o < 8; ++o) {
+    Lat q;
+    if (!octant_cell(p, o, q)) continue;
+    const LeafRef l = leaf_at(t, q);
+    if (const int c = l.cell.corner_index(p); c >= 0) return bool((signs_of(t.nodes[l.node]) >> c) & 1);
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 /// Flips lattice point p's sign in every leaf that has it as a corner (consistently), and

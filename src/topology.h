@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <unordered_set>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct LeafRef {
 /// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the nodes
 /// from the root down to it.
 LeafRef leaf_at(const Octree& t, const std::array<int64_t, 3>& q, std::vector<uint32_t>* path = nullptr);
+/// The sign of lattice point q where a leaf has it as a corner; nothing where none has (q lies
+/// inside a coarser leaf's face, edge or body).
+std::optional<bool> point_sign(const Octree& t, const std::array<int64_t, 3>& q);
 
 /// Lattice points (key: x | y << 21 | z << 42) that remove_islands set in this operation, which
 /// enforce_one_component should not flip back when anything else will do.
