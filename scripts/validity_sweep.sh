@@ -36,22 +36,8 @@ for m in "${inputs[@]}"; do
   row "$name" "$OUT/$name.json" "$m"
 done
 if [[ -f "$THINGI_DIR/thingi10k-1706459.obj" ]]; then
-  # The pair in one cube (the cube around both), then A - B.
-  cube=$(python3 - "$THINGI_DIR/thingi10k-1706459.obj" "$THINGI_DIR/thingi10k-1514499.obj" <<'EOF'
-import sys
-lo = [1e300] * 3; hi = [-1e300] * 3
-for f in sys.argv[1:]:
-    for l in open(f):
-        if l.startswith('v '):
-            p = list(map(float, l.split()[1:4]))
-            lo = [min(a, b) for a, b in zip(lo, p)]; hi = [max(a, b) for a, b in zip(hi, p)]
-side = max(h - l for h, l in zip(hi, lo)) * (1 + 2 / 16)
-print(','.join('%.9g' % ((l + h) / 2 - side / 2) for l, h in zip(lo, hi)) + ',%.9g' % side)
-EOF
-)
-  "$PIC" sample "$THINGI_DIR/thingi10k-1706459.obj" -o "$OUT/pair_a.pic" --depth "$DEPTH" --cube "$cube" > /dev/null
-  "$PIC" sample "$THINGI_DIR/thingi10k-1514499.obj" -o "$OUT/pair_b.pic" --depth "$DEPTH" --cube "$cube" > /dev/null
-  "$PIC" csg "$OUT/pair_a.pic" subtract "$OUT/pair_b.pic" -o "$OUT/thingi_a_minus_b.pic" --mesh "$OUT/thingi_a_minus_b.obj" \
-    --json > "$OUT/thingi_a_minus_b.json"
+  # A - B with both meshes sampled in one cube around them (pic csg does that for mesh operands).
+  "$PIC" csg "$THINGI_DIR/thingi10k-1706459.obj" subtract "$THINGI_DIR/thingi10k-1514499.obj" --depth "$DEPTH" \
+    -o "$OUT/thingi_a_minus_b.pic" --mesh "$OUT/thingi_a_minus_b.obj" --json > "$OUT/thingi_a_minus_b.json"
   row thingi_a_minus_b "$OUT/thingi_a_minus_b.json" ""
 fi
