@@ -23,9 +23,9 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
-#include "qef.h"
-#include "octree_util.h"
-#include "winding.h"
+#include "geometry/qef.h"
+#include "octree/cell.h"
+#include "geometry/winding.h"
 
 namespace {
 

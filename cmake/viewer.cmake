@@ -1,5 +1,5 @@
 # The HTML viewer's JavaScript: viewer/main.js and three.js bundled by esbuild into one IIFE
-# at build time, then embedded into the library as pic::kViewerBundle (src/viewer.cpp).
+# at build time, then embedded into the library as pic::kViewerBundle (src/render/viewer.cpp).
 #
 # Defines:
 #   PIC_GENERATED_DIR       ${CMAKE_BINARY_DIR}/generated

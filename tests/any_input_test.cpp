@@ -8,7 +8,7 @@
 
 #include "support/mesh_checks.h"
 #include "support/shapes.h"
-#include "winding.h"
+#include "geometry/winding.h"
 
 namespace pic {
 namespace {

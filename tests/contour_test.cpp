@@ -9,7 +9,7 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
-#include "contour.h"
+#include "contour/dual_walk.h"
 #include "support/mesh_checks.h"
 #include "support/shapes.h"
 

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "geometry.h"
+#include "geometry/lattice.h"
 
 namespace pic::detail {
 namespace {

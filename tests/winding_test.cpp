@@ -4,9 +4,9 @@
 #include <numbers>
 #include <random>
 
-#include "mesh_repair.h"
+#include "mesh/clean.h"
 #include "support/shapes.h"
-#include "winding.h"
+#include "geometry/winding.h"
 
 namespace pic {
 namespace {

@@ -1,0 +1,276 @@
+// Splitting a closed mesh into sheets where it touches itself: an edge with four triangles
+// (two sheets along a line) or a vertex with two fans (two sheets at a point) gets one copy
+// of its vertices per sheet. Dual contouring with one vertex per cell leaves such spots where
+// a feature is finer than a coarse neighbour; the split mesh is 2-manifold with coincident
+// vertices there, which is what mesh tools downstream (slicers, mesh booleans) accept.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+#include <vector>
+
+#include "pic/pic.h"
+#include "geometry/box_tree.h"
+#include "geometry/predicates.h"
+#include "geometry/union_find.h"
+#include "geometry/vec3.h"
+
+namespace pic {
+namespace {
+
+using detail::UnionFind;
+constexpr auto sub = detail::sub3;
+constexpr auto cross = detail::cross3;
+constexpr auto dot = detail::dot3;
+
+/// Half-edges (3 t + k: from corner k to corner k+1 of triangle t) around one edge, ordered
+/// by angle about it, paired so that each pair bounds one wedge of the solid (`solids_apart`:
+/// the solids on either side touch along the edge but stay apart) or one wedge of the outside
+/// (the solid is pinched along the edge).
+std::vector<std::pair<uint32_t, uint32_t>> pair_around_edge(const TriMesh& m, uint32_t u, uint32_t v,
+                                                            const std::vector<uint32_t>& hs, bool solids_apart) {
+  const Vec3 e0 = sub(m.positions[v], m.positions[u]);
+  const double len = std::sqrt(dot(e0, e0));
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;
+  if (len == 0) return pairs;
+  const Vec3 e{e0[0] / len, e0[1] / len, e0[2] / len};
+  // A unit vector perpendicular to e, and the third axis of a right-handed frame.
+  const Vec3 helper = std::abs(e[0]) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  Vec3 b1 = cross(e, helper);
+  const double l1 = std::sqrt(dot(b1, b1));
+  b1 = {b1[0] / l1, b1[1] / l1, b1[2] / l1};
+  const Vec3 b2 = cross(e, b1);
+  struct Ray {
+    uint32_t h;
+    double angle;
+    bool solid_ccw;  // the solid lies on the counter-clockwise side of this triangle
+  };
+  std::vector<Ray> rays;
+  for (uint32_t h : hs) {
+    const auto& t = m.triangles[h / 3];
+    uint32_t w = t[0];
+    for (uint32_t x : t)
+      if (x != u && x != v) w = x;
+    const Vec3 r = sub(m.positions[w], m.positions[u]);
+    const double x = dot(r, b1), y = dot(r, b2);
+    const Vec3 n = cross(sub(m.positions[t[1]], m.positions[t[0]]), sub(m.positions[t[2]], m.positions[t[0]]));
+    const double nx = dot(n, b1), ny = dot(n, b2);
+    // Counter-clockwise of the ray (x, y) is (-y, x); the outward normal points away from the solid.
+    rays.push_back({h, std::atan2(y, x), (-y * nx + x * ny) < 0});
+  }
+  std::sort(rays.begin(), rays.end(), [](const Ray& a, const Ray& b) { return a.angle < b.angle || (a.angle == b.angle && a.h < b.h); });
+  const size_t n = rays.size();
+  size_t start = 0;
+  while (start < n && rays[start].solid_ccw != solids_apart) ++start;
+  if (start == n) return pairs;
+  for (size_t k = 0; k + 1 < n; k += 2) pairs.push_back({rays[(start + k) % n].h, rays[(start + k + 1) % n].h});
+  return pairs;
+}
+
+size_t split_sheets(TriMesh& m, bool solids_apart) {
+  const auto nt = static_cast<uint32_t>(m.triangles.size());
+  // Half-edges grouped by undirected edge.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(size_t(nt) * 3);
+  for (uint32_t t = 0; t < nt; ++t)
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
+      edges.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), 3 * t + k});
+    }
+  std::sort(edges.begin(), edges.end());
+  // Corners (3 t + k) of one vertex join when their triangles are paired across an edge there.
+  UnionFind fans(size_t(nt) * 3);
+  auto corner_of = [&](uint32_t t, uint32_t vertex) {
+    for (uint32_t k = 0; k < 3; ++k)
+      if (m.triangles[t][k] == vertex) return 3 * t + k;
+    return 3 * t;
+  };
+  auto join = [&](uint32_t h1, uint32_t h2, uint32_t u, uint32_t v) {
+    fans.join(corner_of(h1 / 3, u), corner_of(h2 / 3, u));
+    fans.join(corner_of(h1 / 3, v), corner_of(h2 / 3, v));
+  };
+  std::vector<uint32_t> group;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    group.clear();
+    while (j < edges.size() && edges[j].first == edges[i].first) group.push_back(edges[j++].second);
+    const auto u = uint32_t(edges[i].first >> 32), v = uint32_t(edges[i].first & 0xffffffffu);
+    if (group.size() == 2) {
+      join(group[0], group[1], u, v);
+    } else if (group.size() > 2) {
+      for (const auto& [h1, h2] : pair_around_edge(m, u, v, group, solids_apart)) join(h1, h2, u, v);
+    }
+    i = j;
+  }
+  // One vertex per fan: the first fan (in corner order) keeps the index, the others get copies.
+  std::vector<uint32_t> first_root(m.positions.size(), UINT32_MAX);
+  std::unordered_map<uint32_t, uint32_t> copy_of_fan;  // fan root -> its new vertex
+  size_t added = 0;
+  for (uint32_t c = 0; c < 3 * nt; ++c) {
+    const uint32_t v = m.triangles[c / 3][c % 3];
+    const auto r = static_cast<uint32_t>(fans.root(c));
+    if (first_root[v] == UINT32_MAX) first_root[v] = r;
+    if (first_root[v] == r) continue;
+    auto [it, fresh] = copy_of_fan.try_emplace(r, static_cast<uint32_t>(m.positions.size()));
+    if (fresh) {
+      const Vec3 p = m.positions[v];
+      m.positions.push_back(p);
+      ++added;
+    }
+    m.triangles[c / 3][c % 3] = it->second;
+  }
+  return added;
+}
+
+/// Drops pairs of triangles on the same three vertices with opposite orientations: a pocket of
+/// no volume, which puts four triangles on each of its edges.
+void drop_flat_pockets(TriMesh& m) {
+  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> keyed;  // rotation starting at the smallest index
+  keyed.reserve(m.triangles.size());
+  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+    auto tri = m.triangles[t];
+    while (tri[0] > tri[1] || tri[0] > tri[2]) tri = {tri[1], tri[2], tri[0]};
+    keyed.push_back({tri, t});
+  }
+  auto same_set = [](const std::array<uint32_t, 3>& a, const std::array<uint32_t, 3>& b) {
+    return a[0] == b[0] && ((a[1] == b[1] && a[2] == b[2]) || (a[1] == b[2] && a[2] == b[1]));
+  };
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    const auto ka = std::array<uint32_t, 3>{a.first[0], std::min(a.first[1], a.first[2]), std::max(a.first[1], a.first[2])};
+    const auto kb = std::array<uint32_t, 3>{b.first[0], std::min(b.first[1], b.first[2]), std::max(b.first[1], b.first[2])};
+    return ka != kb ? ka < kb : a.second < b.second;
+  });
+  std::vector<char> drop(m.triangles.size(), 0);
+  for (size_t i = 0; i + 1 < keyed.size(); ++i) {
+    const auto& a = keyed[i].first;
+    const auto& b = keyed[i + 1].first;
+    if (same_set(a, b) && a[1] == b[2] && !drop[keyed[i].second] && !drop[keyed[i + 1].second]) {
+      drop[keyed[i].second] = drop[keyed[i + 1].second] = 1;
+      ++i;
+    }
+  }
+  size_t k = 0;
+  for (size_t t = 0; t < m.triangles.size(); ++t)
+    if (!drop[t]) m.triangles[k++] = m.triangles[t];
+  m.triangles.resize(k);
+}
+
+/// Moves the copies of each split vertex apart, each into its own fan: toward the mean of its
+/// ring by the least of 1/1024, 1/256, 1/64, 1/16 of the way for which no triangle around a
+/// moved copy crosses another (the exact test, CGAL's rules). Coincident copies are one vertex
+/// to a reader that merges equal positions (meshcheck, CGAL's soup loader): to it the sheets
+/// would still touch at a pinched vertex or edge. Copies no step separates cleanly stay put.
+void separate_copies(TriMesh& m) {
+  const auto nv = static_cast<uint32_t>(m.positions.size());
+  std::vector<uint32_t> order(nv);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return m.positions[a] < m.positions[b] || (m.positions[a] == m.positions[b] && a < b);
+  });
+  std::vector<uint32_t> moving;  // vertices sharing their position with another
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i + 1;
+    while (j < order.size() && m.positions[order[j]] == m.positions[order[i]]) ++j;
+    if (j - i > 1) moving.insert(moving.end(), order.begin() + ptrdiff_t(i), order.begin() + ptrdiff_t(j));
+    i = j;
+  }
+  if (moving.empty()) return;
+  std::vector<int32_t> slot(nv, -1);
+  for (size_t k = 0; k < moving.size(); ++k) slot[moving[k]] = int32_t(k);
+  // Each moving vertex's ring mean, and the triangles around the moving vertices.
+  std::vector<Vec3> ring(moving.size(), Vec3{0, 0, 0});
+  std::vector<double> count(moving.size(), 0);
+  std::vector<uint32_t> touched;
+  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+    bool hit = false;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t s = slot[m.triangles[t][k]];
+      if (s < 0) continue;
+      hit = true;
+      for (int j = 1; j < 3; ++j) {
+        const Vec3& q = m.positions[m.triangles[t][(k + j) % 3]];
+        for (int a = 0; a < 3; ++a) ring[size_t(s)][a] += q[a];
+        count[size_t(s)] += 1;
+      }
+    }
+    if (hit) touched.push_back(t);
+  }
+  const std::vector<Vec3> home = m.positions;
+  std::vector<Vec3> dir(moving.size());
+  for (size_t k = 0; k < moving.size(); ++k)
+    for (int a = 0; a < 3; ++a) dir[k][a] = count[k] > 0 ? ring[k][a] / count[k] - home[moving[k]][a] : 0.0;
+  constexpr std::array<double, 4> kSteps{1.0 / 1024, 1.0 / 256, 1.0 / 64, 1.0 / 16};
+  // Triangle boxes cover every step (a copy moves along a segment from its home).
+  std::vector<detail::Box> boxes(m.triangles.size());
+  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+    detail::Box b{m.positions[m.triangles[t][0]], m.positions[m.triangles[t][0]]};
+    for (uint32_t v : m.triangles[t]) {
+      Vec3 far = home[v];
+      if (slot[v] >= 0)
+        for (int a = 0; a < 3; ++a) far[a] += kSteps.back() * dir[size_t(slot[v])][a];
+      for (const Vec3& q : {home[v], far})
+        for (int a = 0; a < 3; ++a) {
+          b.lo[a] = std::min(b.lo[a], q[a]);
+          b.hi[a] = std::max(b.hi[a], q[a]);
+        }
+    }
+    boxes[t] = b;
+  }
+  const detail::BoxTree tree(boxes);
+  // Vertices (by slot) still to place; a step is applied to all of them at once, then every
+  // vertex with a triangle in a crossing goes on to the next step.
+  std::vector<uint8_t> open(moving.size(), 1);
+  for (double step : kSteps) {
+    for (size_t k = 0; k < moving.size(); ++k)
+      if (open[k])
+        for (int a = 0; a < 3; ++a) m.positions[moving[k]][a] = home[moving[k]][a] + step * dir[k][a];
+    std::vector<uint8_t> crossed(moving.size(), 0);
+    for (uint32_t t : touched) {
+      const auto& ta = m.triangles[t];
+      if (detail::projection_axis(m.positions[ta[0]], m.positions[ta[1]], m.positions[ta[2]]) < 0) {
+        for (uint32_t v : ta)
+          if (slot[v] >= 0) crossed[size_t(slot[v])] = 1;
+        continue;
+      }
+      tree.query(boxes[t], [&](uint32_t u) {
+        if (u == t) return;
+        const auto& tb = m.triangles[u];
+        if (!detail::triangles_intersect(m.positions, ta, tb)) return;
+        for (const auto* tri : {&ta, &tb})
+          for (uint32_t v : *tri)
+            if (slot[v] >= 0) crossed[size_t(slot[v])] = 1;
+      });
+    }
+    bool any = false;
+    for (size_t k = 0; k < moving.size(); ++k) {
+      open[k] = crossed[k];
+      any = any || crossed[k];
+    }
+    if (!any) return;
+  }
+  for (size_t k = 0; k < moving.size(); ++k)
+    if (open[k]) m.positions[moving[k]] = home[moving[k]];
+}
+
+}  // namespace
+
+size_t split_nonmanifold(TriMesh& m) {
+  if (analyze_topology(m).manifold()) return 0;
+  TriMesh base = m;
+  drop_flat_pockets(base);
+  // The two pairings around a crowded edge are both manifold there; which one also gives
+  // consistent fans at its end vertices depends on the neighbourhood, so try both.
+  for (const bool solids_apart : {true, false}) {
+    TriMesh c = base;
+    const size_t added = split_sheets(c, solids_apart);
+    if (analyze_topology(c).manifold()) {
+      separate_copies(c);
+      m = std::move(c);
+      return added;
+    }
+  }
+  return 0;
+}
+
+}  // namespace pic

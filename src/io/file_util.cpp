@@ -1,0 +1,63 @@
+#include "io/file_util.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <string>
+
+#include "pic/pic.h"
+
+namespace pic::detail {
+
+std::filesystem::path temp_path_for(const std::filesystem::path& path) {
+  static std::atomic<int> counter{0};
+  auto tmp = path;
+  tmp.replace_filename("." + path.stem().string() + ".tmp" + std::to_string(::getpid()) + "-" +
+                       std::to_string(counter++) + path.extension().string());
+  return tmp;
+}
+
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path&)>& write) {
+  const auto tmp = temp_path_for(path);
+  try {
+    write(tmp);
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) throw IoError("cannot write " + path.string() + ": " + ec.message());
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+}
+
+std::vector<uint8_t> read_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw IoError("cannot read " + path.string() + ": no such file");
+  if (std::filesystem::is_directory(path, ec)) throw IoError("cannot read " + path.string() + ": is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot read " + path.string() + ": permission denied or unreadable");
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError("cannot read " + path.string());
+  return bytes;
+}
+
+void write_bytes(const std::filesystem::path& path, const std::vector<uint8_t>& bytes) {
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError("cannot write " + path.string() + ": cannot create file");
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw IoError("cannot write " + path.string() + ": write failed (disk full?)");
+  });
+}
+
+}  // namespace pic::detail
+
+namespace pic {
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  detail::write_bytes(path, std::vector<uint8_t>(text.begin(), text.end()));
+}
+}  // namespace pic

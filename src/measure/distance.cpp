@@ -1,0 +1,214 @@
+// Distances between surfaces, for `pic compare`, tests and benchmarks: exact point-to-triangle
+// distances over a median-split BVH, sampled at every vertex plus area-weighted points.
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "geometry/lattice.h"
+#include "geometry/vec3.h"
+#include "pic/pic.h"
+
+namespace pic {
+namespace {
+
+Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+Vec3 mul3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+using detail::cross3;
+using detail::dot3;
+using detail::norm3;
+using detail::sub3;
+
+double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return std::sqrt(detail::point_triangle_distance2(p, a, b, c));
+}
+
+/// Exact unsigned distance from points to a triangle mesh, accelerated by a median-split BVH.
+class MeshDistance {
+ public:
+  explicit MeshDistance(const TriMesh& mesh) : mesh_(mesh) {
+    const size_t n = mesh.triangles.size();
+    order_.resize(n);
+    std::iota(order_.begin(), order_.end(), uint32_t{0});
+    lo_.resize(n);
+    hi_.resize(n);
+    centre_.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const auto& t = mesh.triangles[i];
+      for (int k = 0; k < 3; ++k) {
+        lo_[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+        hi_[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+        centre_[i][k] = (lo_[i][k] + hi_[i][k]) / 2;
+      }
+    }
+    if (n > 0) {
+      nodes_.emplace_back();
+      build(0, 0, static_cast<uint32_t>(n));
+    }
+  }
+
+  double distance(const Vec3& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    if (nodes_.empty()) return best;
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const BNode& nd = nodes_[stack[--top]];
+      if (box_distance(nd, p) >= best) continue;
+      if (nd.count > 0) {
+        for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) {
+          const auto& t = mesh_.triangles[order_[i]];
+          best = std::min(best, point_triangle_distance(p, mesh_.positions[t[0]], mesh_.positions[t[1]],
+                                                        mesh_.positions[t[2]]));
+        }
+        continue;
+      }
+      const BNode &l = nodes_[nd.left], &r = nodes_[nd.left + 1];
+      const double dl = box_distance(l, p), dr = box_distance(r, p);
+      // Push the farther first so the nearer is explored first.
+      if (dl < dr) {
+        if (dr < best) stack[top++] = nd.left + 1;
+        if (dl < best) stack[top++] = nd.left;
+      } else {
+        if (dl < best) stack[top++] = nd.left;
+        if (dr < best) stack[top++] = nd.left + 1;
+      }
+    }
+    return best;
+  }
+
+ private:
+  struct BNode {
+    Vec3 lo, hi;
+    uint32_t left = 0;   // internal: children at left, left + 1
+    uint32_t first = 0;  // leaf: range in order_
+    uint32_t count = 0;  // 0 = internal
+  };
+
+  static double box_distance(const BNode& nd, const Vec3& p) {
+    double s = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max({nd.lo[k] - p[k], 0.0, p[k] - nd.hi[k]});
+      s += d * d;
+    }
+    return std::sqrt(s);
+  }
+
+  // Builds the subtree of order_[first, last) into nodes_[id]; children are consecutive.
+  void build(uint32_t id, uint32_t first, uint32_t last) {
+    BNode nd;
+    nd.lo = {1e300, 1e300, 1e300};
+    nd.hi = {-1e300, -1e300, -1e300};
+    for (uint32_t i = first; i < last; ++i)
+      for (int k = 0; k < 3; ++k) {
+        nd.lo[k] = std::min(nd.lo[k], lo_[order_[i]][k]);
+        nd.hi[k] = std::max(nd.hi[k], hi_[order_[i]][k]);
+      }
+    if (last - first <= 4) {
+      nd.first = first;
+      nd.count = last - first;
+      nodes_[id] = nd;
+      return;
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (nd.hi[k] - nd.lo[k] > nd.hi[axis] - nd.lo[axis]) axis = k;
+    const uint32_t mid = first + (last - first) / 2;
+    std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + last,
+                     [&](uint32_t a, uint32_t b) { return centre_[a][axis] < centre_[b][axis]; });
+    nd.left = static_cast<uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    nodes_[id] = nd;
+    build(nd.left, first, mid);
+    build(nd.left + 1, mid, last);
+  }
+
+  const TriMesh& mesh_;
+  std::vector<uint32_t> order_;
+  std::vector<Vec3> lo_, hi_, centre_;
+  std::vector<BNode> nodes_;
+};
+
+/// Deterministic 64-bit generator (SplitMix64) with a portable double in [0, 1).
+class Rng {
+ public:
+  explicit Rng(uint64_t seed) : s_(seed) {}
+  uint64_t next() {
+    uint64_t z = (s_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
+
+ private:
+  uint64_t s_;
+};
+
+/// All vertices plus `samples` area-weighted random points on the surface (deterministic).
+std::vector<Vec3> surface_points(const TriMesh& m, size_t samples, uint64_t seed = 12345) {
+  std::vector<Vec3> pts = m.positions;
+  std::vector<double> cum(m.triangles.size());
+  double total = 0;
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    const auto& t = m.triangles[i];
+    total += norm3(cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]))) / 2;
+    cum[i] = total;
+  }
+  if (!(total > 0)) return pts;
+  Rng rng(seed);
+  for (size_t s = 0; s < samples; ++s) {
+    const double x = rng.uniform() * total;
+    size_t i = std::upper_bound(cum.begin(), cum.end(), x) - cum.begin();
+    i = std::min(i, cum.size() - 1);
+    const auto& t = m.triangles[i];
+    double u = rng.uniform(), v = rng.uniform();
+    if (u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+    pts.push_back(add3(a, add3(mul3(sub3(b, a), u), mul3(sub3(c, a), v))));
+  }
+  return pts;
+}
+
+}  // namespace
+
+std::vector<Vec3> sample_surface(const TriMesh& mesh, size_t samples, uint64_t seed) {
+  return surface_points(mesh, samples, seed);
+}
+
+std::vector<double> distance_to_mesh(const TriMesh& mesh, const std::vector<Vec3>& points) {
+  const MeshDistance d(mesh);
+  std::vector<double> out(points.size());
+  tbb::parallel_for(size_t{0}, points.size(), size_t{4096}, [&](size_t begin) {
+    const size_t end = std::min(points.size(), begin + 4096);
+    for (size_t i = begin; i < end; ++i) out[i] = d.distance(points[i]);
+  });
+  return out;
+}
+
+SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples) {
+  SurfaceDistance r;
+  auto side = [&](const TriMesh& from, const TriMesh& to, double& worst, double& mean) {
+    const auto d = distance_to_mesh(to, sample_surface(from, samples, 12345));
+    worst = 0;
+    mean = 0;
+    for (double x : d) {
+      worst = std::max(worst, x);
+      mean += x;
+    }
+    mean = d.empty() ? 0 : mean / double(d.size());
+  };
+  side(a, b, r.a_to_b, r.mean_a_to_b);
+  side(b, a, r.b_to_a, r.mean_b_to_a);
+  r.hausdorff = std::max(r.a_to_b, r.b_to_a);
+  return r;
+}
+
+}  // namespace pic

@@ -1,0 +1,111 @@
+// Inside/outside for inputs that are not clean closed meshes (docs/algorithms.md, "Any input").
+//
+// Triangle soups: the generalized winding number w of the input M is split as
+//   w_M(p) = w_{M+C}(p) - w_C(p),
+// where C is a set of cones closing M's boundary chain. M + C has no boundary, so w_{M+C} is an
+// integer that the sampler carries from corner to corner by signed crossing counts — exact, with
+// the same predicates and tie-break as crossing parity. Only w_C, the few cone triangles, is a
+// real number; a dipole tree evaluates it, exactly where the decision |w| >= 1/2 is close.
+// Every sign is a function of the lattice point alone.
+//
+// Point clouds: w is the points' winding number (each point a disc of its neighbours' spacing),
+// evaluated per lattice point with the same tree.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "geometry/box_tree.h"
+#include "geometry/bvh.h"
+#include "sample/sampler.h"
+#include "geometry/winding.h"
+
+namespace pic::detail {
+
+/// Remembers recent inside/outside decisions of one source per thread: a lattice point is
+/// asked for by up to 4 cells of a level (shared faces and edges) and by their children, and
+/// a decision near a hole costs hundreds of solid angles. Direct mapped, no locks.
+class DecisionCache {
+ public:
+  DecisionCache();
+  /// The cached decision at p (-1: none).
+  int find(const I3& p) const;
+  void store(const I3& p, bool inside) const;
+  /// Tells this source's entries in per-thread memos from those of other sources.
+  uint32_t id() const { return id_; }
+
+ private:
+  uint32_t id_;  // tells this source's entries from an earlier source's in the same thread
+};
+
+class WindingSource : public SurfaceSource {
+ public:
+  /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it;
+  /// `boundary`: the input's boundary edges; `cap_boxes`: a box around each boundary loop
+  /// (unit space), outside which the caps' solid angle is taken to be below 1/2.
+  WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary,
+                std::vector<Box> cap_boxes);
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
+                        Wind27* wind) const override;
+  bool tracks_winding() const override { return true; }
+  bool surface_matters(const Cell& cell, uint8_t signs, const Wind8* wind,
+                       const std::vector<uint32_t>& idx) const override;
+  void add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind, const std::vector<uint32_t>& idx,
+                       Qef& q) const override;
+
+  /// Integer winding number of input + cones at a grid point (a ray to the cube's boundary).
+  int32_t ray_winding(const I3& p) const;
+  /// Integer winding number at grid point b, given w at a nearby point a (after ray_winding).
+  int32_t winding_from(const I3& a, int32_t w, const I3& b) const;
+  /// The sign at grid point p whose integer winding number is w.
+  bool inside(const I3& p, int32_t w) const;
+  /// Integer winding number at grid point p of `cell` (corner windings `wind`), by a path
+  /// along the cell's edges directions from its first corner.
+  int32_t winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx, const I3& p) const;
+  /// Uniform cells that input triangles meet without showing a sign change on them (interior
+  /// walls, flaps): a sign change elsewhere in such a cell goes unseen, so finer neighbours
+  /// can show islands and cracks there. Thread-safe; in no particular order.
+  std::vector<Cell> skipped_cells() const;
+  /// Marks input triangles with the solid on both sides or on neither (interior walls of
+  /// overlapping shells, stray sheets) as playing no part in the surface. Returns how many.
+  size_t drop_interior_triangles();
+
+ private:
+  /// Whether `box` (unit space) meets a boundary loop's box: only there do the caps decide.
+  bool near_caps(const Box& box) const;
+
+  std::vector<ITri> all_;
+  size_t mesh_count_;
+  bool dropped_any_ = false;  // drop_interior_triangles took some out of the surface
+  mutable TriangleBvh bvh_;  // built on the first ray
+  mutable std::once_flag bvh_built_;
+  DipoleTree caps_;
+  BoxTree cap_boxes_;
+  std::vector<std::array<Vec3, 2>> boundary_;  // unit space
+  DecisionCache cache_;
+  mutable std::mutex skipped_mutex_;
+  mutable std::vector<Cell> skipped_;
+};
+
+class PointSource : public SurfaceSource {
+ public:
+  /// Points and normals in unit space (root cube [0,1]^3).
+  PointSource(const std::vector<Vec3>& pos, const std::vector<Vec3>& normals);
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
+                        Wind27* wind) const override;
+  void add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind, const std::vector<uint32_t>& idx,
+                       Qef& q) const override;
+  bool inside(const I3& p) const;
+  /// Median distance from a point to its 8th nearest neighbour (unit space): the scale below
+  /// which the cloud says nothing about the surface.
+  double spacing() const { return spacing_; }
+
+ private:
+  double spacing_ = 0;
+  std::vector<ITri> prims_;  // per point: a splat (QEF) and a tiny marker (meets)
+  DipoleTree tree_;
+  DecisionCache cache_;
+};
+
+}  // namespace pic::detail

@@ -1,0 +1,748 @@
+#include "signs/passes.h"
+
+#include "contour/dual_walk.h"
+#include "sample/sampler.h"
+#include "geometry/union_find.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+namespace pic::detail {
+namespace {
+
+using Lat = std::array<int64_t, 3>;
+
+/// The node covering cell `target`, or the leaf above it; `path` gets the nodes from the
+/// root down to it.
+LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path = nullptr) {
+  uint32_t node = 0;
+  Cell cell;
+  while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
+    if (path) path->push_back(node);
+    const int64_t h = cell.span() / 2;
+    int c = 0;
+    for (int k = 0; k < 3; ++k)
+      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
+    node = t.nodes[node].index + c;
+    cell = cell.child(c);
+  }
+  if (path) path->push_back(node);
+  return {node, cell};
+}
+
+/// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
+/// in depth-first order.
+void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                     int max_level, std::vector<LeafRef>& out) {
+  if (cell.level > max_level) return;
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  const Node& n = t.nodes[node];
+  if (n.kind != CellKind::Internal) {
+    out.push_back({node, cell});
+    return;
+  }
+  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
+}
+
+/// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
+/// false when it falls outside the root.
+bool octant_cell(const Lat& p, int o, Lat& q) {
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
+    if (q[k] < 0 || q[k] >= kLimit) return false;
+  }
+  return true;
+}
+
+/// Leaves having lattice point p as a corner, with the corner index in each; `path` gets
+/// every node on the way down to them.
+struct Around {
+  uint32_t node;
+  int corner;
+  Cell cell;
+};
+std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr) {
+  std::vector<Around> out;
+  for (int o = 0; o < 8; ++o) {
+    Lat q;
+    if (!octant_cell(p, o, q)) continue;
+    const LeafRef l = leaf_at(t, q, path);
+    const int c = l.cell.corner_index(p);
+    if (c < 0) continue;
+    bool seen = false;
+    for (const auto& a : out) seen = seen || a.node == l.node;
+    if (!seen) out.push_back({l.node, c, l.cell});
+  }
+  return out;
+}
+
+/// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
+/// one when null), depth first.
+template <class F>
+void for_each_gray_leaf(const Octree& t, const std::function<bool(uint32_t)>* active, F&& f) {
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray) {
+      f(node, cell);
+    }
+  };
+  walk(walk, 0, Cell{});
+}
+
+}  // namespace
+
+uint8_t signs_of(const Node& n) {
+  if (n.kind == CellKind::Gray) return n.signs;
+  return n.kind == CellKind::Black ? 0xff : 0;
+}
+
+bool multi_component(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
+
+void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
+  Node& n = t.nodes[node];
+  if (n.kind == CellKind::Gray) {
+    n.signs ^= uint8_t(1 << c);
+    return;
+  }
+  const uint8_t s = uint8_t(signs_of(n) ^ (1 << c));
+  n = add_gray(t.vertices, cell, s, cell_vertex(Qef{}, cell, s).position);
+}
+
+LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path) {
+  return node_at(t, Cell{kMaxLevel, q}, path);
+}
+
+std::optional<bool> point_sign(const Octree& t, const Lat& p) {
+  for (int o = 0; o < 8; ++o) {
+    Lat q;
+    if (!octant_cell(p, o, q)) continue;
+    const LeafRef l = leaf_at(t, q);
+    if (const int c = l.cell.corner_index(p); c >= 0) return bool((signs_of(t.nodes[l.node]) >> c) & 1);
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+/// Flips lattice point p's sign in every leaf that has it as a corner (consistently), and
+/// reports the nodes on the way to them.
+void flip_point(Octree& t, const Lat& p, const std::function<void(uint32_t)>* touched) {
+  std::vector<uint32_t> path;
+  for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
+  if (touched)
+    for (uint32_t x : path) (*touched)(x);
+}
+
+/// Whether lattice point p, of sign sp, on the boundary of gray leaf `big` (not one of its
+/// corners) disagrees with all of big's corners on the smallest face or edge through it.
+bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
+  const int64_t sz = cell.span();
+  bool all_differ = true;
+  int seen = 0;
+  for (int c = 0; c < 8; ++c) {
+    bool on = true;
+    for (int a = 0; a < 3; ++a) {
+      const bool at_lo = p[a] == cell.lat[a], at_hi = p[a] == cell.lat[a] + sz;
+      if (at_lo && ((c >> a) & 1)) on = false;
+      if (at_hi && !((c >> a) & 1)) on = false;
+    }
+    if (!on) continue;
+    ++seen;
+    all_differ = all_differ && (((big.signs >> c) & 1) != 0) != sp;
+  }
+  return seen > 0 && seen < 8 && all_differ;
+}
+
+}  // namespace
+
+namespace {
+
+/// A leaf with the nodes from the root down to it (path[l] = its ancestor at level l), so
+/// that searches around it can start from a near ancestor instead of the root.
+struct PathLeaf {
+  uint32_t node;
+  Cell cell;
+  size_t path;  // offset of the ancestors in IslandSearch::paths
+};
+
+struct IslandSearch {
+  const Octree& t;
+  std::vector<PathLeaf> leaves;
+  std::vector<uint32_t> paths;
+
+  /// The ancestor of `l` at `level`, with its cell.
+  LeafRef ancestor(const PathLeaf& l, int level) const {
+    Cell c{level, l.cell.lat};
+    const int64_t span = c.span();
+    for (auto& x : c.lat) x -= x % span;
+    return {paths[l.path + size_t(level)], c};
+  }
+  /// The deepest ancestor of `l` whose cell holds the closed box [lo, hi] away from its
+  /// boundary (`strict`) or anywhere inside it: every leaf meeting the box is below it.
+  LeafRef start_for(const PathLeaf& l, const Lat& lo, const Lat& hi, bool strict) const {
+    for (int level = l.cell.level; level > 0; --level) {
+      const LeafRef a = ancestor(l, level);
+      const int64_t s = a.cell.span();
+      bool inside = true;
+      for (int k = 0; k < 3 && inside; ++k)
+        inside = strict ? (a.cell.lat[k] < lo[k] && hi[k] < a.cell.lat[k] + s)
+                        : (a.cell.lat[k] <= lo[k] && hi[k] <= a.cell.lat[k] + s);
+      if (inside) return a;
+    }
+    return {0, Cell{}};
+  }
+  /// The node covering `target` (or the leaf above it), searched from `from`.
+  LeafRef node_below(LeafRef from, const Cell& target) const {
+    while (from.cell.level < target.level && t.nodes[from.node].kind == CellKind::Internal) {
+      const int64_t h = from.cell.span() / 2;
+      int c = 0;
+      for (int k = 0; k < 3; ++k)
+        if (target.lat[k] >= from.cell.lat[k] + h) c |= 1 << k;
+      from = {t.nodes[from.node].index + c, from.cell.child(c)};
+    }
+    return from;
+  }
+
+  void collect(uint32_t node, const Cell& cell, const std::function<bool(uint32_t)>* active,
+               std::vector<uint32_t>& path) {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    path.push_back(node);
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c), active, path);
+    } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 5) {
+      // Islands are features near the finest cell size, next to leaves up to 5 levels up (the
+      // teapot had one on a leaf 5 levels up; coarser faces cost more than they find).
+      leaves.push_back({node, cell, paths.size()});
+      paths.insert(paths.end(), path.begin(), path.end());
+    }
+    path.pop_back();
+  }
+};
+
+}  // namespace
+
+namespace {
+
+/// The face's plane, its in-face axes u and v, and its rectangle [lo, hi] (lo[d] = hi[d] =
+/// plane); points on it are keyed by their in-face coordinates.
+struct FaceFrame {
+  int d, side, u, v;
+  Lat lo, hi;
+  uint8_t signs;  // the coarse leaf's corner signs
+
+  FaceFrame(const LeafRef& big, int f, uint8_t leaf_signs)
+      : d(f / 2), side(f % 2), u(d == 0 ? 1 : 0), v(d == 2 ? 1 : 2), lo(big.cell.lat), hi(big.cell.corner(7)),
+        signs(leaf_signs) {
+    lo[d] = hi[d] = big.cell.lat[d] + side * big.cell.span();
+  }
+  uint64_t key(const Lat& q) const { return uint64_t(q[u]) << 32 | uint64_t(q[v]); }
+  Lat lat_of(uint64_t k) const {
+    Lat q;
+    q[d] = lo[d];
+    q[u] = int64_t(k >> 32);
+    q[v] = int64_t(k & 0xffffffffu);
+    return q;
+  }
+  /// The coarse leaf's sign at the face's corner (cu, cv).
+  bool corner_sign(int cu, int cv) const { return ((signs >> ((side << d) | (cu << u) | (cv << v))) & 1) != 0; }
+};
+
+/// Buffers face_flips reuses from face to face.
+struct FaceScratch {
+  std::vector<LeafRef> leaves;
+  std::vector<std::pair<uint64_t, bool>> pts;  // sorted by key
+  std::vector<std::pair<uint64_t, uint64_t>> links;
+  std::vector<size_t> run;
+  std::vector<char> flipped, anchored;
+  UnionFind regions{0};
+  std::vector<Lat> flips;
+
+  size_t index_of(uint64_t k) const {
+    return size_t(std::lower_bound(pts.begin(), pts.end(), std::pair{k, false}) - pts.begin());
+  }
+};
+
+/// The points the finer leaves across the face show on it, with their signs, and links along
+/// the edges of those leaves' faces (which join a region once the edge pass has set signs).
+/// False when the node across the face is not subdivided (nothing finer to see).
+bool collect_face_points(const Octree& t, const LeafRef& big, const FaceFrame& fr, FaceScratch& s) {
+  const int d = fr.d, u = fr.u, v = fr.v;
+  const int64_t span = big.cell.span();
+  Cell across = big.cell;
+  across.lat[d] += fr.side ? span : -span;
+  if (across.lat[d] < 0 || across.lat[d] >= (int64_t{1} << kMaxLevel)) return false;
+  const LeafRef n = node_at(t, across);
+  if (n.cell.level < across.level || t.nodes[n.node].kind != CellKind::Internal) return false;
+  s.leaves.clear();
+  leaves_touching(t, n.node, n.cell, fr.lo, fr.hi, kMaxLevel, s.leaves);
+  s.pts.clear();
+  s.links.clear();
+  for (const LeafRef& l : s.leaves) {
+    if (l.cell.level <= big.cell.level) continue;
+    // On the far side of the plane, with a face inside the rectangle.
+    const int64_t ls = l.cell.span();
+    const int touching = fr.side ? 0 : 1;  // which of its own sides lies on the plane
+    if (l.cell.lat[d] + touching * ls != fr.lo[d]) continue;
+    if (l.cell.lat[u] < fr.lo[u] || l.cell.lat[u] + ls > fr.hi[u] || l.cell.lat[v] < fr.lo[v] ||
+        l.cell.lat[v] + ls > fr.hi[v])
+      continue;
+    const uint8_t sg = signs_of(t.nodes[l.node]);
+    std::array<std::pair<uint64_t, bool>, 4> c4;
+    for (int k = 0; k < 4; ++k) {
+      const int c = (touching << d) | ((k & 1) << u) | ((k >> 1) << v);
+      c4[k] = {fr.key(l.cell.corner(c)), ((sg >> c) & 1) != 0};
+      s.pts.push_back(c4[k]);
+    }
+    for (const auto& [a, b] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
+      s.links.push_back({c4[a].first, c4[b].first});
+  }
+  std::sort(s.pts.begin(), s.pts.end());
+  s.pts.erase(std::unique(s.pts.begin(), s.pts.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+              s.pts.end());
+  return !s.pts.empty();
+}
+
+/// Along each edge of the face, the points in order between the coarse leaf's two corners
+/// take the first corner's sign before one cut and the second's after it, at the cut needing
+/// the fewest flips (marked in s.flipped).
+void settle_face_edges(const FaceFrame& fr, FaceScratch& s) {
+  auto& pts = s.pts;
+  for (int e = 0; e < 4; ++e) {
+    const int along = e < 2 ? fr.u : fr.v, across = along == fr.u ? fr.v : fr.u;
+    const int64_t fixed = (e & 1) ? fr.hi[across] : fr.lo[across];
+    std::vector<size_t>& run = s.run;
+    run.clear();
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Lat q = fr.lat_of(pts[i].first);
+      if (q[across] == fixed && q[along] > fr.lo[along] && q[along] < fr.hi[along]) run.push_back(i);
+    }
+    if (run.empty()) continue;
+    std::sort(run.begin(), run.end(),
+              [&](size_t x, size_t y) { return fr.lat_of(pts[x].first)[along] < fr.lat_of(pts[y].first)[along]; });
+    const int fa = across == fr.u ? int(e & 1) : 0, fb = across == fr.v ? int(e & 1) : 0;
+    const bool s0 = fr.corner_sign(fa, fb);
+    const bool s1 = fr.corner_sign(along == fr.u ? 1 : fa, along == fr.v ? 1 : fb);
+    size_t best_cut = 0, best = SIZE_MAX, before = 0, after = 0;
+    for (size_t i : run) after += pts[i].second != s1;
+    for (size_t cut = 0; cut <= run.size(); ++cut) {
+      if (before + after < best) {
+        best = before + after;
+        best_cut = cut;
+      }
+      if (cut < run.size()) {
+        before += pts[run[cut]].second != s0;
+        after -= pts[run[cut]].second != s1;
+      }
+    }
+    for (size_t r = 0; r < run.size(); ++r) {
+      const bool want = r < best_cut ? s0 : s1;
+      if (pts[run[r]].second != want) {
+        pts[run[r]].second = want;
+        s.flipped[run[r]] = 1;
+      }
+    }
+  }
+}
+
+/// Regions of one sign on the face (union-find over same-sign links, edge flips applied)
+/// that reach no face corner of their sign are flipped whole (marked in s.flipped).
+void flip_stray_regions(const FaceFrame& fr, FaceScratch& s) {
+  const auto& pts = s.pts;
+  UnionFind& regions = s.regions;
+  regions.reset(pts.size());
+  for (const auto& [a, b] : s.links) {
+    const size_t ia = s.index_of(a), ib = s.index_of(b);
+    if (pts[ia].second == pts[ib].second) regions.join(ia, ib);
+  }
+  std::vector<char>& anchored = s.anchored;
+  anchored.assign(pts.size(), 0);
+  for (int c = 0; c < 4; ++c) {
+    Lat q = fr.lo;
+    if (c & 1) q[fr.u] = fr.hi[fr.u];
+    if (c & 2) q[fr.v] = fr.hi[fr.v];
+    const size_t i = s.index_of(fr.key(q));
+    if (i < pts.size() && pts[i].first == fr.key(q) && pts[i].second == fr.corner_sign(c & 1, c >> 1))
+      anchored[regions.root(i)] = 1;
+  }
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (!anchored[regions.root(i)]) s.flipped[i] ^= 1;
+}
+
+/// Face `f` (axis f / 2, high side if f % 2) of a coarse gray leaf, as the finer leaves
+/// across it see it. Dual contouring gives the coarse leaf one vertex, so what those leaves
+/// show on the face must look like a face of one cell:
+/// - along each edge of the face the sign changes at most once (never when its ends agree),
+///   else the edge gets several dual polygons through the same coarse vertices (a doubled
+///   sheet, non-manifold edges);
+/// - every connected region of one sign on the face reaches a corner of the face with that
+///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
+///   vertex).
+/// Returns the lattice points to flip (as few as possible along edges; whole stray regions
+/// on the face).
+const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
+  s.flips.clear();
+  const FaceFrame fr(big, f, signs_of(t.nodes[big.node]));
+  if (!collect_face_points(t, big, fr, s)) return s.flips;
+  s.flipped.assign(s.pts.size(), 0);
+  settle_face_edges(fr, s);
+  flip_stray_regions(fr, s);
+  for (size_t i = 0; i < s.pts.size(); ++i)
+    if (s.flipped[i]) s.flips.push_back(fr.lat_of(s.pts[i].first));
+  return s.flips;
+}
+
+/// A face of a coarse gray leaf to check with face_flips once the point islands are gone.
+using CoarseFace = std::pair<LeafRef, int>;
+
+/// Faces of `big` that meet the box [lo, hi].
+void faces_meeting(const LeafRef& big, const Lat& lo, const Lat& hi, std::vector<CoarseFace>& faces) {
+  const int64_t s = big.cell.span();
+  for (int f = 0; f < 6; ++f) {
+    const int d = f / 2;
+    const int64_t plane = big.cell.lat[d] + (f % 2) * s;
+    bool meets = lo[d] <= plane && plane <= hi[d];
+    for (int k = 0; k < 3 && meets; ++k)
+      if (k != d) meets = big.cell.lat[k] < hi[k] && lo[k] < big.cell.lat[k] + s;
+    if (meets) faces.push_back({big, f});
+  }
+}
+
+/// A fine active leaf's corners against the coarser gray leaves around them (an old coarse
+/// leaf next to new fine ones): a corner that is an island on one of them is flipped. The
+/// coarse leaves' faces are queued.
+template <class Flip>
+void fine_corners_on_coarse_leaves(const Octree& t, const IslandSearch& search, const PathLeaf& l, Flip&& flip,
+                                   std::vector<LeafRef>& near, std::vector<CoarseFace>& faces) {
+  const Cell& cell = l.cell;
+  // The coarser leaves around its corners (a leaf as fine or finer touching a corner has it
+  // as a corner too): one descent for the cell's closed box, from the nearest ancestor that
+  // holds it.
+  near.clear();
+  const Lat lo = cell.lat, hi = cell.corner(7);
+  const LeafRef from = search.start_for(l, lo, hi, true);
+  leaves_touching(t, from.node, from.cell, lo, hi, cell.level - 1, near);
+  for (const LeafRef& big : near)
+    if (t.nodes[big.node].kind == CellKind::Gray) faces_meeting(big, lo, hi, faces);
+  for (int k = 0; k < 8; ++k) {
+    const Lat p = cell.corner(k);
+    const bool sp = (signs_of(t.nodes[l.node]) >> k) & 1;
+    for (const LeafRef& big : near) {
+      if (t.nodes[big.node].kind != CellKind::Gray || big.cell.corner_index(p) >= 0) continue;
+      bool touches = true;
+      for (int a = 0; a < 3 && touches; ++a)
+        touches = p[a] >= big.cell.lat[a] && p[a] <= big.cell.lat[a] + big.cell.span();
+      if (!touches || !is_island(t.nodes[big.node], big.cell, p, sp)) continue;
+      flip(p);
+      break;
+    }
+  }
+}
+
+/// An active coarse leaf against the finer leaves across its faces (a new coarse leaf next to
+/// old fine ones): their corners on the shared face that are islands on it are flipped. The
+/// leaf's faces with finer leaves across are queued.
+template <class Flip>
+void finer_corners_on_coarse_leaf(const Octree& t, const IslandSearch& search, const PathLeaf& l, Flip&& flip,
+                                  std::vector<CoarseFace>& faces) {
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  const uint32_t big = l.node;
+  const Cell& cell = l.cell;
+  const int64_t sz = cell.span();
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      Cell across = cell;
+      across.lat[d] += side ? sz : -sz;
+      if (across.lat[d] < 0 || across.lat[d] >= kLimit) continue;
+      const Lat across_hi = across.corner(7);
+      const LeafRef n = search.node_below(search.start_for(l, across.lat, across_hi, false), across);
+      if (n.cell.level < cell.level || t.nodes[n.node].kind != CellKind::Internal) continue;
+      if (t.nodes[big].kind == CellKind::Gray) faces.push_back({{big, cell}, 2 * d + side});
+      const int64_t plane = side ? cell.lat[d] + sz : cell.lat[d];
+      // Leaves of the finer side touching the shared face, and their corners on it.
+      std::function<void(uint32_t, const Cell&)> visit = [&](uint32_t node, const Cell& c) {
+        const Node& m = t.nodes[node];
+        if (m.kind == CellKind::Internal) {
+          for (int k = 0; k < 8; ++k) {
+            const Cell ch = c.child(k);
+            if (ch.lat[d] <= plane && ch.lat[d] + ch.span() >= plane) visit(m.index + k, ch);
+          }
+          return;
+        }
+        for (int k = 0; k < 8; ++k) {
+          const Lat p = c.corner(k);
+          if (p[d] != plane || cell.corner_index(p) >= 0) continue;
+          const bool sp = (signs_of(m) >> k) & 1;
+          if (is_island(t.nodes[big], cell, p, sp)) flip(p);
+        }
+      };
+      visit(n.node, n.cell);
+    }
+}
+
+}  // namespace
+
+size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
+                      const std::function<void(uint32_t)>* touched, PinnedPoints* pinned) {
+  IslandSearch search{t, {}, {}};
+  {
+    std::vector<uint32_t> path;
+    search.collect(0, Cell{}, active, path);
+  }
+  size_t flipped = 0;
+  auto flip = [&](const Lat& p) {
+    flip_point(t, p, touched);
+    if (pinned) pinned->insert(lattice_key(p));
+    ++flipped;
+  };
+  std::vector<CoarseFace> faces;
+  std::vector<LeafRef> near;
+  for (const PathLeaf& l : search.leaves)
+    if (l.cell.level >= t.max_depth - 1)  // the finest leaves carry the islands
+      fine_corners_on_coarse_leaves(t, search, l, flip, near, faces);
+  for (const PathLeaf& l : search.leaves)
+    if (l.cell.level < t.max_depth) finer_corners_on_coarse_leaf(t, search, l, flip, faces);
+  // What the finer side shows on each coarse face (edges, stray regions), each face once.
+  FaceScratch face_scratch;
+  std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
+    return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
+  });
+  faces.erase(std::unique(faces.begin(), faces.end(),
+                          [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
+              faces.end());
+  for (const auto& [big, f] : faces) {
+    if (t.nodes[big.node].kind != CellKind::Gray) continue;
+    for (const Lat& p : face_flips(t, big, f, face_scratch)) flip(p);
+  }
+  return flipped;
+}
+
+namespace {
+
+/// Whether a flip leaves a coarser gray leaf without a sign change: its surface is gone and
+/// only a crack repair's vertex is left, whose faces the island pass then clears of the finer
+/// side's sign changes too. At the thin end of a wedge that erodes the wedge by a cell or two
+/// (harness seeds 263, 265: 1.5 and 1.9 finest cells where the exact solid is a cell thick).
+bool emptied_coarse_leaf(const Octree& t, const Around& a, uint8_t flipped) {
+  return a.cell.level < t.max_depth && t.nodes[a.node].kind == CellKind::Gray && (flipped == 0 || flipped == 0xff);
+}
+
+}  // namespace
+
+TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
+                                  const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned,
+                                  bool spare_coarse) {
+  TopologyFix fix;
+  for (int pass = 0; pass < 6; ++pass) {
+    // Only subtrees with active nodes are visited: a sculpting stroke stays local.
+    std::vector<LeafRef> bad;
+    for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
+      if (multi_component(t.nodes[node].signs)) bad.push_back({node, cell});
+    });
+    fix.remaining = bad.size();
+    if (bad.empty()) break;
+    for (const LeafRef& l : bad) {
+      const uint8_t s = t.nodes[l.node].signs;
+      if (!multi_component(s)) continue;  // fixed by an earlier flip
+      // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
+      // preferring to flip the minority sign (removing the thinner feature).
+      int best = -1, best_cost = 1 << 30;
+      const bool minority_inside = __builtin_popcount(s) <= 4;
+      for (int k = 0; k < 8; ++k) {
+        if (multi_component(uint8_t(s ^ (1 << k)))) continue;
+        const auto around = leaves_around(t, l.cell.corner(k));
+        int cost = 0;
+        for (const auto& a : around) {
+          const uint8_t flipped = uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner));
+          cost += 2 * multi_component(flipped);
+          cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
+        }
+        cost += (((s >> k) & 1) != 0) != minority_inside;
+        // Undoing what remove_islands just set would bring its defect back.
+        if (pinned && pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;
+        if (cost < best_cost) {
+          best_cost = cost;
+          best = k;
+        }
+      }
+      if (best < 0) continue;
+      flip_point(t, l.cell.corner(best), touched);
+      ++fix.flipped;
+    }
+  }
+  return fix;
+}
+
+namespace {
+
+/// At most this many lattice points make a speck: the Boolean's specks are 1-3 points (two
+/// surfaces passing within a fraction of a cell of each other); bigger regions are features.
+constexpr size_t kMaxSpeckPoints = 4;
+
+/// How thin, in finest cells, a speck that reaches a coarser leaf must be to be removed: two
+/// surfaces passing within a fraction of a cell of each other (harness seed 300: a void a
+/// quarter cell thick) are; a piece a cell thick is a feature.
+constexpr double kMaxSpeckThickness = 0.5;
+
+/// The extent of points across their flattest direction (the smallest principal axis).
+double thickness(const std::vector<Vec3>& pts) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Vec3& p : pts) mean += Eigen::Vector3d(p[0], p[1], p[2]);
+  mean /= double(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) {
+    const Eigen::Vector3d d = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
+    cov += d * d.transpose();
+  }
+  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  double lo = 0, hi = 0;
+  for (const Vec3& p : pts) {
+    const double x = (Eigen::Vector3d(p[0], p[1], p[2]) - mean).dot(axis);
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return hi - lo;
+}
+
+/// Corners of active gray leaves at `min_level` or finer holding the leaf's minority sign
+/// (both signs when tied), with that sign: where a speck's points must be.
+std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active,
+                                                   int min_level) {
+  std::vector<std::pair<Lat, bool>> out;
+  for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
+    const uint8_t s = t.nodes[node].signs;
+    if (cell.level < min_level || s == 0 || s == 0xff) return;
+    const int in = std::popcount(s);
+    for (int c = 0; c < 8; ++c) {
+      const bool sign = (s >> c) & 1;
+      if (sign == (in <= 4) || in == 4) out.push_back({cell.corner(c), sign});
+    }
+  });
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The region of p's sign (`inside`) connected to p through shared leaves, if it is a speck:
+/// every leaf around its points gray with the point as a corner (or, with `uniform_rim`,
+/// uniform of the other sign), one of them at least touched by this operation (active), and
+/// at most kMaxSpeckPoints points. `seen` gets the points visited either way.
+std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p,
+                                bool inside, bool uniform_rim, bool coarse_rim, std::unordered_set<uint64_t>& seen) {
+  const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  Speck sp;
+  sp.inside = inside;
+  std::vector<Lat> queue{p};
+  seen.insert(lattice_key(p));
+  bool ok = true, touched = false, coarse = false;
+  std::vector<Vec3> vertices;  // of the speck's leaves, its surface (with coarse_rim)
+  for (size_t i = 0; i < queue.size() && ok; ++i) {
+    const Lat q = queue[i];
+    for (int o = 0; o < 8 && ok; ++o) {
+      Lat c;
+      for (int k = 0; k < 3; ++k) {
+        c[k] = q[k] - ((o >> k) & 1) * step;
+        ok = ok && c[k] >= 0 && c[k] + step <= kLimit;
+      }
+      if (!ok) break;
+      const auto [node, cell] = leaf_at(t, c);
+      const Node& n = t.nodes[node];
+      if (uniform_rim && n.kind != CellKind::Gray) {
+        // A uniform leaf of the other sign: all of it is rim already.
+        ok = (n.kind == CellKind::Black) != sp.inside;
+        continue;
+      }
+      // A point is on the boundary of every leaf around it; with coarse_rim it need not be
+      // a corner of a leaf one level coarser (its sign then is the finer side's alone). Not
+      // of coarser ones: the speck's leaves become uniform, and a big leaf's surface is no speck.
+      const bool corner = cell.corner_index(q) >= 0;
+      ok = n.kind == CellKind::Gray && (corner || (coarse_rim && cell.level >= t.max_depth - 1));
+      if (!ok) break;
+      coarse = coarse || !corner;
+      touched = touched || !active || (*active)(node);
+      sp.leaves.push_back(node);
+      if (coarse_rim) vertices.push_back(vertex_unit(cell, t.vertices[n.index]));
+      for (int k = 0; k < 8; ++k) {
+        const Lat r = cell.corner(k);
+        const bool in = (n.signs >> k) & 1;
+        if (in != sp.inside) {
+          sp.rim.push_back(r);
+        } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
+          // A point seen before belongs to a region that was not a speck: so is this one.
+          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
+          queue.push_back(r);
+        }
+      }
+    }
+  }
+  if (!ok || !touched) return std::nullopt;
+  // Beside a coarser leaf the region may be a small real piece (harness seed 43: 4 cells
+  // across, a component of the exact result too); only a flat one is the Boolean's noise.
+  if (coarse && thickness(vertices) * double(int64_t{1} << t.max_depth) >= kMaxSpeckThickness) return std::nullopt;
+  sp.points = std::move(queue);
+  std::sort(sp.leaves.begin(), sp.leaves.end());
+  sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
+  return sp;
+}
+
+}  // namespace
+
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
+                     const std::function<bool(const Speck&)>& keep, const SpeckSearch& search) {
+  std::unordered_set<uint64_t> seen;
+  size_t removed = 0;
+  for (const auto& [p, inside] : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
+    if (seen.count(lattice_key(p))) continue;
+    const std::optional<Speck> sp = grow_speck(t, active, p, inside, search.uniform_rim, search.coarse_rim, seen);
+    if (!sp || keep(*sp)) continue;
+    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+    ++removed;
+  }
+  return removed;
+}
+
+/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
+/// edge's midpoint), so the contour stays closed whatever the geometry decided.
+size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active) {
+  size_t fixed = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    DualStats ds;
+    std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
+    dual_walk(t, active, emit, &ds);
+    if (ds.crack_leaves.empty()) break;
+    std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
+    std::unordered_map<uint32_t, Cell> cells;
+    for (size_t k = 0; k < ds.crack_leaves.size(); ++k) {
+      auto& [sum, n] = mid_sum[ds.crack_leaves[k]];
+      for (int a = 0; a < 3; ++a) sum[a] += ds.crack_points[k][a];
+      ++n;
+      cells[ds.crack_leaves[k]] = ds.crack_cells[k];
+    }
+    for (const auto& [node, ms] : mid_sum) {
+      Node& n = t.nodes[node];
+      if (n.kind == CellKind::Gray) continue;
+      const Cell& cell = cells[node];
+      const auto& [sum, cnt] = ms;
+      constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
+      const Vec3 x{sum[0] * k / (2 * cnt), sum[1] * k / (2 * cnt), sum[2] * k / (2 * cnt)};
+      n = add_gray(t.vertices, cell, n.kind == CellKind::Black ? 0xff : 0, x);
+      ++fixed;
+    }
+  }
+  return fixed;
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,94 @@
+// Topology clean-up after sampling and CSG: leaves at the depth cap may hold two surface
+// components (the paper's rule 3 could not be met). Dual contouring then makes non-manifold
+// edges. A corner sign is flipped — consistently in every leaf that has that lattice point as
+// a corner — until every leaf holds one component. This removes or joins features thinner
+// than the finest cell, which the octree cannot represent anyway.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <unordered_set>
+#include <vector>
+
+#include "octree/cell.h"
+
+namespace pic::detail {
+
+/// A leaf (or node) and its cell.
+struct LeafRef {
+  uint32_t node;
+  Cell cell;
+};
+/// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the nodes
+/// from the root down to it.
+LeafRef leaf_at(const Octree& t, const std::array<int64_t, 3>& q, std::vector<uint32_t>* path = nullptr);
+/// The sign of lattice point q where a leaf has it as a corner; nothing where none has (q lies
+/// inside a coarser leaf's face, edge or body).
+std::optional<bool> point_sign(const Octree& t, const std::array<int64_t, 3>& q);
+
+/// Lattice points (key: x | y << 21 | z << 42) that remove_islands set in this operation, which
+/// enforce_one_component should not flip back when anything else will do.
+using PinnedPoints = std::unordered_set<uint64_t>;
+inline uint64_t lattice_key(const std::array<int64_t, 3>& p) {
+  return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42;
+}
+
+/// A leaf's corner signs as a mask (uniform leaves: all corners alike).
+uint8_t signs_of(const Node& n);
+/// Whether corner signs make more than one surface component in a cell.
+bool multi_component(uint8_t signs);
+/// Flips corner c of a leaf (its cell `cell`). A uniform leaf becomes gray with its vertex
+/// right next to that corner (the only place its surface can be).
+void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell);
+
+struct TopologyFix {
+  size_t flipped = 0;    // lattice points whose sign changed
+  size_t remaining = 0;  // leaves still holding more than one component
+};
+
+/// Works on the leaves for which `active` is true (all leaves when null); `touched` is called
+/// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
+/// With `spare_coarse` (CSG), a flip that leaves a coarser gray leaf without a sign change
+/// costs more: another flip usually does, and the coarse leaf keeps its surface.
+TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
+                                  const std::function<void(uint32_t)>* touched = nullptr,
+                                  const PinnedPoints* pinned = nullptr, bool spare_coarse = false);
+
+/// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
+/// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
+/// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
+/// to match, in every leaf that has it as a corner. Returns how many points changed.
+size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
+                      const std::function<void(uint32_t)>* touched = nullptr, PinnedPoints* pinned = nullptr);
+
+/// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
+/// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or
+/// void a cell or two across; `leaves` are the leaves around its points.
+struct Speck {
+  std::vector<std::array<int64_t, 3>> points, rim;
+  std::vector<uint32_t> leaves;
+  bool inside = false;
+};
+/// Where remove_specks looks. By default as the CSG clean-up needs: points that are corners
+/// of finest gray leaves only, every leaf around them gray.
+struct SpeckSearch {
+  int min_level = -1;        ///< the coarsest gray leaves whose corners may be specks (-1: finest)
+  bool uniform_rim = false;  ///< uniform leaves of the other sign may surround the speck too
+  /// Gray leaves one level coarser than the finest may have a speck point on a face or edge
+  /// instead of a corner (a leaf copied whole from one operand beside finest ones the
+  /// Boolean made).
+  bool coarse_rim = false;
+};
+/// Removes the specks with a leaf for which `active` is true (all when null) unless `keep`
+/// says otherwise: the speck's points take their neighbours' sign (its leaves become uniform).
+/// Specks are features about a cell across. Returns how many were removed.
+size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
+                     const std::function<bool(const Speck&)>& keep, const SpeckSearch& search = {});
+
+/// Turns uniform leaves that border a sign change into gray leaves (vertex at the crossing
+/// edges' midpoint), so the contour stays closed. Returns how many leaves changed.
+size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active);
+
+}  // namespace pic::detail
