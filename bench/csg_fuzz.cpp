@@ -32,9 +32,7 @@ using namespace pic;
 std::vector<TriMesh> g_models;  // data/ meshes normalized to the unit cube around the origin
 
 TriMesh written(const Octree& t) {
-  TriMesh m = contour(t);
-  split_nonmanifold(m);
-  return m;
+  return contour(t);
 }
 
 struct CaseResult {

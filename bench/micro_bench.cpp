@@ -103,7 +103,7 @@ void BM_Contour(benchmark::State& state) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(state.range(0)));
   size_t tris = 0;
   for (auto _ : state) {
-    auto m = pic::contour(t);
+    auto m = pic::unsplit_contour(t);
     tris = m.triangles.size();
     benchmark::DoNotOptimize(m);
   }

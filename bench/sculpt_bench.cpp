@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     for (int s = 0; s < strokes; ++s) {
       if (s % repick == 0 || candidates.empty()) {
         const auto t0 = Clock::now();
-        candidates = pic::contour(tree).positions;
+        candidates = pic::unsplit_contour(tree).positions;
         pick_s += since(t0);
         if (candidates.empty()) throw std::runtime_error("the object vanished");
       }
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
       combine_s.push_back(st.csg_seconds - st.cleanup_seconds);
       cleanup_s.push_back(st.cleanup_seconds);
       if (check) {
-        pic::TriMesh m = pic::contour(tree);
+        pic::TriMesh m = pic::unsplit_contour(tree);
         const auto topo = pic::analyze_topology(m);
         if (!topo.manifold()) {
           pic::split_nonmanifold(m);
@@ -170,7 +170,7 @@ int main(int argc, char** argv) {
     const auto stats = pic::analyze(tree);
     std::string extra;
     {
-      pic::TriMesh m = pic::contour(tree);
+      pic::TriMesh m = pic::unsplit_contour(tree);
       const auto topo = pic::analyze_topology(m);
       const size_t split = pic::split_nonmanifold(m);
       if (check)

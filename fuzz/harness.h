@@ -25,7 +25,7 @@ inline void sample_and_contour(const TriMesh& mesh) {
   o.parallel = false;  // deterministic and cheaper under the sanitizers
   try {
     const Octree tree = sample(mesh, o);
-    const TriMesh surface = contour(tree);
+    const TriMesh surface = unsplit_contour(tree);
     (void)surface;
   } catch (const InvalidInput&) {  // e.g. an open mesh: a legitimate refusal
   }
@@ -56,7 +56,7 @@ inline int run_pic(const uint8_t* data, size_t size) {
   try {
     const Octree tree = deserialize(bytes);
     (void)analyze(tree);
-    (void)contour(tree);
+    (void)unsplit_contour(tree);
   } catch (const IoError&) {
   } catch (const InvalidInput&) {
   }

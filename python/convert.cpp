@@ -78,7 +78,17 @@ py::tuple from_mesh(const pic::TriMesh& mesh) {
   int64_t* fp = f.mutable_data();
   for (const auto& t : mesh.triangles)
     for (uint32_t i : t) *fp++ = i;
-  return py::make_tuple(v, f);
+  // pic.Mesh: a (vertices, faces) named tuple, so `v, f = ...` and `m.vertices` both work.
+  return py::module_::import("pic").attr("Mesh")(v, f);
+}
+
+std::optional<pic::TriMesh> as_mesh(py::handle obj) {
+  if (py::hasattr(obj, "vertices") && py::hasattr(obj, "faces")) return to_mesh(obj.attr("vertices"), obj.attr("faces"));
+  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != 2) return std::nullopt;
+  const auto t = obj.cast<py::tuple>();
+  const py::array second = py::array::ensure(t[1]);
+  if (!second || (second.dtype().kind() != 'i' && second.dtype().kind() != 'u')) return std::nullopt;
+  return to_mesh(t[0], t[1]);
 }
 
 std::optional<pic::Cube> to_cube(py::handle obj) {

@@ -21,10 +21,13 @@ namespace py = pybind11;
 std::vector<pic::Vec3> to_points(py::handle array, const char* what);
 /// `vertices` (n, 3) real and `faces` (m, 3) integer with indices in [0, n).
 pic::TriMesh to_mesh(py::handle vertices, py::handle faces);
+/// A mesh given as one object: anything with .vertices and .faces (pic.Mesh, trimesh.Trimesh),
+/// or a (vertices, faces) tuple whose faces are integers. Nothing for anything else.
+std::optional<pic::TriMesh> as_mesh(py::handle obj);
 /// `points` and `normals`, both (n, 3) real.
 pic::PointCloud to_cloud(py::handle points, py::handle normals);
 
-/// (vertices float64 (n, 3), faces int64 (m, 3)).
+/// pic.Mesh(vertices float64 (n, 3), faces int64 (m, 3)), a named tuple.
 py::tuple from_mesh(const pic::TriMesh& mesh);
 
 /// None, or (x, y, z, size) as the CLI's --cube X,Y,Z,SIZE: the minimum corner and the side.

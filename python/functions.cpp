@@ -31,36 +31,101 @@ pic::SampleOptions sample_options(int depth, double error, py::handle cube, cons
   return o;
 }
 
+std::unique_ptr<PyOctree> sample_cloud(const pic::PointCloud& cloud, const pic::SampleOptions& o) {
+  pic::SampleStats st;
+  pic::Octree tree;
+  {
+    py::gil_scoped_release nogil;
+    tree = pic::sample(cloud, o, &st);
+  }
+  return wrap(std::move(tree), sample_stats(st));
+}
+
 std::unique_ptr<PyOctree> sample(py::object input, py::object faces, int depth, double error, py::object cube,
                                  const std::string& inside, bool parallel, double margin) {
   const pic::SampleOptions o = sample_options(depth, error, cube, inside, parallel, margin);
   pic::SampleStats st;
-  size_t points_in = 0;
   pic::Octree tree;
   if (is_path(input)) {
     if (!faces.is_none()) throw py::value_error("sample(path) takes no faces");
     const fs::path path = to_path(input);
-    py::gil_scoped_release nogil;
-    const pic::Geometry geo = pic::read_geometry(path);
-    points_in = geo.points.positions.size();
-    tree = geo.is_point_cloud() ? pic::sample(geo.points, o, &st) : pic::sample(geo.mesh, o, &st);
-  } else if (faces.is_none() && py::isinstance<py::tuple>(input)) {
-    const auto t = input.cast<py::tuple>();
-    if (t.size() != 2) throw py::value_error("a point cloud is sample((points, normals))");
-    const pic::PointCloud cloud = to_cloud(t[0], t[1]);
-    points_in = cloud.positions.size();
-    py::gil_scoped_release nogil;
-    tree = pic::sample(cloud, o, &st);
-  } else {
-    if (faces.is_none())
-      throw py::value_error("faces is missing: a mesh is sample(vertices, faces), a point cloud sample((points, normals))");
-    const pic::TriMesh mesh = to_mesh(input, faces);
-    py::gil_scoped_release nogil;
-    tree = pic::sample(mesh, o, &st);
+    {
+      py::gil_scoped_release nogil;
+      const pic::Geometry geo = pic::read_geometry(path);
+      tree = geo.is_point_cloud() ? pic::sample(geo.points, o, &st) : pic::sample(geo.mesh, o, &st);
+    }
+    return wrap(std::move(tree), sample_stats(st));
   }
-  py::dict stats = sample_stats(st);
-  stats["points_in"] = points_in;
-  return wrap(std::move(tree), stats);
+  std::optional<pic::TriMesh> mesh;
+  if (faces.is_none()) {
+    mesh = as_mesh(input);
+    if (!mesh && py::isinstance<py::tuple>(input) && py::len(input) == 2) {
+      // The old spelling of a point cloud: sample((points, normals)).
+      PyErr_WarnEx(PyExc_DeprecationWarning, "sample((points, normals)) is deprecated: use sample_points(points, normals)", 1);
+      const auto t = input.cast<py::tuple>();
+      return sample_cloud(to_cloud(t[0], t[1]), o);
+    }
+    if (!mesh)
+      throw py::value_error("faces is missing: a mesh is sample(vertices, faces) or sample(mesh), a point cloud "
+                            "sample_points(points, normals)");
+  } else {
+    mesh = to_mesh(input, faces);
+  }
+  {
+    py::gil_scoped_release nogil;
+    tree = pic::sample(*mesh, o, &st);
+  }
+  return wrap(std::move(tree), sample_stats(st));
+}
+
+/// One operand of csg_meshes: a PIC object as it is, or a mesh.
+pic::CsgOperand to_operand(py::handle x, size_t k) {
+  pic::CsgOperand out;
+  out.name = "operand " + std::to_string(k);
+  if (py::isinstance<PyOctree>(x)) {
+    const PyOctree& t = x.cast<const PyOctree&>();
+    std::lock_guard lock(t.mutex);
+    out.tree = t.tree;
+  } else if (auto m = as_mesh(x)) {
+    out.mesh = std::move(*m);
+  } else if (is_path(x)) {
+    out.mesh = pic::read_mesh(to_path(x));
+  } else {
+    throw py::value_error("csg_meshes operands are meshes (pic.Mesh, (vertices, faces), .vertices/.faces), mesh "
+                          "paths or Octrees");
+  }
+  return out;
+}
+
+std::unique_ptr<PyOctree> csg_meshes(py::args args, int depth, double error, bool parallel, py::object cube) {
+  if (args.size() < 3 || args.size() % 2 == 0)
+    throw py::value_error("csg_meshes(a, op, b [, op, c ...]): operands and operations alternate");
+  std::vector<pic::CsgOperand> operands;
+  std::vector<pic::CsgOp> ops;
+  for (size_t k = 0; k < args.size(); ++k) {
+    if (k % 2 == 0) operands.push_back(to_operand(args[k], k / 2));
+    else ops.push_back(to_csg_op(args[k].cast<std::string>()));
+  }
+  pic::CsgChainOptions o;
+  o.sampling.depth = depth;
+  o.sampling.error = error;
+  o.sampling.parallel = parallel;
+  o.sampling.cube = to_cube(cube);
+  o.csg.error = error;
+  o.csg.parallel = parallel;
+  py::list steps;
+  std::vector<pic::CsgStats> stats(ops.size());
+  o.on_step = [&](size_t k, const pic::CsgStats& st) { stats[k - 1] = st; };
+  pic::Octree tree;
+  {
+    py::gil_scoped_release nogil;
+    tree = pic::csg_chain(std::move(operands), ops, o);
+  }
+  for (size_t k = 0; k < ops.size(); ++k) steps.append(csg_stats(stats[k], ops[k], false));
+  py::dict d;
+  d["op"] = "csg_meshes";
+  d["steps"] = steps;
+  return wrap(std::move(tree), d);
 }
 
 pic::CsgOptions csg_options(double error, bool parallel) {
@@ -85,14 +150,7 @@ std::unique_ptr<PyOctree> eval(bool is_text, const std::string& input, int depth
   }
   py::dict d;
   d["op"] = "eval";
-  d["seconds"] = st.seconds;
-  d["openscad_seconds"] = st.openscad_seconds;
-  d["mesh_seconds"] = st.mesh_seconds;
-  d["octree_seconds"] = st.octree_seconds;
-  d["nodes"] = st.nodes;
-  d["leaves"] = st.leaves;
-  d["leaf_triangles"] = st.triangles;
-  d["booleans"] = st.booleans;
+  add_fields(d, st);
   return wrap(std::move(tree), d);
 }
 
@@ -128,6 +186,28 @@ share one cube between CSG operands. inside: 'auto', 'parity' or 'winding'.
 parallel: use all cores (same bytes as serial).
 Raises ValueError for bad input (empty, open with inside='parity', non-finite, wrong shape),
 OSError for an unreadable file. The result's .stats hold the sampling statistics.)doc");
+  m.def(
+      "sample_points",
+      [](py::object points, py::object normals, int depth, double error, py::object cube, bool parallel,
+         double margin) {
+        const pic::SampleOptions o = sample_options(depth, error, cube, "auto", parallel, margin);
+        return sample_cloud(to_cloud(points, normals), o);
+      },
+      py::arg("points"), py::arg("normals"), py::arg("depth") = 12, py::arg("error") = 1e-8,
+      py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("margin") = 1.0 / 16,
+      R"doc(Samples an oriented point cloud (a scan) into a PIC object (pic::sample of a PointCloud).
+
+points, normals: (n, 3) real arrays; normals point out of the solid (any length but zero).
+Signs come from the points' winding number; the depth stops where a cell is half the points'
+spacing (stats['depth_used']). Raises ValueError for an empty cloud or missing/zero normals.)doc");
+  m.def("csg_meshes", &csg_meshes, py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
+        py::arg("parallel") = true, py::arg("cube") = py::none(),
+        R"doc(Booleans of meshes, left to right: csg_meshes(a, 'subtract', b [, 'union', c ...]).
+
+Operands are meshes (pic.Mesh, a (vertices, faces) tuple, anything with .vertices and .faces),
+mesh file paths, or Octrees. Mesh operands are sampled at `depth` into one cube around all of
+them (or `cube`), so no cube needs choosing by hand (pic::csg_chain, as `pic csg` does).
+The result's stats['steps'] hold each Boolean's statistics.)doc");
   m.def(
       "bounding_cube",
       [](py::object vertices, double margin) {
@@ -223,20 +303,27 @@ unreadable file.)doc");
       "int64 (m, 3)). Raises OSError (missing, unreadable, unknown format) or ValueError (empty, non-finite).");
   m.def(
       "write_mesh",
-      [](py::object vertices, py::object faces, const fs::path& path) {
-        const pic::TriMesh mesh = to_mesh(vertices, faces);
+      [](py::object a, py::object b, py::object c) {
+        // write_mesh(mesh, path) or write_mesh(vertices, faces, path).
+        const std::optional<pic::TriMesh> one = c.is_none() ? as_mesh(a) : std::nullopt;
+        if (c.is_none() && !one) throw py::value_error("write_mesh(mesh, path) or write_mesh(vertices, faces, path)");
+        const pic::TriMesh mesh = one ? *one : to_mesh(a, b);
+        const fs::path path = to_path(c.is_none() ? b : c);
         py::gil_scoped_release nogil;
         pic::write_mesh(mesh, path);
       },
-      py::arg("vertices"), py::arg("faces"), py::arg("path"),
-      "Writes a mesh, the format from the extension (obj, stl, ply, off, glb), atomically. Raises OSError.");
+      py::arg("mesh_or_vertices"), py::arg("faces_or_path"), py::arg("path") = py::none(),
+      "write_mesh(mesh, path) or write_mesh(vertices, faces, path): the format from the extension (obj, stl, ply, "
+      "off, glb), written atomically. Raises OSError.");
   m.def(
       "volume",
-      [](py::object vertices, py::object faces) {
-        const pic::TriMesh mesh = to_mesh(vertices, faces);
-        return pic::volume(mesh);
+      [](py::object a, py::object faces) {
+        const std::optional<pic::TriMesh> one = faces.is_none() ? as_mesh(a) : std::nullopt;
+        if (faces.is_none() && !one) throw py::value_error("volume(mesh) or volume(vertices, faces)");
+        return pic::volume(one ? *one : to_mesh(a, faces));
       },
-      py::arg("vertices"), py::arg("faces"), "Signed volume of a mesh (positive for outward orientation).");
+      py::arg("mesh_or_vertices"), py::arg("faces") = py::none(),
+      "volume(mesh) or volume(vertices, faces): signed volume (positive for outward orientation).");
   m.def(
       "check_validity",
       [](py::object vertices, py::object faces, bool self_intersections) {
@@ -311,7 +398,7 @@ unreadable file.)doc");
         pic::Image img;
         if (py::isinstance<PyOctree>(obj)) {
           const PyOctree& t = obj.cast<const PyOctree&>();
-          img = without_gil([&] { return pic::render(pic::contour(t.tree), &t.tree, o); }, t);
+          img = without_gil([&] { return pic::render(pic::unsplit_contour(t.tree), &t.tree, o); }, t);
         } else {
           if (octree) throw py::value_error("render: octree=True needs a pic.Octree");
           if (!py::isinstance<py::tuple>(obj) || py::len(obj) != 2)

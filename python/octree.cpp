@@ -16,24 +16,6 @@ using Clock = std::chrono::steady_clock;
 
 py::list vec_list(const pic::Vec3& v) { return py::cast(std::vector<double>(v.begin(), v.end())); }
 
-py::dict csg_stats(const pic::CsgStats& st, pic::CsgOp op, bool inplace) {
-  py::dict d;
-  d["op"] = pic::to_string(op);
-  d["inplace"] = inplace;
-  d["seconds"] = st.seconds;
-  d["contour_a_seconds"] = st.contour_a_seconds;
-  d["contour_b_seconds"] = st.contour_b_seconds;
-  d["csg_seconds"] = st.csg_seconds;
-  d["cleanup_seconds"] = st.cleanup_seconds;
-  d["cells_visited"] = st.cells_visited;
-  d["cells_stamped"] = st.cells_stamped;
-  d["gray_pairs"] = st.gray_pairs;
-  d["forced_subdivisions"] = st.forced_subdivisions;
-  d["repaired"] = st.repaired;
-  d["stamp"] = st.stamp;
-  d["resampled_b"] = st.resampled_b;
-  return d;
-}
 
 // The same keys and values as `pic info --json` (apps/pic/main.cpp), file_bytes being the
 // size of the .pic bytes.
@@ -105,6 +87,14 @@ std::unique_ptr<PyOctree> copy_of(const PyOctree& t) {
 
 }  // namespace
 
+py::dict csg_stats(const pic::CsgStats& st, pic::CsgOp op, bool inplace) {
+  py::dict d;
+  d["op"] = pic::to_string(op);
+  d["inplace"] = inplace;
+  add_fields(d, st);
+  return d;
+}
+
 std::unique_ptr<PyOctree> wrap(pic::Octree tree, py::dict stats) {
   auto r = std::make_unique<PyOctree>();
   r->tree = std::move(tree);
@@ -143,14 +133,13 @@ void csg_inplace(PyOctree& a, const PyOctree& b, pic::CsgOp op, const pic::CsgOp
 py::tuple contour(const PyOctree& t, bool intersection_free, bool split, py::object stats) {
   pic::ContourOptions o;
   o.intersection_free = intersection_free;
+  o.split_sheets = split;
   pic::ContourStats st;
-  size_t split_vertices = 0;
   double seconds = 0;
   const pic::TriMesh mesh = without_gil(
       [&] {
         const auto t0 = Clock::now();
         pic::TriMesh m = pic::contour(t.tree, o, &st);
-        if (split) split_vertices = pic::split_nonmanifold(m);
         seconds = std::chrono::duration<double>(Clock::now() - t0).count();
         return m;
       },
@@ -159,37 +148,16 @@ py::tuple contour(const PyOctree& t, bool intersection_free, bool split, py::obj
     stats["seconds"] = seconds;
     stats["vertices"] = mesh.positions.size();
     stats["triangles"] = mesh.triangles.size();
-    stats["split_vertices"] = split_vertices;
-    stats["fans"] = st.fans;
-    stats["other_diagonal"] = st.other_diagonal;
-    stats["moved_vertices"] = st.moved_vertices;
-    stats["initial_intersections"] = st.initial_intersections;
-    stats["remaining_intersections"] = st.remaining_intersections;
-    stats["rounds"] = st.rounds;
+    py::dict d = stats.cast<py::dict>();
+    add_fields(d, st);
   }
   return from_mesh(mesh);
 }
 
 py::dict sample_stats(const pic::SampleStats& st) {
-  py::dict d, defects;
+  py::dict d;
   d["op"] = "sample";
-  d["pics"] = st.pics;
-  d["seconds"] = st.seconds;
-  d["triangles_in"] = st.triangles_in;
-  d["capped"] = st.capped;
-  d["depth_used"] = st.depth;
-  d["inside"] = st.classifier;
-  const auto& x = st.defects;
-  defects["boundary_edges"] = x.boundary_edges;
-  defects["nonmanifold_edges"] = x.nonmanifold_edges;
-  defects["inconsistent_edges"] = x.inconsistent_edges;
-  defects["duplicated_faces"] = x.duplicated_faces;
-  defects["degenerate_faces"] = x.degenerate_faces;
-  defects["shells"] = x.shells;
-  defects["overlapping_shells"] = x.overlapping_shells;
-  d["defects"] = defects;
-  d["interior_triangles"] = st.interior_triangles;
-  d["boundary_loops"] = st.boundary_loops;
+  add_fields(d, st);
   return d;
 }
 
@@ -236,7 +204,7 @@ stats: a dict to fill with the contour's counts and seconds.)doc");
             [&] {
               in.stats = pic::analyze(t.tree);
               in.file_bytes = pic::serialize(t.tree).size();
-              const pic::TriMesh mesh = pic::contour(t.tree);
+              const pic::TriMesh mesh = pic::unsplit_contour(t.tree);
               in.topology = pic::analyze_topology(mesh);
               in.validity = pic::check_validity(mesh, check);
               return 0;

@@ -1,6 +1,6 @@
 // The Python `pic.Octree`: a pic::Octree plus the statistics of the operation that made or last
 // changed it. Long calls run without the GIL; each object's mutex then keeps a second Python
-// thread from editing it (CSG also writes its operands' timestamps) in the meantime.
+// thread from editing it in the meantime.
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -9,6 +9,7 @@
 #include <mutex>
 #include <utility>
 
+#include "pic/fields.h"
 #include "pic/pic.h"
 
 namespace pic_python {
@@ -51,6 +52,21 @@ void csg_inplace(PyOctree& a, const PyOctree& b, pic::CsgOp op, const pic::CsgOp
 py::tuple contour(const PyOctree& t, bool intersection_free, bool split, py::object stats);
 
 py::dict sample_stats(const pic::SampleStats& st);
+py::dict csg_stats(const pic::CsgStats& st, pic::CsgOp op, bool inplace);
+
+/// Adds a stats struct's fields (pic/fields.h) to `d`; nested structs become nested dicts.
+template <class S>
+void add_fields(py::dict& d, const S& stats) {
+  pic::for_each_field(stats, [&](const char* name, const auto& value) {
+    if constexpr (pic::HasFields<std::decay_t<decltype(value)>>) {
+      py::dict sub;
+      add_fields(sub, value);
+      d[name] = sub;
+    } else {
+      d[name] = value;
+    }
+  });
+}
 
 void bind_octree(py::module_& m);
 

@@ -18,7 +18,7 @@ using test::IsClosedManifold;
 constexpr double kPi = std::numbers::pi;
 
 TriMesh contour_split(const Octree& t) {
-  TriMesh m = contour(t);
+  TriMesh m = unsplit_contour(t);
   split_nonmanifold(m);
   return m;
 }

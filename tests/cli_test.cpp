@@ -216,7 +216,7 @@ TEST_F(Cli, PrimBoxWorks) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   const Octree t = load(path("b.pic"));
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   EXPECT_TRUE(test::IsClosedManifold(m));
   EXPECT_NEAR(volume(m), 1.0, 1e-6);
   for (int c = 0; c < 8; ++c) {

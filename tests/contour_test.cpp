@@ -54,12 +54,12 @@ std::set<Vec3> cube_corners(const Vec3& lo, const Vec3& hi) {
 
 TEST(Contour, EmptyTreesGiveEmptyMeshes) {
   Octree white;
-  EXPECT_TRUE(contour(white).triangles.empty());
-  EXPECT_TRUE(contour(white).positions.empty());
+  EXPECT_TRUE(unsplit_contour(white).triangles.empty());
+  EXPECT_TRUE(unsplit_contour(white).positions.empty());
 
   Octree black;
   black.nodes[0].kind = CellKind::Black;
-  EXPECT_TRUE(contour(black).triangles.empty());
+  EXPECT_TRUE(unsplit_contour(black).triangles.empty());
 
   // Subdivided, but every leaf uniform: still nothing to contour (the root's boundary is
   // not an interior edge).
@@ -67,15 +67,15 @@ TEST(Contour, EmptyTreesGiveEmptyMeshes) {
   mixed.max_depth = 2;
   const uint32_t first = subdivide(mixed, 0);
   subdivide(mixed, first + 3);
-  EXPECT_TRUE(contour(mixed).triangles.empty());
+  EXPECT_TRUE(unsplit_contour(mixed).triangles.empty());
   for (auto& n : mixed.nodes)
     if (n.kind == CellKind::White) n.kind = CellKind::Black;
-  EXPECT_TRUE(contour(mixed).triangles.empty());
+  EXPECT_TRUE(unsplit_contour(mixed).triangles.empty());
 }
 
 TEST(Contour, CentreBlobIsAnAxisAlignedCube) {
   const Octree t = centre_blob();
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   // 6 sign-changing minimal edges (centre to face centres) -> 6 quads.
   EXPECT_EQ(m.positions.size(), 8u);
@@ -89,7 +89,7 @@ TEST(Contour, ComplementedSignsGiveAnInwardFacingCavity) {
   Octree t = centre_blob();
   for (auto& n : t.nodes)
     if (n.kind == CellKind::Gray) n.signs = uint8_t(~n.signs);
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(m.triangles.size(), 12u);
   // A cavity around the centre: the surface faces into it, so the signed volume is negative.
@@ -99,7 +99,7 @@ TEST(Contour, ComplementedSignsGiveAnInwardFacingCavity) {
 TEST(Contour, OutputIsInTheTreeCubeCoordinates) {
   Octree t = centre_blob();
   t.cube = Cube{{10, -20, 30}, 4};
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(vertex_set(m), cube_corners({10 + 4 * 0.4375, -20 + 4 * 0.4375, 30 + 4 * 0.4375},
                                         {10 + 4 * 0.5625, -20 + 4 * 0.5625, 30 + 4 * 0.5625}));
@@ -115,7 +115,7 @@ TEST(Contour, MixedLevelNeighboursAreStitched) {
   const uint32_t first = t.nodes[0].index;
   const uint32_t grand = subdivide(t, first + 0);
   make_gray(t, grand + 7, 0x80, {0.75f, 0.75f, 0.75f});  // (0.4375, 0.4375, 0.4375)
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(m.positions.size(), 8u);
   EXPECT_EQ(m.triangles.size(), 12u);
@@ -139,7 +139,7 @@ TEST(Contour, TwoSeparateBlobsAtDifferentLevels) {
       make_gray(t, g + k, uint8_t(1u << (7 - k)), local);
     }
   }
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(m.positions.size(), 16u);
   EXPECT_EQ(m.triangles.size(), 24u);
@@ -164,7 +164,7 @@ void expect_exact_box(const Vec3& lo, const Vec3& hi, const Cube& cube, int dept
   SampleStats st;
   const Octree t = sample(make_box(lo, hi), o, &st);
   EXPECT_EQ(st.capped, 0u);
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(test::euler_characteristic(m), 2);
   if (minimal) {
@@ -202,7 +202,7 @@ TEST(Contour, OffLatticeBoxHasEightVerticesAndEulerTwo) {
   o.depth = 9;
   o.cube = Cube{{0, 0, 0}, 1};
   const TriMesh box = make_box({0.31, 0.22, 0.405}, {0.66, 0.71, 0.59});
-  const TriMesh m = contour(sample(box, o));
+  const TriMesh m = unsplit_contour(sample(box, o));
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(m.positions.size(), 8u);
   EXPECT_EQ(m.triangles.size(), 12u);
@@ -251,7 +251,7 @@ TEST(Contour, SmoothSphereTrianglesFaceOutward) {
     o.depth = 8;
     o.cube = Cube{{0, 0, 0}, 1};
     const Octree t = sample(make_sphere(c, radius, 512), o);
-    const TriMesh m = contour(t);
+    const TriMesh m = unsplit_contour(t);
     ASSERT_TRUE(IsClosedManifold(m));
     EXPECT_GT(volume(m), 0);
     size_t inward = 0;
@@ -287,11 +287,11 @@ TEST(Contour, VerticesAreTheLeafVertices) {
 // all threads give the same mesh, vertex for vertex.
 TEST(Contour, OneThreadEqualsAllThreads) {
   const Octree t = sample(read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj"), SampleOptions{});
-  const TriMesh all = contour(t);
+  const TriMesh all = unsplit_contour(t);
   TriMesh one;
   {
     tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
-    one = contour(t);
+    one = unsplit_contour(t);
   }
   ASSERT_GT(all.triangles.size(), 10000u);
   EXPECT_TRUE(one.positions == all.positions);

@@ -125,7 +125,7 @@ void expect_exact_box_result(const Box& a, const Box& b, CsgOp op, int depth, do
                              const Cube& cube = kUnit, bool all_corners = true, size_t min_corners = 8) {
   const Octree ta = sample_in_unit(a.mesh(), depth, cube), tb = sample_in_unit(b.mesh(), depth, cube);
   const Octree r = csg(ta, tb, op);
-  const TriMesh m = contour(r);
+  const TriMesh m = unsplit_contour(r);
   ASSERT_FALSE(m.triangles.empty());
   EXPECT_TRUE(IsClosedManifold(m));
   double worst = 0, worst_capped = 0;
@@ -213,7 +213,7 @@ TEST(Csg, Figure7WedgeKeepsItsSharpEdge) {
   const Cube cube{{-0.5, -0.5, -0.5}, 2.0};
   expect_exact_box_result(a, b, CsgOp::Subtract, 10, -1, cube, /*all_corners=*/false, /*min_corners=*/6);
   const Octree r = csg(sample_in_unit(a.mesh(), 10, cube), sample_in_unit(b.mesh(), 10, cube), CsgOp::Subtract);
-  const TriMesh m = contour(r);
+  const TriMesh m = unsplit_contour(r);
   // The wedge's volume: a triangular prism of depth 0.5 and legs 0.2 and 0.2 tan(10 deg).
   EXPECT_NEAR(volume(m), 0.5 * 0.2 * 0.2 * std::tan(alpha) * 0.5, 2e-4);
   // The wedge's two edges at its thick end (A's bottom edge and where B's face meets A's
@@ -244,14 +244,14 @@ Octree* AlgebraTest::b = nullptr;
 
 TEST_F(AlgebraTest, AMinusAIsEmpty) {
   const Octree r = csg(*a, *a, CsgOp::Subtract);
-  EXPECT_TRUE(contour(r).triangles.empty());
+  EXPECT_TRUE(unsplit_contour(r).triangles.empty());
   EXPECT_EQ(analyze(r).pics, 0u);
 }
 
 TEST_F(AlgebraTest, UnionAndIntersectionWithItselfGiveA) {
-  const TriMesh ma = contour(*a);
+  const TriMesh ma = unsplit_contour(*a);
   for (CsgOp op : {CsgOp::Union, CsgOp::Intersect}) {
-    const TriMesh m = contour(csg(*a, *a, op));
+    const TriMesh m = unsplit_contour(csg(*a, *a, op));
     EXPECT_TRUE(IsClosedManifold(m));
     EXPECT_LT(two_sided_distance(m, ma), 1e-6) << to_string(op);
     EXPECT_NEAR(volume(m), volume(ma), 1e-9) << to_string(op);
@@ -261,15 +261,15 @@ TEST_F(AlgebraTest, UnionAndIntersectionWithItselfGiveA) {
 TEST_F(AlgebraTest, IntersectionWithDisjointIsEmpty) {
   const Octree far = sample_in_unit(make_box({0.85, 0.85, 0.85}, {0.95, 0.95, 0.95}), 8);
   const Octree r = csg(*a, far, CsgOp::Intersect);
-  EXPECT_TRUE(contour(r).triangles.empty());
-  const TriMesh u = contour(csg(*a, far, CsgOp::Union));
+  EXPECT_TRUE(unsplit_contour(r).triangles.empty());
+  const TriMesh u = unsplit_contour(csg(*a, far, CsgOp::Union));
   EXPECT_TRUE(IsClosedManifold(u));
   EXPECT_EQ(component_count(u), 2u);
 }
 
 TEST_F(AlgebraTest, UnionMinusBEqualsAMinusB) {
   const TriMesh lhs = contour(csg(csg(*a, *b, CsgOp::Union), *b, CsgOp::Subtract));
-  const TriMesh rhs = contour(csg(*a, *b, CsgOp::Subtract));
+  const TriMesh rhs = unsplit_contour(csg(*a, *b, CsgOp::Subtract));
   EXPECT_TRUE(IsClosedManifold(lhs));
   EXPECT_TRUE(IsClosedManifold(rhs));
   EXPECT_LT(two_sided_distance(lhs, rhs), 2e-3);
@@ -282,7 +282,7 @@ TEST_F(AlgebraTest, ResultsChainSaveAndLoad) {
   const Octree back = deserialize(bytes);
   EXPECT_EQ(serialize(back), bytes);
   const Octree s = sample_in_unit(make_sphere({0.3, 0.5, 0.5}, 0.1, 64), 8);
-  const TriMesh m = contour(csg(back, s, CsgOp::Union));
+  const TriMesh m = unsplit_contour(csg(back, s, CsgOp::Union));
   EXPECT_TRUE(IsClosedManifold(m));
 }
 
@@ -294,9 +294,9 @@ TEST_F(AlgebraTest, InPlaceEditsSaveAndLoad) {
     csg_inplace(r, sample_in_unit(make_sphere({x, 0.5, 0.72}, 0.05, 48), 8), CsgOp::Subtract);
   const Octree back = deserialize(serialize(r));
   EXPECT_EQ(analyze(back).pics, analyze(r).pics);
-  const TriMesh m = contour(back);
+  const TriMesh m = unsplit_contour(back);
   EXPECT_TRUE(IsClosedManifold(m));
-  EXPECT_LT(two_sided_distance(m, contour(r)), 1e-6);
+  EXPECT_LT(two_sided_distance(m, unsplit_contour(r)), 1e-6);
 }
 
 TEST(Csg, OperandsInDifferentCubesShareOneFrame) {
@@ -313,7 +313,7 @@ TEST(Csg, OperandsInDifferentCubesShareOneFrame) {
     EXPECT_LE(r.cube.origin[k], std::min(a.cube.origin[k], b.cube.origin[k]));
     EXPECT_GE(r.cube.origin[k] + r.cube.size, b.cube.origin[k] + b.cube.size);
   }
-  const TriMesh m = contour(r);
+  const TriMesh m = unsplit_contour(r);
   EXPECT_TRUE(IsClosedManifold(m));
   // The box minus an eighth of the ball: 0.216 - (1/8)(4/3)pi 0.25^3.
   // A sphere that fits in A's cube is resampled into it, and A keeps its frame.
@@ -321,7 +321,7 @@ TEST(Csg, OperandsInDifferentCubesShareOneFrame) {
   const Octree r2 = csg(a, inner, CsgOp::Subtract, {}, &st);
   EXPECT_TRUE(st.resampled_b);
   EXPECT_TRUE(r2.cube == a.cube);
-  EXPECT_TRUE(IsClosedManifold(contour(r2)));
+  EXPECT_TRUE(IsClosedManifold(unsplit_contour(r2)));
   EXPECT_NEAR(volume(m), 0.216 - M_PI * 0.015625 / 6, 2e-3 * 0.216);
 }
 
@@ -343,7 +343,7 @@ TEST(Csg, CadToolMatchesTheExactSolid) {
   t = csg(t, sample_in_unit(make_cylinder(c, 0.15, 0.8, 2, seg), depth), CsgOp::Union, {}, &stats[0]);
   t = csg(t, sample_in_unit(make_cylinder(c, 0.1, 0.8, 0, seg), depth), CsgOp::Subtract, {}, &stats[1]);
   t = csg(t, sample_in_unit(make_cylinder(c, 0.07, 0.8, 1, seg), depth), CsgOp::Subtract, {}, &stats[2]);
-  const TriMesh m = contour(t);
+  const TriMesh m = unsplit_contour(t);
   ASSERT_TRUE(IsClosedManifold(m));
   EXPECT_EQ(euler_characteristic(m), -4);  // genus 3
   auto sdf = [&](const Vec3& p) {
@@ -381,7 +381,7 @@ TEST(Csg, ParallelEqualsSerial) {
   EXPECT_TRUE(serialize(serial) == serialize(parallel));
   EXPECT_EQ(serial.nodes.size(), parallel.nodes.size());
   EXPECT_TRUE(serial.vertices == parallel.vertices);
-  EXPECT_TRUE(IsClosedManifold(contour(parallel)));
+  EXPECT_TRUE(IsClosedManifold(unsplit_contour(parallel)));
 }
 
 // ---- cost follows the overlap -----------------------------------------------------------------
@@ -390,7 +390,7 @@ size_t cells_for_stroke(const Octree& object, const Vec3& at, double radius, int
   const Octree tool = sample_in_unit(make_sphere(at, radius, 64), depth);
   CsgStats st;
   Octree r = csg(object, tool, CsgOp::Subtract, {}, &st);
-  EXPECT_TRUE(IsClosedManifold(contour(r)));
+  EXPECT_TRUE(IsClosedManifold(unsplit_contour(r)));
   return st.cells_visited;
 }
 
@@ -410,7 +410,7 @@ TEST(Csg, SculptingStaysClosedAndManifold) {
     const TriMesh surface = contour(clay, plain);
     const Vec3 c = surface.positions[std::uniform_int_distribution<size_t>(0, surface.positions.size() - 1)(rng)];
     csg_inplace(clay, sample_in_unit(make_sphere(c, 0.02, 24), depth), CsgOp::Subtract);
-    const TriMesh m = contour(clay);
+    const TriMesh m = unsplit_contour(clay);
     const auto topo = analyze_topology(m);
     EXPECT_TRUE(topo.closed()) << "stroke " << stroke;
     if (!topo.manifold()) ++bad;
@@ -502,11 +502,11 @@ TEST(Csg, FandiskMinusSphereFollowsTheExactBoolean) {
   const double r = 1.0;
   const Octree b = sample(make_sphere(c, r, 256), o);
   const Octree res = csg(a, b, CsgOp::Subtract);
-  const TriMesh m = contour(res);
+  const TriMesh m = unsplit_contour(res);
   ASSERT_TRUE(IsClosedManifold(m));
   // Reference: fandisk's own contour minus the analytic sphere (the tessellation of the 256-gon
   // sphere is 7.5e-5 of its radius), in units of the root cube.
-  const TriMesh ca = contour(a);
+  const TriMesh ca = unsplit_contour(a);
   auto sd_sphere = [&](const Vec3& p) { return dist3(p, c) - r; };
   const double d = distance_to_boolean(m, ca, sd_sphere, CsgOp::Subtract, 1e-4 * o.cube->size) / o.cube->size;
   std::printf("  [measure] fandisk - sphere: %.3g of the root cube from the exact boolean\n", d);
@@ -524,17 +524,40 @@ TEST(Csg, SpotUnionTorusFollowsTheExactBoolean) {
   const Vec3 c{0.0, 0.2, 0.4};
   const double big = 0.45, small = 0.08;
   const Octree b = sample(make_torus(c, big, small, 2, 256, 64), o);
-  const TriMesh m = contour(csg(a, b, CsgOp::Union));
+  const TriMesh m = unsplit_contour(csg(a, b, CsgOp::Union));
   ASSERT_TRUE(IsClosedManifold(m));
   auto sd_torus = [&](const Vec3& p) {
     const double q = std::hypot(p[0] - c[0], p[1] - c[1]) - big;
     return std::hypot(q, p[2] - c[2]) - small;
   };
-  const TriMesh ca = contour(a);
+  const TriMesh ca = unsplit_contour(a);
   const double d = distance_to_boolean(m, ca, sd_torus, CsgOp::Union, 1e-4 * o.cube->size) / o.cube->size;
   std::printf("  [measure] spot | torus: %.3g of the root cube from the exact boolean\n", d);
   EXPECT_LT(d, 4e-4);
   EXPECT_GT(volume(m), volume(ca));
+}
+
+}  // namespace
+}  // namespace pic
+
+namespace pic {
+namespace {
+
+// csg(a, b) keeps its bookkeeping (the timestamps of paper 5.2.1) to itself: both operands
+// are left exactly as they were, so they can be shared between threads without a lock.
+TEST(Csg, LeavesItsOperandsUntouched) {
+  const Octree a = sample_in_unit(make_box({0.2, 0.2, 0.2}, {0.7, 0.7, 0.7}), 7);
+  const Octree b = sample_in_unit(make_sphere({0.6, 0.6, 0.6}, 0.25, 48), 7);
+  const std::vector<uint8_t> bytes_a = serialize(a), bytes_b = serialize(b);
+  const size_t nodes_a = a.nodes.size(), nodes_b = b.nodes.size();
+  for (CsgOp op : {CsgOp::Union, CsgOp::Intersect, CsgOp::Subtract}) {
+    const Octree r = csg(a, b, op);
+    EXPECT_GT(r.vertices.size(), 0u);
+  }
+  EXPECT_EQ(a.nodes.size(), nodes_a);
+  EXPECT_EQ(b.nodes.size(), nodes_b);
+  EXPECT_TRUE(serialize(a) == bytes_a);
+  EXPECT_TRUE(serialize(b) == bytes_b);
 }
 
 }  // namespace

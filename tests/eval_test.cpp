@@ -35,7 +35,7 @@ Result eval_file(const std::string& name, int depth = 8) {
   o.depth = depth;
   const Octree t = eval_csg_file(kData / name, o);
   Result r;
-  r.mesh = contour(t);
+  r.mesh = unsplit_contour(t);
   split_nonmanifold(r.mesh);
   r.volume = volume(r.mesh);
   r.cell = t.cube.size / double(1 << depth);
@@ -116,7 +116,7 @@ TEST(Eval, SmoothSphereIsCloserToTheTrueSphere) {
   o.depth = 7;
   o.smooth = true;
   const Octree t = eval_csg("sphere($fn = 0, $fa = 12, $fs = 2, r = 1);", o);
-  const double v = volume(contour(t)), exact = 4.0 / 3 * std::numbers::pi;
+  const double v = volume(unsplit_contour(t)), exact = 4.0 / 3 * std::numbers::pi;
   EXPECT_NEAR(v, exact, 0.01 * exact);  // the $fa/$fs sphere (5 fragments) is far smaller
   o.smooth = false;
   const double coarse = volume(contour(eval_csg("sphere($fn = 0, $fa = 12, $fs = 2, r = 1);", o)));
@@ -154,7 +154,7 @@ TEST(EvalCli, WritesMeshAndPic) {
                     " --depth 7",
                 dir.path()),
             0);
-  EXPECT_NEAR(volume(contour(load(dir / "a.pic"))), 3 * std::sqrt(3.0), 0.01);
+  EXPECT_NEAR(volume(unsplit_contour(load(dir / "a.pic"))), 3 * std::sqrt(3.0), 0.01);
 }
 
 TEST(EvalCli, UnsupportedNodeExits2WithOneLine) {
@@ -192,7 +192,7 @@ TEST(EvalCli, ScadThroughOpenscad) {
   }
   EvalOptions o;
   o.depth = 7;
-  const TriMesh m = contour(eval_scad(dir / "part.scad", o));
+  const TriMesh m = unsplit_contour(eval_scad(dir / "part.scad", o));
   // A $fn = 4 cylinder of radius 2 is a square of diagonal 4: area 8.
   EXPECT_NEAR(volume(m), 1000 - 8 * 10, 0.5);
   EXPECT_FALSE(fs::exists(dir / "part.csg"));  // the export goes to a temporary directory

@@ -122,7 +122,7 @@ TEST(MeshIo, HandWrittenAsciiStlIsWelded) {
   // And it samples.
   SampleOptions o;
   o.depth = 6;
-  const TriMesh c = contour(sample(m, o));
+  const TriMesh c = unsplit_contour(sample(m, o));
   EXPECT_TRUE(IsClosedManifold(c));
   EXPECT_NEAR(volume(c), 1.0 / 6, 1e-3);
 }
@@ -264,7 +264,7 @@ TEST(MeshIo, DegenerateTrianglesAreToleratedBySampling) {
   o.depth = 8;
   o.cube = Cube{{0, 0, 0}, 1};
   SampleStats st;
-  const TriMesh c = contour(sample(box, o, &st));
+  const TriMesh c = unsplit_contour(sample(box, o, &st));
   ASSERT_TRUE(IsClosedManifold(c));
   EXPECT_NEAR(volume(c), v, 1e-6 * v);
   EXPECT_EQ(st.capped, 0u);
@@ -281,7 +281,7 @@ TEST(MeshIo, DegenerateFacesInAFileAreTolerated) {
   const TriMesh m = read_mesh(dir / "box.obj");
   SampleOptions o;
   o.depth = 7;
-  const TriMesh c = contour(sample(m, o));
+  const TriMesh c = unsplit_contour(sample(m, o));
   ASSERT_TRUE(IsClosedManifold(c));
   EXPECT_NEAR(volume(c), 1.0, 1e-6);
 }

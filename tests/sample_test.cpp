@@ -35,7 +35,7 @@ Sampled sample_and_contour(const TriMesh& in, int depth, std::optional<Cube> cub
   o.depth = depth;
   o.cube = cube;
   s.tree = sample(in, o, &s.stats);
-  s.out = contour(s.tree);
+  s.out = unsplit_contour(s.tree);
   s.volume_in = volume(in);
   s.volume_out = volume(s.out);
   if (distance) s.hausdorff = test::two_sided_distance(s.out, in) / s.tree.cube.size;
@@ -260,7 +260,7 @@ TEST(Sample, InsideOutMeshGivesTheSameSolid) {
   SampleOptions o;
   o.depth = 8;
   o.cube = Cube{{0, 0, 0}, 1};
-  const TriMesh out = contour(sample(m, o));
+  const TriMesh out = unsplit_contour(sample(m, o));
   ASSERT_TRUE(IsClosedManifold(out));
   EXPECT_NEAR(volume(out), v, 5e-3 * v);
 }

@@ -107,7 +107,7 @@ TEST(SelfIntersect, ClosedPrimitivesAreClean) {
 }
 
 TriMesh written(const Octree& t) {
-  TriMesh m = contour(t);
+  TriMesh m = unsplit_contour(t);
   split_nonmanifold(m);
   return m;
 }
@@ -118,11 +118,15 @@ struct TwoContours {
   ContourStats stats;
 };
 TwoContours fast_and_default(const Octree& t) {
+  // Sheets not split apart: the two meshes then have the same vertices, in the same order.
   ContourOptions fast;
   fast.intersection_free = false;
+  fast.split_sheets = false;
+  ContourOptions clean;
+  clean.split_sheets = false;
   TwoContours r;
   r.plain = contour(t, fast);
-  r.clean = contour(t, ContourOptions{}, &r.stats);
+  r.clean = contour(t, clean, &r.stats);
   return r;
 }
 
@@ -190,7 +194,7 @@ TEST(Validity, SculptingRunStaysValid) {
   Octree clay = sample_in(make_box({0.1, 0.25, 0.42}, {0.9, 0.75, 0.58}), depth);
   std::mt19937_64 rng(7);
   for (int stroke = 0; stroke < 30; ++stroke) {
-    const TriMesh surface = contour(clay);
+    const TriMesh surface = unsplit_contour(clay);
     const Vec3 c = surface.positions[std::uniform_int_distribution<size_t>(0, surface.positions.size() - 1)(rng)];
     csg_inplace(clay, sample_in(make_sphere(c, 0.03, 24), depth), CsgOp::Subtract);
   }

@@ -2,7 +2,7 @@
 // and benchmarks).
 #pragma once
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic {
 

@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/octree.h"
 
 namespace pic {
 

@@ -8,7 +8,7 @@
 #include <functional>
 #include <string>
 
-#include "pic/pic.h"
+#include "pic/octree.h"
 
 namespace pic {
 

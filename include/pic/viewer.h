@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "pic/pic.h"
+#include "pic/octree.h"
 
 namespace pic {
 

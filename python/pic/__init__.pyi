@@ -1,6 +1,6 @@
 """PIC: solids as points with implicit connectivity (type stubs for the `pic` module)."""
 import os
-from typing import Any, Optional, Sequence, Tuple, Union, overload
+from typing import Any, NamedTuple, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -16,7 +16,14 @@ Vertices = npt.NDArray[np.float64]
 """(n, 3) float64 positions."""
 Faces = npt.NDArray[np.int64]
 """(m, 3) int64 vertex indices, counter-clockwise seen from outside."""
-Mesh = Tuple[Vertices, Faces]
+class Mesh(NamedTuple):
+    """A triangle mesh (vertices, faces): a tuple, so ``v, f = pic.read_mesh(p)`` works, and
+    ``mesh.vertices`` too. pic.sample and pic.csg_meshes take it as one argument."""
+    vertices: Vertices
+    faces: Faces
+
+MeshLike = Any
+"""A Mesh, a (vertices, faces) tuple with integer faces, or anything with .vertices and .faces."""
 ArrayLike = npt.ArrayLike
 """Inputs: (n, 3) arrays of float32/float64 (vertices) or int32/int64 (faces), or nested lists."""
 
@@ -84,7 +91,7 @@ class Octree:
 def sample(input: PathLike, *, depth: int = 12, error: float = 1e-8, cube: Optional[Sequence[float]] = None,
            inside: str = "auto", parallel: bool = True, margin: float = 1 / 16) -> Octree: ...
 @overload
-def sample(input: Tuple[ArrayLike, ArrayLike], *, depth: int = 12, error: float = 1e-8,
+def sample(input: MeshLike, *, depth: int = 12, error: float = 1e-8,
            cube: Optional[Sequence[float]] = None, inside: str = "auto", parallel: bool = True,
            margin: float = 1 / 16) -> Octree: ...
 @overload
@@ -96,13 +103,26 @@ def sample(input: Any, faces: Any = None, depth: int = 12, error: float = 1e-8,
            margin: float = 1 / 16) -> Octree:
     """Adaptively samples a solid into a PIC object (pic::sample).
 
-    input: (n, 3) vertices with faces (m, 3); or a path to a mesh (obj, stl, ply, off, gltf,
-    glb) or point cloud (ply with normals, xyz); or a tuple (points, normals), an oriented
-    point cloud. depth: maximum level (1..MAX_LEVEL). error: QEF residual threshold in
+    input: (n, 3) vertices with faces (m, 3); or one mesh (pic.Mesh as read_mesh returns it,
+    a (vertices, faces) tuple, anything with .vertices and .faces); or a path to a mesh (obj,
+    stl, ply, off, gltf, glb) or point cloud (ply with normals, xyz). Arrays of points go
+    through sample_points (a (points, normals) tuple still works, deprecated). depth: maximum level (1..MAX_LEVEL). error: QEF residual threshold in
     root-cube units squared. cube: (x, y, z, size), default the bounding cube plus `margin`
     of the extent; share one between CSG operands. inside: 'auto', 'parity', 'winding'.
     Raises ValueError for bad input, OSError for an unreadable file. The GIL is released.
     """
+
+def sample_points(points: ArrayLike, normals: ArrayLike, depth: int = 12, error: float = 1e-8,
+                  cube: Optional[Sequence[float]] = None, parallel: bool = True,
+                  margin: float = 1 / 16) -> Octree:
+    """Samples an oriented point cloud (normals pointing out of the solid) into a PIC object.
+    The depth stops where a cell is half the points' spacing (stats['depth_used'])."""
+
+def csg_meshes(*args: Any, depth: int = 12, error: float = 1e-8, parallel: bool = True,
+               cube: Optional[Sequence[float]] = None) -> Octree:
+    """Booleans left to right: csg_meshes(a, 'subtract', b [, 'union', c ...]). Operands are
+    meshes (MeshLike), mesh paths or Octrees; meshes are sampled into one cube around all of
+    them, as `pic csg` does. stats['steps'] hold each Boolean's statistics."""
 
 def bounding_cube(vertices: ArrayLike, margin: float = 1 / 16) -> Cube:
     """The automatic root cube around points (bounding cube plus margin of the extent)."""
@@ -138,11 +158,12 @@ def eval_csg(text: str, depth: int = 12, error: float = 1e-8, smooth: bool = Fal
 def read_mesh(path: PathLike) -> Mesh:
     """Reads OBJ, STL, PLY, OFF, glTF/GLB, duplicate vertices welded. Raises OSError, ValueError."""
 
-def write_mesh(vertices: ArrayLike, faces: ArrayLike, path: PathLike) -> None:
-    """Writes a mesh; format from the extension (obj, stl, ply, off, glb); atomic. Raises OSError."""
+def write_mesh(mesh_or_vertices: Any, faces_or_path: Any, path: Optional[PathLike] = None) -> None:
+    """write_mesh(mesh, path) or write_mesh(vertices, faces, path); format from the extension,
+    written atomically. Raises OSError."""
 
-def volume(vertices: ArrayLike, faces: ArrayLike) -> float:
-    """Signed volume of a mesh (positive for outward orientation)."""
+def volume(mesh_or_vertices: Any, faces: Optional[ArrayLike] = None) -> float:
+    """volume(mesh) or volume(vertices, faces): signed volume (positive for outward orientation)."""
 
 def check_validity(vertices: ArrayLike, faces: ArrayLike, self_intersections: bool = True) -> dict[str, Any]:
     """Validity as a solid's boundary (pic::check_validity): 'valid' and the counts."""

@@ -293,8 +293,6 @@ Vec3 fan_point(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Ve
 
 namespace pic {
 
-TriMesh contour(const Octree& tree) { return contour(tree, ContourOptions{}); }
-
 TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats* stats) {
   using namespace detail;
   const bool split = tree.nodes[0].kind == CellKind::Internal;
@@ -360,6 +358,8 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
     stats->remaining_intersections = ts.remaining_intersections;
     stats->rounds = ts.rounds;
   }
+  const size_t split_vertices = options.split_sheets ? split_nonmanifold(out) : 0;
+  if (stats) stats->split_vertices = split_vertices;
   return out;
 }
 

@@ -1,7 +1,7 @@
 // The CSG clean-up: see csg_cleanup.h.
 #include "csg/cleanup.h"
 
-#include "signs/passes.h"
+#include "signs/settle.h"
 
 namespace pic::detail {
 namespace {
@@ -132,10 +132,10 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
 
 }  // namespace
 
-void clean_up(Octree& a, CsgOp op, uint32_t stamp, const std::vector<SignHint>& hints,
+void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
               const std::function<bool(const Lat&)>& sign_b, CsgStats& stats) {
-  std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return a.stamps[n] == stamp; };
-  std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { a.stamps[n] = stamp; };
+  std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return stamps[n] == stamp; };
+  std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { stamps[n] = stamp; };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
   // for coarse neighbours that finer sign changes contradict (issue 10's slit).
   withdraw_crack_repairs(a, 0, stamped);
@@ -143,16 +143,15 @@ void clean_up(Octree& a, CsgOp op, uint32_t stamp, const std::vector<SignHint>& 
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
   apply_sign_hints(a, hints, stamped, pinned);
-  for (int round = 0; round < 4; ++round) {
-    const size_t islands = remove_islands(a, &stamped, &stamp_it, &pinned);
-    if (enforce_one_component(a, &stamped, &stamp_it, &pinned, true).flipped == 0 && (islands == 0 || round > 0)) break;
-  }
+  SettlePlan plan;
+  plan.active = &stamped;
+  plan.touched = &stamp_it;
+  plan.spare_coarse = true;
   // Specks the Boolean made (where the two operands' surfaces pass within a fraction of a
   // cell of each other); one operand's own small components stay.
-  SpeckSearch search;
-  search.coarse_rim = true;
-  remove_specks(a, &stamped, [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); }, search);
-  stats.repaired = repair_cracks(a, &stamped);
+  plan.keep_speck = [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); };
+  plan.specks.coarse_rim = true;
+  stats.repaired = settle(a, plan, pinned);
 }
 
 }  // namespace pic::detail

@@ -11,9 +11,13 @@
 #include <functional>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/csg.h"
 
 namespace pic::detail {
+
+/// Per node of a tree: the timestamp of the last operation that worked on it (paper 5.2.1).
+/// A CSG operation's own bookkeeping: never part of an octree.
+using Stamps = std::vector<uint32_t>;
 
 /// A lattice point whose sign the clean-up should set to `inside` (see sign_hint in csg.cpp).
 struct SignHint {
@@ -21,11 +25,11 @@ struct SignHint {
   bool inside;
 };
 
-/// Clean-up of the leaves whose stamp is `stamp` after `a op b` was combined into `a`: crack
+/// Clean-up of the leaves whose `stamps` entry is `stamp` after `a op b` was combined into `a`: crack
 /// repairs withdrawn and redone, sign hints applied, islands and leaves of more than one
 /// component removed, and specks the Boolean made absorbed (`sign_b`: B's sign at a lattice
 /// point, to tell those from B's own small components). Sets stats.repaired.
-void clean_up(Octree& a, CsgOp op, uint32_t stamp, const std::vector<SignHint>& hints,
+void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
               const std::function<bool(const std::array<int64_t, 3>&)>& sign_b, CsgStats& stats);
 
 }  // namespace pic::detail

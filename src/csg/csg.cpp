@@ -8,7 +8,7 @@
 //                               edge_verdict, surfaces_meet, feature_is_local, ...), forced
 //                               subdivision (resampling a leaf's partial contour), writing
 //                               through a FragmentWriter
-//   csg_cleanup.h               sign hints, islands, one component per leaf, specks, crack
+//   cleanup.h                   sign hints, islands, one component per leaf, specks, crack
 //                               repair on the stamped part of the result
 //
 // Topology comes from signs alone: each operand's sign is a single-valued function of the
@@ -130,12 +130,13 @@ struct Operand {
   SignMemo memo;                                                  // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
+  const Stamps& stamps;  // per node of t: the operation's stamp where it stamped it
   uint32_t stamp = 0;
 
-  Operand(const Octree& tree, const PartialContour& contour, uint32_t op_stamp)
+  Operand(const Octree& tree, const Stamps& tree_stamps, const PartialContour& contour, uint32_t op_stamp)
       : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
         parity_tris(contour.wider() ? contour.parity_tris : contour.tris),
-        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamp(op_stamp) {}
+        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamps(tree_stamps), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -212,7 +213,7 @@ struct Operand {
       if (!contains(cc, p)) continue;
       const Hit h = find(n.index + c, cc, p);
       if (h.state == 1) return h;
-      if (h.state == 2 && (gray.state == 0 || (t.stamps[gray.leaf] != stamp && t.stamps[h.leaf] == stamp)))
+      if (h.state == 2 && (gray.state == 0 || (stamps[gray.leaf] != stamp && stamps[h.leaf] == stamp)))
         gray = h;
     }
     return gray;
@@ -770,7 +771,7 @@ class Combiner {
     std::array<Fragment, 8> frags;
     std::array<CombineCounts, 8> sub_stats;
     auto task = [&](int c) {
-      Operand ca(a_.t, a_.pc, stamp_), cb(b_.t, b_.pc, stamp_);
+      Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
       Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
       kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c), child_side(cb, b, cell, c));
     };
@@ -859,19 +860,19 @@ struct Deferred {
 /// Stamps the overlap: pairs of cells where neither operand is uniform (paper 5.2.1). Where a
 /// gray leaf of A covers a subtree of B, B's subtree is not stamped yet: `deferred` keeps it
 /// for stamp_under_surface(), which stamps only the parts A's surface comes near.
-void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
-         size_t& count, std::vector<Deferred>& deferred) {
+void tag(const Octree& a, Stamps& sa, uint32_t na, const Octree& b, Stamps& sb, uint32_t nb, const Cell& cell,
+         uint32_t stamp, size_t& count, std::vector<Deferred>& deferred) {
   const Node& x = a.nodes[na];
   const Node& y = b.nodes[nb];
   const bool ux = x.kind == CellKind::White || x.kind == CellKind::Black;
   const bool uy = y.kind == CellKind::White || y.kind == CellKind::Black;
   if (ux || uy) return;
-  if (a.stamps[na] != stamp) {
-    a.stamps[na] = stamp;
+  if (sa[na] != stamp) {
+    sa[na] = stamp;
     ++count;
   }
-  if (b.stamps[nb] != stamp) {
-    b.stamps[nb] = stamp;
+  if (sb[nb] != stamp) {
+    sb[nb] = stamp;
     ++count;
   }
   if (x.kind != CellKind::Internal && y.kind != CellKind::Internal) return;
@@ -880,27 +881,28 @@ void tag(const Octree& a, uint32_t na, const Octree& b, uint32_t nb, const Cell&
     return;
   }
   for (int c = 0; c < 8; ++c)
-    tag(a, x.index + c, b, y.kind == CellKind::Internal ? y.index + c : nb, cell.child(c), stamp, count, deferred);
+    tag(a, sa, x.index + c, b, sb, y.kind == CellKind::Internal ? y.index + c : nb, cell.child(c), stamp, count,
+        deferred);
 }
 
 /// Stamps the cells of B's subtree that A's partial contour comes near: elsewhere A is
 /// uniform inside its gray leaf, so the result there is B's subtree or uniform, with no need
 /// for B's partial contour. This makes the cost of a coarse clay against a fine tool follow
 /// the clay's surface, not the tool's whole volume.
-void stamp_under_surface(const PartialContour& a, const Octree& b, uint32_t nb, const Cell& cell, uint32_t stamp,
-                         size_t& count, std::vector<uint32_t>& scratch) {
+void stamp_under_surface(const PartialContour& a, const Octree& b, Stamps& sb, uint32_t nb, const Cell& cell,
+                         uint32_t stamp, size_t& count, std::vector<uint32_t>& scratch) {
   const Node& y = b.nodes[nb];
   if (y.kind == CellKind::White || y.kind == CellKind::Black) return;
   const IBox box = cell.box();
   scratch.clear();
   a.bvh.query(a.tris, box.lo, box.hi, scratch);
   if (scratch.empty()) return;
-  if (b.stamps[nb] != stamp) {
-    b.stamps[nb] = stamp;
+  if (sb[nb] != stamp) {
+    sb[nb] = stamp;
     ++count;
   }
   if (y.kind == CellKind::Internal)
-    for (int c = 0; c < 8; ++c) stamp_under_surface(a, b, y.index + c, cell.child(c), stamp, count, scratch);
+    for (int c = 0; c < 8; ++c) stamp_under_surface(a, b, sb, y.index + c, cell.child(c), stamp, count, scratch);
 }
 
 /// Marks `node` and every node below it whose closed cell meets an edge of the lattice box
@@ -929,10 +931,10 @@ void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const
 /// harness seed 81). Only cells at the leaf's edges matter: a polygon's vertices lie in their
 /// cells, and cells that touch only the inside of one face all lie beyond that face's plane,
 /// and so do their polygons.
-std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, uint32_t stamp) {
+std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, const Stamps& stamps, uint32_t stamp) {
   std::unordered_set<uint32_t> out;
   std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
-    if (t.stamps[node] != stamp) return;
+    if (stamps[node] != stamp) return;
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
@@ -947,15 +949,15 @@ std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, uint32_t stam
 /// The partial contour: dual polygons around stamped cells, indexed for box queries; for the
 /// parity walks also those around the edges of stamped coarse leaves. One walk: a polygon
 /// with a stamped leaf is the operation's own.
-void partial_contour(const Octree& t, uint32_t stamp, PartialContour& x) {
-  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamp);
+void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x) {
+  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamps, stamp);
   const std::function<bool(uint32_t)> active = [&](uint32_t n) {
-    return t.stamps[n] == stamp || around.count(n) != 0;
+    return stamps[n] == stamp || around.count(n) != 0;
   };
   std::vector<ITri> extra;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
     bool own = false;
-    for (int k = 0; k < poly.count; ++k) own = own || t.stamps[poly.leaf[k]] == stamp;
+    for (int k = 0; k < poly.count; ++k) own = own || stamps[poly.leaf[k]] == stamp;
     std::vector<ITri>& out = own ? x.tris : extra;
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
@@ -984,7 +986,6 @@ void compact(Octree& t) {
   c.nodes.clear();
   c.nodes.reserve(t.nodes.size());
   c.nodes.push_back(Node{});
-  c.stamps.assign(1, t.stamps.empty() ? 0 : t.stamps[0]);
   std::function<void(uint32_t, uint32_t)> copy = [&](uint32_t from, uint32_t to) {
     Node n = t.nodes[from];
     if (n.kind == CellKind::Gray) {
@@ -993,11 +994,7 @@ void compact(Octree& t) {
     } else if (n.kind == CellKind::Internal) {
       const auto first = static_cast<uint32_t>(c.nodes.size());
       c.nodes.resize(first + 8);
-      c.stamps.resize(first + 8, 0);
-      for (int k = 0; k < 8; ++k) {
-        c.stamps[first + k] = t.stamps[n.index + k];
-        copy(n.index + k, first + k);
-      }
+      for (int k = 0; k < 8; ++k) copy(n.index + k, first + k);
       n.index = first;
     }
     c.nodes[to] = n;
@@ -1005,7 +1002,6 @@ void compact(Octree& t) {
   copy(0, 0);
   t.nodes = std::move(c.nodes);
   t.vertices = std::move(c.vertices);
-  t.stamps = std::move(c.stamps);
 }
 
 /// One frame: B re-expressed in A's cube when they differ (its contour resampled). When B's
@@ -1018,7 +1014,7 @@ std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptio
     so.cube = a.cube;
     so.depth = std::max(a.max_depth, b_in.max_depth);
     so.error = options.error;
-    const TriMesh mb = contour(b_in);
+    const TriMesh mb = unsplit_contour(b_in);
     try {
       resampled = sample(mb, so);
     } catch (const InvalidInput&) {
@@ -1031,9 +1027,9 @@ std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptio
       }
       both.size = hi;
       so.cube = both;
-      const TriMesh ma = contour(a);
+      const TriMesh ma = unsplit_contour(a);
       if (!ma.triangles.empty()) a = sample(ma, so);
-      else a = Octree{both, so.depth, {Node{}}, {}, {}};
+      else a = Octree{both, so.depth, {Node{}}, {}};
       resampled = sample(mb, so);
     }
     stats.resampled_b = true;
@@ -1045,15 +1041,15 @@ std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptio
 
 /// Stamps the cells where the operands' surfaces may meet (tag, then stamp_under_surface for
 /// the subtrees of B it deferred) and builds both operands' partial contours.
-void stamp_overlap(Octree& a, const Octree& b, uint32_t stamp, PartialContour& pa, PartialContour& pb,
-                   CsgStats& stats) {
-  if (a.stamps.size() != a.nodes.size()) a.stamps.resize(a.nodes.size(), 0);
-  if (b.stamps.size() != b.nodes.size()) b.stamps.resize(b.nodes.size(), 0);
+void stamp_overlap(const Octree& a, Stamps& sa, const Octree& b, Stamps& sb, uint32_t stamp, PartialContour& pa,
+                   PartialContour& pb, CsgStats& stats) {
+  sa.assign(a.nodes.size(), 0);
+  sb.assign(b.nodes.size(), 0);
   std::vector<Deferred> deferred;
-  tag(a, 0, b, 0, Cell{}, stamp, stats.cells_stamped, deferred);
+  tag(a, sa, 0, b, sb, 0, Cell{}, stamp, stats.cells_stamped, deferred);
 
   auto tc = Clock::now();
-  partial_contour(a, stamp, pa);
+  partial_contour(a, sa, stamp, pa);
   stats.contour_a_seconds = since(tc);
   tc = Clock::now();
   {
@@ -1061,19 +1057,20 @@ void stamp_overlap(Octree& a, const Octree& b, uint32_t stamp, PartialContour& p
     for (const Deferred& d : deferred) {
       const Node& y = b.nodes[d.b_node];
       for (int c = 0; c < 8; ++c)
-        stamp_under_surface(pa, b, y.index + c, d.cell.child(c), stamp, stats.cells_stamped, scratch);
+        stamp_under_surface(pa, b, sb, y.index + c, d.cell.child(c), stamp, stats.cells_stamped, scratch);
     }
   }
-  partial_contour(b, stamp, pb);
+  partial_contour(b, sb, stamp, pb);
   stats.contour_b_seconds = since(tc);
 }
 
 /// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
 /// A's, and A's own slots are written only once all tasks are done.
-std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialContour& pa, const PartialContour& pb,
-                                      CsgOp op, const CsgOptions& options, int depth, uint32_t stamp, CsgStats& stats) {
+std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, const Stamps& sb, const PartialContour& pa,
+                                      const PartialContour& pb, CsgOp op, const CsgOptions& options, int depth,
+                                      uint32_t stamp, CsgStats& stats) {
   Fragment f;
-  Operand oa(a, pa, stamp), ob(b, pb, stamp);
+  Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
   CombineCounts counts;
   Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
   const Node root = comb.run();
@@ -1083,7 +1080,7 @@ std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialC
   const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
   for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
   a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
-  a.stamps.resize(a.nodes.size(), stamp);
+  sa.resize(a.nodes.size(), stamp);
   // A slot written here is part of the result this operation made, even where the tag step
   // left it unstamped (A uniform there, B's subtree copied in): the clean-up must see it, or
   // B's own defects there pass into the result unchecked (an island a sampled tool carries —
@@ -1091,7 +1088,7 @@ std::vector<SignHint> combine_stamped(Octree& a, const Octree& b, const PartialC
   // stroke's pinched vertex). Cleaning these parts too costs sculpting about 2-3 ms a stroke.
   for (const auto& [slot, n] : f.pending) {
     a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
-    a.stamps[slot] = stamp;
+    sa[slot] = stamp;
   }
   a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
   return std::move(f.hints);
@@ -1112,6 +1109,22 @@ size_t reachable_nodes(const Octree& t) {
 
 }  // namespace detail
 
+std::string to_string(CsgOp op) {
+  switch (op) {
+    case CsgOp::Union: return "union";
+    case CsgOp::Intersect: return "intersect";
+    case CsgOp::Subtract: return "subtract";
+  }
+  return "?";
+}
+
+std::optional<CsgOp> parse_csg_op(const std::string& s) {
+  if (s == "union" || s == "add") return CsgOp::Union;
+  if (s == "intersect" || s == "intersection") return CsgOp::Intersect;
+  if (s == "subtract" || s == "difference" || s == "minus") return CsgOp::Subtract;
+  return std::nullopt;
+}
+
 void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& options, CsgStats* stats_out) {
   using namespace detail;
   const auto t0 = Clock::now();
@@ -1122,17 +1135,20 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
 
   const uint32_t stamp = ++g_timestamp;
   stats.stamp = stamp;
+  // The cells this operation works on, per node of each operand: kept here, not in the
+  // trees, so that csg(a, b) only reads b.
+  Stamps sa, sb;
   PartialContour pa, pb;
-  stamp_overlap(a, b, stamp, pa, pb, stats);
+  stamp_overlap(a, sa, b, sb, stamp, pa, pb, stats);
 
   const auto tc = Clock::now();
   const size_t before = a.nodes.size();
-  const std::vector<SignHint> hints = combine_stamped(a, b, pa, pb, op, options, depth, stamp, stats);
+  const std::vector<SignHint> hints = combine_stamped(a, sa, b, sb, pa, pb, op, options, depth, stamp, stats);
   a.max_depth = depth;
   const auto tclean = Clock::now();
   {
-    Operand ob(b, pb, stamp);
-    clean_up(a, op, stamp, hints, [&](const Lat& p) { return ob.sign(p); }, stats);
+    Operand ob(b, sb, pb, stamp);
+    clean_up(a, sa, stamp, op, hints, [&](const Lat& p) { return ob.sign(p); }, stats);
   }
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);

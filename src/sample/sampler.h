@@ -10,6 +10,7 @@
 #include "geometry/lattice.h"
 #include "octree/cell.h"
 #include "geometry/qef.h"
+#include "octree/cell_vertex.h"
 
 namespace pic::detail {
 
@@ -124,11 +125,6 @@ void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
 void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
                  std::vector<uint32_t>& out);
 
-/// The vertex of a gray cell: QEF minimum seeded at the centre, then at the corner with the
-/// smallest error when the first solution leaves the cell (paper Figure 2). With no planes at
-/// all, the mass point of the sign-changing edges' midpoints.
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs);
-bool inside_cell(const Vec3& x, const Cell& cell);
 
 /// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`. `wind`:
 /// the corners' winding numbers, for a source that tracks_winding.

@@ -669,7 +669,7 @@ class Evaluator {
           pts.clear();
           auto u = balanced(s.children, 0, s.children.size(), CsgOp::Union);
           if (!u) return std::nullopt;
-          pts = contour(*u).positions;
+          pts = unsplit_contour(*u).positions;
         }
         TriMesh h = detail::scad::convex_hull(pts);
         if (h.triangles.empty()) return std::nullopt;

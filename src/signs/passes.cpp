@@ -1,7 +1,7 @@
 #include "signs/passes.h"
 
 #include "contour/dual_walk.h"
-#include "sample/sampler.h"
+#include "octree/cell_vertex.h"
 #include "geometry/union_find.h"
 
 #include <Eigen/Dense>

@@ -249,7 +249,7 @@ def test_point_cloud(tmp_path):
     r = np.sqrt(1 - z * z)
     phi = i * math.pi * (3 - math.sqrt(5))
     p = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1).astype(np.float32)
-    t = pic.sample((p, p), depth=6)
+    t = pic.sample_points(p, p, depth=6)
     assert t.stats["inside"] == "points" and t.stats["points_in"] == n
     v, f = t.contour()
     assert mesh_volume(v, f) == pytest.approx(4 / 3 * math.pi, rel=0.05)
@@ -257,11 +257,65 @@ def test_point_cloud(tmp_path):
     xyz = tmp_path / "sphere.xyz"
     p64 = p.astype(np.float64)
     xyz.write_text("".join(f"{a!r} {b!r} {c!r} {a!r} {b!r} {c!r}\n" for a, b, c in p64.tolist()))
-    assert pic.sample(xyz, depth=6).serialize() == pic.sample((p64, p64), depth=6).serialize()
+    assert pic.sample(xyz, depth=6).serialize() == pic.sample_points(p64, p64, depth=6).serialize()
+    # The old spelling still works, with a warning.
+    with pytest.warns(DeprecationWarning, match="sample_points"):
+        assert pic.sample((p64, p64), depth=6).serialize() == pic.sample_points(p64, p64, depth=6).serialize()
     with pytest.raises(ValueError, match="differ in length"):
-        pic.sample((p, p[:-1]))
+        pic.sample_points(p, p[:-1])
     with pytest.raises(ValueError, match=r"normals must be an \(n, 3\) array"):
-        pic.sample((p, p[:, :2]))
+        pic.sample_points(p, p[:, :2])
+
+
+# --- composing: meshes as one value, Booleans of meshes ----------------------------------------
+
+
+def test_sample_takes_a_mesh_value():
+    mesh = pic.read_mesh(DATA / "fandisk.obj")
+    assert isinstance(mesh, pic.Mesh) and isinstance(mesh, tuple)
+    v, f = mesh  # still unpacks
+    ref = pic.sample(v, f, depth=7).serialize()
+    assert pic.sample(mesh, depth=7).serialize() == ref
+    assert pic.sample((v, f), depth=7).serialize() == ref
+
+    class TrimeshLike:  # what trimesh users pass: .vertices and .faces
+        vertices = v
+        faces = f.astype(np.int32)
+
+    assert pic.sample(TrimeshLike(), depth=7).serialize() == ref
+    # A (vertices, faces) tuple whose counts happen to be equal is still a mesh, not a cloud.
+    tet_v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    tet_f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    t = pic.sample((tet_v, tet_f), depth=6)
+    assert t.stats["inside"] == "parity" and t.stats["triangles_in"] == 4
+    assert mesh_volume(*t.contour()) == pytest.approx(1 / 6, rel=0.02)
+
+
+def test_csg_meshes_picks_the_shared_cube():
+    model = pic.read_mesh(DATA / "fandisk.obj")
+    lo, hi = model.vertices.min(axis=0), model.vertices.max(axis=0)
+    centre = (lo + hi) / 2
+    drill = pic.make_cylinder(tuple(centre), 0.15 * (hi - lo).min(), 2 * (hi - lo).max(), axis=0)
+    holed = pic.csg_meshes(model, "subtract", drill, depth=8)
+    v, f = holed.contour()
+    assert edges_closed_manifold(f)
+    whole = mesh_volume(*pic.sample(model, depth=8).contour())
+    assert 0.5 * whole < mesh_volume(v, f) < 0.99 * whole
+    assert len(holed.stats["steps"]) == 1 and holed.stats["steps"][0]["op"] == "subtract"
+    # Octrees and meshes mix; bad chains are refused.
+    again = pic.csg_meshes(pic.sample(model, depth=8, cube=pic.bounding_cube(np.vstack([model.vertices, drill.vertices]))),
+                           "subtract", drill, depth=8)
+    assert again.serialize() == holed.serialize()
+    with pytest.raises(ValueError, match="alternate"):
+        pic.csg_meshes(model, "subtract")
+
+
+@needs_cli
+def test_csg_meshes_same_bytes_as_cli(tmp_path):
+    a, b = DATA / "spot.obj", DATA / "suzanne.obj"
+    cli("csg", a, "subtract", b, "--depth", 7, "-o", tmp_path / "r.pic")
+    r = pic.csg_meshes(pic.read_mesh(a), "subtract", str(b), depth=7)
+    assert r.serialize() == (tmp_path / "r.pic").read_bytes()
 
 
 # --- errors ------------------------------------------------------------------------------------
@@ -408,6 +462,18 @@ def test_example_subtract_cylinder(tmp_path):
     assert pic.check_validity(v, f, self_intersections=False)["boundary_edges"] == 0
 
 
+def test_readme_example_runs_as_written(tmp_path):
+    """The README's Python block, run as it is written (data/ beside it)."""
+    readme = (HERE.parents[1] / "README.md").read_text()
+    code = readme.split("```python\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "data").mkdir()
+    shutil.copy(DATA / "spot.obj", tmp_path / "data" / "spot.obj")
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, check=True, capture_output=True, text=True)
+    assert out.stdout.split()[-1] == "True"
+    v, f = pic.read_mesh(tmp_path / "spot_holed.obj")
+    assert edges_closed_manifold(f)
+
+
 # --- the type stubs ----------------------------------------------------------------------------
 
 
@@ -419,7 +485,7 @@ def test_stubs_cover_the_module():
     funcs = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
     octree = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Octree")
     members = {n.name for n in octree.body if isinstance(n, ast.FunctionDef)}
-    public = {n for n in dir(pic) if not n.startswith("_") and callable(getattr(pic, n)) and n != "Octree"}
+    public = {n for n in dir(pic) if not n.startswith("_") and callable(getattr(pic, n)) and n not in ("Octree", "Mesh")}
     assert funcs == public
     octree_public = {n for n in dir(pic.Octree) if not n.startswith("_")} | {
         n for n in ("__or__", "__and__", "__sub__", "__ior__", "__iand__", "__isub__") if hasattr(pic.Octree, n)}

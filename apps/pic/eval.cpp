@@ -1,0 +1,75 @@
+// pic eval: an OpenSCAD model (.scad through openscad, or its .csg export) -> a PIC object.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "cli.h"
+
+namespace pic::cli {
+
+namespace {
+struct EvalArgs {
+  std::string in, out;
+  int depth = 12;
+  double error = 1e-8;
+  bool smooth = false, json = false, serial = false, no_split = false;
+};
+
+void run(const EvalArgs& a) {
+  EvalOptions eo;
+  eo.depth = a.depth;
+  eo.error = a.error;
+  eo.smooth = a.smooth;
+  eo.parallel = !a.serial;
+  eo.progress = [](const std::string& m) { std::cerr << "pic: " << m << "\n"; };
+  EvalStats st;
+  const Octree tree = eval_scad(a.in, eo, &st);
+  Json j;
+  j.fields(st)
+      .add("depth", a.depth)
+      .add("smooth", a.smooth)
+      .add("pics", analyze(tree).pics)
+      .raw("cube", cube_json(tree.cube));
+  std::string summary;
+  if (is_mesh_path(a.out)) {
+    const auto t1 = Clock::now();
+    ContourOptions co;
+    co.split_sheets = !a.no_split;
+    ContourStats cs;
+    const TriMesh mesh = contour(tree, co, &cs);
+    const double secs = since(t1);
+    write_mesh(mesh, a.out);
+    const auto topo = analyze_topology(mesh);
+    j.add("contour_seconds", secs)
+        .add("triangles", mesh.triangles.size())
+        .add("split_vertices", cs.split_vertices)
+        .add("volume", volume(mesh))
+        .raw("topology", topology_json(topo));
+    summary = std::to_string(mesh.triangles.size()) + " triangles (" + topology_words(topo) + ")";
+  } else {
+    save(tree, a.out);
+    summary = std::to_string(analyze(tree).pics) + " PICs";
+  }
+  if (a.json) std::cout << j.str() << "\n";
+  else
+    std::printf("%zu leaves, %zu Booleans in %.3f s: %s -> %s\n", st.leaves, st.booleans, st.seconds, summary.c_str(),
+                a.out.c_str());
+}
+}  // namespace
+
+void add_eval(CLI::App& app) {
+  auto a = std::make_shared<EvalArgs>();
+  auto* c = app.add_subcommand("eval", "Evaluate an OpenSCAD model (.scad via openscad, or its .csg export)");
+  c->add_option("input", a->in, "OpenSCAD .scad or .csg file")->required();
+  c->add_option("-o,--output", a->out, "Output .pic, or a mesh (.stl, .obj, .ply, .off, .glb)")->required();
+  c->add_option("--depth", a->depth, "Maximum octree level")->capture_default_str();
+  c->add_option("--error", a->error, "QEF residual threshold (root-cube units squared)")->capture_default_str();
+  c->add_flag("--smooth", a->smooth,
+              "Tessellate spheres, cylinders and circles to 0.05 finest cells instead of by $fn/$fa/$fs");
+  c->add_flag("--json", a->json, "Print one JSON object on stdout");
+  c->add_flag("--serial", a->serial, "Do not use threads");
+  c->add_flag("--no-split", a->no_split, "Mesh output: write the dual contouring mesh as is");
+  c->callback([a] { run(*a); });
+}
+
+}  // namespace pic::cli

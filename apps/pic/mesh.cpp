@@ -1,0 +1,60 @@
+// pic mesh: a PIC object -> its closed surface as a mesh file.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "cli.h"
+
+namespace pic::cli {
+
+namespace {
+struct MeshArgs {
+  std::string in, out;
+  bool json = false, no_split = false, no_check = false, fast = false;
+};
+
+void run(const MeshArgs& a) {
+  const Octree tree = load(a.in);
+  const auto t0 = Clock::now();
+  ContourOptions opt;
+  opt.intersection_free = !a.fast;
+  opt.split_sheets = !a.no_split;
+  ContourStats st;
+  const TriMesh mesh = contour(tree, opt, &st);
+  const double secs = since(t0);
+  write_mesh(mesh, a.out);
+  const auto topo = analyze_topology(mesh);
+  if (a.json) {
+    Json j;
+    j.add("vertices", mesh.positions.size())
+        .add("triangles", mesh.triangles.size())
+        .add("seconds", secs)
+        .add("split_vertices", st.split_vertices)
+        .add("fans", st.fans)
+        .add("moved_vertices", st.moved_vertices)
+        .add("volume", volume(mesh))
+        .raw("topology", topology_json(topo));
+    std::cout << add_validity(j, check_validity(mesh, !a.no_check)).str() << "\n";
+  } else {
+    std::printf("%zu vertices, %zu triangles in %.4f s (%s) -> %s\n", mesh.positions.size(), mesh.triangles.size(),
+                secs, topology_words(topo).c_str(), a.out.c_str());
+  }
+}
+}  // namespace
+
+void add_mesh(CLI::App& app) {
+  auto a = std::make_shared<MeshArgs>();
+  auto* c = app.add_subcommand("mesh", "Extract the surface of a PIC object");
+  c->add_option("input", a->in, "Input .pic file")->required();
+  c->add_option("-o,--output", a->out, "Output mesh (.obj, .stl, .ply, .off, .glb)")->required();
+  c->add_flag("--json", a->json, "Print one JSON object on stdout");
+  c->add_flag("--no-split", a->no_split,
+              "Write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
+  c->add_flag("--no-check", a->no_check, "With --json: skip the exact self-intersection test (huge meshes)");
+  c->add_flag("--fast", a->fast,
+              "Plain dual contouring split: no exact re-triangulation, so a few triangles may cross "
+              "(slivers folded over a neighbour, long triangles at sharp creases)");
+  c->callback([a] { run(*a); });
+}
+
+}  // namespace pic::cli

@@ -1,0 +1,76 @@
+// PIC — Booleans computed directly on two octrees (paper section 5).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <functional>
+#include <vector>
+
+#include "pic/octree.h"
+#include "pic/sample.h"
+
+namespace pic {
+
+enum class CsgOp { Union, Intersect, Subtract };
+std::string to_string(CsgOp op);
+/// Parses "union", "intersect"/"intersection", "subtract"/"difference".
+std::optional<CsgOp> parse_csg_op(const std::string& s);
+
+struct CsgOptions {
+  double error = 1e-8;  ///< QEF residual threshold for new vertices
+  bool parallel = true; ///< combine subtrees near the root with TBB (output identical to serial)
+};
+
+struct CsgStats {
+  double seconds = 0;
+  double contour_a_seconds = 0;  ///< partial contour of A
+  double contour_b_seconds = 0;  ///< partial contour of B
+  double csg_seconds = 0;        ///< the octree recursion itself, clean-up included
+  double cleanup_seconds = 0;    ///< of which: islands, one component per leaf, cracks
+  size_t cells_visited = 0;      ///< cell pairs visited by the recursion
+  size_t cells_stamped = 0;      ///< operand cells stamped as overlap
+  size_t gray_pairs = 0;         ///< gray/gray evaluations (GraycellCSG)
+  size_t forced_subdivisions = 0;
+  size_t repaired = 0;           ///< uniform leaves turned gray to keep the surface closed
+  uint32_t stamp = 0;            ///< this operation's timestamp
+  bool resampled_b = false;      ///< B was re-expressed in A's cube
+};
+
+/// Boolean of two PIC objects computed on the octrees (paper section 5). Operands should
+/// share a root cube; if they do not, B is resampled from its contour into A's cube, or,
+/// when B does not fit there, both are resampled into the cube around both cubes. Depths may
+/// differ (the result takes the larger). The result is closed; see docs/algorithms.md.
+/// \throws InvalidInput when an operand cannot be resampled.
+Octree csg(const Octree& a, const Octree& b, CsgOp op, const CsgOptions& options = {},
+           CsgStats* stats = nullptr);
+
+/// The same Boolean written into `a` (A := A op B). Only the overlap region is rebuilt;
+/// untouched subtrees stay where they are, so a sculpting stroke costs what it touches.
+void csg_inplace(Octree& a, const Octree& b, CsgOp op, const CsgOptions& options = {},
+                 CsgStats* stats = nullptr);
+
+/// One operand of a chain of Booleans: a PIC object used as it is, or else a mesh that the chain
+/// samples into the cube it shares with the chain's other meshes.
+struct CsgOperand {
+  std::optional<Octree> tree;
+  TriMesh mesh;
+  std::string name;  ///< for progress messages and errors
+};
+struct CsgChainOptions {
+  SampleOptions sampling;  ///< for mesh operands; its `cube`, when unset, is the bounding
+                           ///< cube of all the mesh operands together
+  CsgOptions csg;
+  std::function<void(const std::string&)> progress;  ///< optional: "sampling x", "union y"
+  /// Optional: called after each Boolean with its operand's index and statistics.
+  std::function<void(size_t, const CsgStats&)> on_step;
+};
+/// operands[0] ops[0] operands[1] ops[1] operands[2] ..., left to right. Mesh operands are
+/// sampled one at a time into one cube around all of them, so the Booleans between them need
+/// no resampling (a Boolean with a PIC object in another cube resamples as csg() does).
+/// \throws InvalidInput when ops.size() + 1 != operands.size() or as sample() and csg().
+Octree csg_chain(std::vector<CsgOperand> operands, const std::vector<CsgOp>& ops,
+                 const CsgChainOptions& options = {});
+
+}  // namespace pic

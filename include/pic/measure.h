@@ -1,0 +1,74 @@
+// PIC — what a mesh is: topology, validity as a solid, volume, distances between surfaces.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "pic/types.h"
+
+namespace pic {
+
+/// Topology of a triangle mesh (exact vertex indices; no position merging).
+struct MeshTopology {
+  size_t vertices = 0, triangles = 0;
+  size_t boundary_edges = 0;       ///< edges with one triangle
+  size_t nonmanifold_edges = 0;    ///< edges with more than two triangles
+  size_t inconsistent_edges = 0;   ///< edges whose two triangles disagree on orientation
+  size_t nonmanifold_vertices = 0; ///< vertices whose triangle fan is not a single disk
+  size_t degenerate_triangles = 0; ///< repeated vertex index
+  bool closed() const { return boundary_edges == 0; }
+  bool manifold() const {
+    return closed() && nonmanifold_edges == 0 && nonmanifold_vertices == 0 && inconsistent_edges == 0;
+  }
+};
+MeshTopology analyze_topology(const TriMesh& mesh);
+
+/// @name Validity of a mesh as a solid's boundary (src/self_intersect.cpp).
+/// Vertices at bit-identical positions count as one vertex (as a mesh file reader sees them).
+///@{
+/// Pairs of triangles that intersect other than in a shared vertex or edge, with CGAL's rules
+/// (Polygon_mesh_processing::self_intersections): triangles sharing an edge count only when
+/// coplanar and folded onto the same side; sharing a vertex, only when the edge opposite it in
+/// one meets the other. Exact predicates on the doubles as given. Zero-area triangles are
+/// skipped. Each pair (i < j) once, sorted.
+std::vector<std::pair<uint32_t, uint32_t>> self_intersecting_pairs(const TriMesh& mesh);
+size_t count_self_intersections(const TriMesh& mesh);
+struct MeshValidity {
+  bool checked = false;             ///< self_intersections was computed
+  size_t self_intersections = 0;    ///< as count_self_intersections
+  size_t collinear_triangles = 0;   ///< zero-area triangles (skipped by the test)
+  size_t nonmanifold_vertices = 0;  ///< after merging equal positions
+  size_t nonmanifold_edges = 0;
+  size_t boundary_edges = 0;
+  size_t degenerate_triangles = 0;  ///< a repeated vertex after merging
+  size_t components = 0;            ///< triangles connected across shared edges
+  bool valid() const {
+    return checked && self_intersections == 0 && nonmanifold_vertices == 0 && nonmanifold_edges == 0 &&
+           boundary_edges == 0 && degenerate_triangles == 0 && collinear_triangles == 0;
+  }
+};
+/// Topology after merging equal positions, and (unless `self_intersections` is false) the
+/// exact self-intersection count.
+MeshValidity check_validity(const TriMesh& mesh, bool self_intersections = true);
+///@}
+/// Signed volume (positive for outward orientation).
+double volume(const TriMesh& mesh);
+
+/// @name Distances between surfaces (exact point-to-triangle, sampled).
+///@{
+/// Every vertex plus `samples` area-weighted points (deterministic for a given seed).
+std::vector<Vec3> sample_surface(const TriMesh& mesh, size_t samples, uint64_t seed = 12345);
+/// Unsigned distance from each point to the mesh.
+std::vector<double> distance_to_mesh(const TriMesh& mesh, const std::vector<Vec3>& points);
+struct SurfaceDistance {
+  double hausdorff = 0;            ///< max of the two one-sided distances
+  double a_to_b = 0, b_to_a = 0;   ///< one-sided maxima
+  double mean_a_to_b = 0, mean_b_to_a = 0;
+};
+/// Two-sided (Hausdorff) distance sampled at all vertices plus `samples` points per side.
+SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples = 100000);
+///@}
+
+}  // namespace pic

@@ -1,0 +1,82 @@
+// PIC — adaptive sampling of a mesh or a point cloud into a PIC object (paper section 4).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include "pic/octree.h"
+
+namespace pic {
+
+/// How sample() tells inside from outside.
+enum class InsideMode {
+  Auto,     ///< Parity for a clean closed mesh (see MeshDefects::clean), Winding otherwise
+  Parity,   ///< exact crossing parity: closed meshes only (an open one is refused)
+  Winding,  ///< generalized winding number |w| >= 1/2: any triangle soup (docs/algorithms.md)
+};
+std::string to_string(InsideMode mode);
+/// Parses "auto", "parity", "winding".
+std::optional<InsideMode> parse_inside_mode(const std::string& s);
+
+/// Defects of a triangle mesh, counted after exact welding of equal positions.
+struct MeshDefects {
+  size_t boundary_edges = 0;      ///< edges with one triangle
+  size_t nonmanifold_edges = 0;   ///< edges with more than two triangles
+  size_t inconsistent_edges = 0;  ///< edges whose two triangles traverse them the same way
+  size_t duplicated_faces = 0;    ///< extra copies of a triangle, in either orientation
+  size_t degenerate_faces = 0;    ///< triangles with a repeated vertex
+  size_t shells = 0;              ///< edge-connected components
+  bool overlapping_shells = false;  ///< the bounding boxes of two shells overlap
+  /// The domain of exact crossing parity: closed, every edge on exactly two triangles, no
+  /// duplicates, shells apart. (Orientation does not matter to parity.)
+  bool clean() const {
+    return boundary_edges == 0 && nonmanifold_edges == 0 && duplicated_faces == 0 && !overlapping_shells;
+  }
+};
+MeshDefects find_defects(const TriMesh& mesh);
+
+/// Options for sampling a triangle mesh or a point cloud (paper section 4).
+struct SampleOptions {
+  int depth = 12;          ///< maximum octree level, 1..kMaxLevel
+  double error = 1e-8;     ///< QEF residual threshold delta^2, in root-cube units squared
+  std::optional<Cube> cube;  ///< root cube; default: bounding cube plus a margin
+  double margin = 1.0 / 16;  ///< automatic cube: margin on each side, relative to the extent
+  bool parallel = true;      ///< build subtrees with TBB (output identical to serial)
+  InsideMode inside = InsideMode::Auto;  ///< meshes only; point clouds use their winding number
+};
+
+/// Statistics of a sampling run.
+struct SampleStats {
+  int max_depth = 0;    ///< the option's maximum level
+  double error = 0;     ///< the option's QEF threshold
+  size_t triangles_in = 0;
+  size_t points_in = 0;  ///< point clouds: input points
+  size_t pics = 0;
+  size_t capped = 0;  ///< leaves accepted at the depth cap although a refinement rule failed
+  double seconds = 0;
+  std::string classifier;   ///< "parity", "winding" or "points"
+  MeshDefects defects;      ///< of the input mesh (meshes only)
+  size_t interior_triangles = 0;  ///< winding: triangles with the solid on both sides (dropped)
+  size_t boundary_loops = 0;      ///< winding: closed curves of the input's boundary, capped
+  int depth = 0;  ///< deepest level allowed: the option's, or for a point cloud its spacing's
+};
+
+/// Adaptively samples a triangle mesh into a PIC object. A clean closed mesh is classified by
+/// exact crossing parity; any other (holes, non-manifold edges, flipped or duplicated triangles,
+/// overlapping shells, unwelded soups) by its generalized winding number, after welding,
+/// removing duplicates and orienting each edge-connected part by its majority (InsideMode).
+/// \throws InvalidInput for an empty mesh, non-finite coordinates, bad options, a mesh that
+///         does not fit strictly inside the given cube, an open mesh with InsideMode::Parity,
+///         or a mesh that encloses no solid (its winding number never reaches 1/2).
+Octree sample(const TriMesh& mesh, const SampleOptions& options = {}, SampleStats* stats = nullptr);
+/// Samples an oriented point cloud: signs from the points' winding number (each point a small
+/// disc of the area its neighbours leave it), vertices from their tangent planes. The depth
+/// stops where a cell is half the points' spacing (SampleStats::depth says where).
+/// \throws InvalidInput for an empty cloud, missing or zero normals, non-finite values.
+Octree sample(const PointCloud& cloud, const SampleOptions& options = {}, SampleStats* stats = nullptr);
+
+/// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.
+Cube bounding_cube(const TriMesh& mesh, double margin = 1.0 / 16);
+
+}  // namespace pic

@@ -1,0 +1,289 @@
+// Sampling (paper section 4): the public entry points. A clean closed mesh runs the sampler
+// kernel (sampler.h) over crossing parity; any other mesh over its winding number, a point
+// cloud over the points' winding number (sources.h); both then settle their signs (signs/).
+#include "sample/sampler.h"
+#include "sample/sources.h"
+#include "mesh/clean.h"
+#include "signs/settle.h"
+#include "geometry/vec3.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace pic {
+
+using namespace detail;
+
+Cube bounding_cube(const TriMesh& mesh, double margin) {
+  if (mesh.positions.empty()) throw InvalidInput("mesh has no vertices");
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Vec3& p : mesh.positions)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(extent > 0) || !std::isfinite(extent)) throw InvalidInput("mesh has zero or non-finite extent");
+  const double side = extent * (1 + 2 * margin);
+  Cube c;
+  for (int k = 0; k < 3; ++k) c.origin[k] = (lo[k] + hi[k]) / 2 - side / 2;
+  c.size = side;
+  return c;
+}
+
+namespace {
+
+void check_options(const SampleOptions& options) {
+  if (options.depth < 1 || options.depth > kMaxLevel)
+    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
+  if (!(options.error >= 0) || !std::isfinite(options.error)) throw InvalidInput("error must be a finite number >= 0");
+}
+
+void check_finite(const std::vector<Vec3>& points, const char* what) {
+  for (const Vec3& p : points)
+    for (double x : p)
+      if (!std::isfinite(x)) throw InvalidInput(std::string(what) + " has non-finite (NaN or inf) coordinates");
+}
+
+void check_mesh(const TriMesh& mesh) {
+  if (mesh.triangles.empty()) throw InvalidInput("mesh has no triangles");
+  check_finite(mesh.positions, "mesh");
+  for (const auto& t : mesh.triangles)
+    for (uint32_t v : t)
+      if (v >= mesh.positions.size()) throw InvalidInput("mesh has a triangle with an invalid vertex index");
+}
+
+/// Crossing parity needs every edge on an even number of triangles.
+void check_closed(const TriMesh& mesh) {
+  std::unordered_map<uint64_t, uint32_t> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int e = 0; e < 3; ++e) {
+      const uint64_t a = t[e], b = t[(e + 1) % 3];
+      ++edges[std::min(a, b) << 32 | std::max(a, b)];
+    }
+  }
+  size_t odd = 0;
+  for (const auto& [k, n] : edges) odd += n & 1;
+  if (odd > 0)
+    throw InvalidInput("mesh is not closed: " + std::to_string(odd) +
+                       " boundary edges (crossing parity needs a closed mesh; use --inside winding or auto)");
+}
+
+Cube checked_cube(const SampleOptions& options, const std::vector<Vec3>& points) {
+  const Cube cube = options.cube ? *options.cube : bounding_cube(TriMesh{points, {}}, options.margin);
+  if (!(cube.size > 0) || !std::isfinite(cube.size) || !std::isfinite(cube.origin[0]) ||
+      !std::isfinite(cube.origin[1]) || !std::isfinite(cube.origin[2]))
+    throw InvalidInput("root cube must have a finite origin and a positive size");
+  return cube;
+}
+
+std::vector<I3> to_grid_inside(const Cube& cube, const std::vector<Vec3>& points, const char* what) {
+  std::vector<I3> grid(points.size());
+  for (size_t i = 0; i < grid.size(); ++i) {
+    grid[i] = to_grid(world_to_unit(cube, points[i]));
+    for (int k = 0; k < 3; ++k)
+      if (grid[i][k] <= 0 || grid[i][k] >= (int64_t{1} << kGridBits))
+        throw InvalidInput(std::string(what) + " does not fit strictly inside the root cube");
+  }
+  return grid;
+}
+
+SampleParams params_of(const SampleOptions& options) {
+  SampleParams p;
+  p.memo_id = new_memo_id();
+  p.max_depth = options.depth;
+  p.error = options.error;
+  p.parallel_levels = options.parallel ? 2 : 0;
+  return p;
+}
+
+/// Runs the sampler from the root and assembles the tree.
+Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
+                   const Wind8* root_wind, size_t& capped) {
+  std::vector<uint32_t> idx(src.tris().size());
+  for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
+  Builder b;
+  b.nodes.resize(1);
+  sample_cell(src, params_of(options), Cell{}, root_signs, idx, b, 0, capped, root_wind);
+  Octree tree;
+  tree.cube = cube;
+  tree.max_depth = options.depth;
+  tree.nodes = std::move(b.nodes);
+  tree.vertices = std::move(b.vertices);
+  return tree;
+}
+
+/// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
+std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
+                            double margin, double spread) {
+  std::vector<Box> out;
+  for (const auto& loop : loops) {
+    Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+    for (uint32_t v : loop) {
+      const Vec3 p = to_unit(grid[v]);
+      for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], p[k]), b.hi[k] = std::max(b.hi[k], p[k]);
+    }
+    const double grow = margin + spread * norm3(sub3(b.hi, b.lo));
+    for (int k = 0; k < 3; ++k) b.lo[k] -= grow, b.hi[k] += grow;
+    out.push_back(b);
+  }
+  return out;
+}
+
+Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
+                      const Cube& cube, SampleStats& st, size_t& capped) {
+  // Close the input's boundary with caps: input + caps has an exact integer winding number.
+  const auto chain = boundary_chain(clean.mesh);
+  const auto cones = cap_loops(chain, &st.boundary_loops);
+  const std::vector<I3>& g = grid;
+  std::vector<ITri> tris;
+  tris.reserve(clean.mesh.triangles.size() + cones.size());
+  for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+  for (const auto& t : cones) {
+    tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+    tris.back().use = 0;  // a cap: counts in the winding number, is no part of the surface
+  }
+  std::vector<std::array<Vec3, 2>> boundary;
+  boundary.reserve(chain.size());
+  for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
+  // Caps decide signs only in their loops' boxes (two cells of slack): a box holds its loop's
+  // convex hull, outside which the signs are parity's (see WindingSource::inside).
+  const auto loops = boundary_loops(chain);
+  const double cell = 1.0 / double(int64_t{1} << options.depth);
+  WindingSource src(std::move(tris), clean.mesh.triangles.size(), std::move(boundary),
+                    loop_boxes(loops, grid, 2 * cell, 0));
+  // Interior walls exist only where parts meet or overlap.
+  if (clean.defects.shells > 1 || clean.defects.nonmanifold_edges > 0)
+    st.interior_triangles = src.drop_interior_triangles();
+  // Nothing lies outside the cube: the root's corners have winding number 0.
+  const Wind8 root_wind{};
+  uint8_t signs = 0;
+  for (int c = 0; c < 8; ++c)
+    signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
+  Octree tree = sample_tree(src, options, cube, signs, &root_wind, capped);
+  // Islands and cracks come from the caps' decisions and from uniform cells whose triangles
+  // showed no sign change (the sampler's only departures from crossing parity): settle there,
+  // with room for the leaves around them.
+  SettleRegion region{false, loop_boxes(loops, grid, 16 * cell, 0.1)};
+  for (const Cell& c : src.skipped_cells()) {
+    const Vec3 lo = c.min_unit();
+    const double s = c.size();
+    region.boxes.push_back({{lo[0] - s, lo[1] - s, lo[2] - s}, {lo[0] + 2 * s, lo[1] + 2 * s, lo[2] + 2 * s}});
+  }
+  settle_sampled(tree, region);
+  if (tree.vertices.empty())
+    throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
+  return tree;
+}
+
+}  // namespace
+
+std::string to_string(InsideMode mode) {
+  switch (mode) {
+    case InsideMode::Auto: return "auto";
+    case InsideMode::Parity: return "parity";
+    case InsideMode::Winding: return "winding";
+  }
+  return "auto";
+}
+
+std::optional<InsideMode> parse_inside_mode(const std::string& s) {
+  if (s == "auto") return InsideMode::Auto;
+  if (s == "parity") return InsideMode::Parity;
+  if (s == "winding") return InsideMode::Winding;
+  return std::nullopt;
+}
+
+Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_options(options);
+  check_mesh(mesh);
+  const Cube cube = checked_cube(options, mesh.positions);
+  const CleanMesh clean = clean_mesh(mesh);
+  if (clean.mesh.triangles.empty()) throw InvalidInput("mesh has no triangles (all degenerate or cancelling)");
+  InsideMode mode = options.inside;
+  if (mode == InsideMode::Auto) mode = clean.defects.clean() ? InsideMode::Parity : InsideMode::Winding;
+  const std::vector<I3> grid = to_grid_inside(cube, clean.mesh.positions, "mesh");
+
+  SampleStats st;
+  st.defects = clean.defects;
+  st.classifier = to_string(mode);
+  size_t capped = 0;
+  Octree tree;
+  if (mode == InsideMode::Parity) {
+    check_closed(clean.mesh);
+    std::vector<ITri> tris;
+    tris.reserve(clean.mesh.triangles.size());
+    for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(grid[t[0]], grid[t[1]], grid[t[2]]));
+    // Root corners are outside: the mesh lies strictly inside the cube.
+    tree = sample_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
+    // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
+    if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) repair_cracks(tree, nullptr);
+  } else {
+    tree = sample_winding(clean, grid, options, cube, st, capped);
+  }
+  if (stats) {
+    st.triangles_in = mesh.triangles.size();
+    st.pics = tree.vertices.size();
+    st.capped = capped;
+    st.depth = options.depth;
+    st.max_depth = options.depth;
+    st.error = options.error;
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    *stats = st;
+  }
+  return tree;
+}
+
+Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_options(options);
+  if (cloud.positions.empty()) throw InvalidInput("point cloud has no points");
+  if (cloud.normals.size() != cloud.positions.size())
+    throw InvalidInput("point cloud needs one normal per point: normals are needed to tell inside from outside");
+  check_finite(cloud.positions, "point cloud");
+  check_finite(cloud.normals, "point cloud normals");
+  size_t zero = 0;
+  for (const Vec3& n : cloud.normals) zero += n[0] == 0 && n[1] == 0 && n[2] == 0;
+  if (zero > 0)
+    throw InvalidInput("point cloud has " + std::to_string(zero) +
+                       " points with a zero normal: normals are needed to tell inside from outside");
+  const Cube cube = checked_cube(options, cloud.positions);
+  to_grid_inside(cube, cloud.positions, "point cloud");
+  std::vector<Vec3> unit(cloud.positions.size());
+  for (size_t i = 0; i < unit.size(); ++i) unit[i] = world_to_unit(cube, cloud.positions[i]);
+  const PointSource src(unit, cloud.normals);
+  uint8_t signs = 0;
+  for (int c = 0; c < 8; ++c) signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)))) << c;
+  // Cells finer than the points' spacing would only resolve the noise between neighbouring
+  // tangent planes: the depth stops where a cell is about half the spacing.
+  SampleOptions opt = options;
+  const double spacing = src.spacing();
+  if (spacing > 0) opt.depth = std::clamp(int(std::ceil(std::log2(2 / spacing))), 1, options.depth);
+  size_t capped = 0;
+  Octree tree = sample_tree(src, opt, cube, signs, nullptr, capped);
+  settle_sampled(tree, SettleRegion{});
+  if (tree.vertices.empty())
+    throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
+  if (stats) {
+    *stats = SampleStats{};
+    stats->triangles_in = 0;
+    stats->points_in = cloud.positions.size();
+    stats->max_depth = options.depth;
+    stats->error = options.error;
+    stats->pics = tree.vertices.size();
+    stats->capped = capped;
+    stats->classifier = "points";
+    stats->depth = opt.depth;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return tree;
+}
+
+}  // namespace pic

@@ -1,0 +1,65 @@
+// The settling loop: see settle.h.
+#include "signs/settle.h"
+
+#include <numeric>
+
+namespace pic::detail {
+
+size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
+  const auto* component_scope = plan.one_component_everywhere ? nullptr : plan.active;
+  for (int round = 0; round < 4; ++round) {
+    const size_t islands = remove_islands(t, plan.active, plan.touched, &pinned);
+    const TopologyFix fix = enforce_one_component(t, component_scope, plan.touched, &pinned, plan.spare_coarse);
+    if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
+  }
+  const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
+  remove_specks(t, plan.active, plan.keep_speck ? plan.keep_speck : keep_none, plan.specks);
+  return repair_cracks(t, plan.active);
+}
+
+namespace {
+
+/// Per node: whether its cell meets one of the region's boxes (an ancestor of such a node
+/// does too, as the passes in topology.h need of an `active` filter). Each node tests only
+/// the boxes its parent met.
+std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
+  std::vector<uint8_t> in(t.nodes.size(), 0);
+  std::vector<std::vector<uint32_t>> met(kMaxLevel + 2);  // per level: the boxes the cell meets
+  met[0].resize(region.boxes.size());
+  std::iota(met[0].begin(), met[0].end(), 0u);
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    const Box box{cell.min_unit(), cell.max_unit()};
+    const std::vector<uint32_t>& from = met[cell.level];
+    std::vector<uint32_t>& here = met[cell.level + 1];
+    here.clear();
+    for (uint32_t i : from)
+      if (overlap(region.boxes[i], box)) here.push_back(i);
+    if (here.empty()) return;
+    in[node] = 1;
+    const Node& n = t.nodes[node];
+    if (n.kind != CellKind::Internal) return;
+    for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));  // children fill the next list
+  };
+  walk(walk, 0, Cell{});
+  return in;
+}
+
+}  // namespace
+
+void settle_sampled(Octree& tree, const SettleRegion& region) {
+  std::vector<uint8_t> in;
+  if (!region.everywhere) in = nodes_in(tree, region);
+  const std::function<bool(uint32_t)> active = [&](uint32_t n) { return in[n] != 0; };
+  const std::function<void(uint32_t)> touched = [&](uint32_t n) { in[n] = 1; };
+  SettlePlan plan;
+  plan.active = region.everywhere ? nullptr : &active;
+  plan.touched = region.everywhere ? nullptr : &touched;
+  plan.one_component_everywhere = true;
+  // Where |w| hovers at 1/2 (an open part's end inside another part) the level set leaves
+  // specks a cell across, closed shells or voids of a few triangles: resolution noise.
+  plan.specks = {tree.max_depth - 1, true};
+  PinnedPoints pinned;
+  settle(tree, plan, pinned);
+}
+
+}  // namespace pic::detail

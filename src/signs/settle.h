@@ -1,0 +1,44 @@
+// The settling loop: after sampling and after a Boolean, corner signs are flipped until every
+// leaf is a valid PIC (one surface component, no finer islands on a coarse leaf's faces, no
+// specks a cell across, no cracks). Sampling and CSG run the same loop with their own scope.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "geometry/box_tree.h"
+#include "signs/passes.h"
+
+namespace pic::detail {
+
+/// What one settling run works on and how.
+struct SettlePlan {
+  const std::function<bool(uint32_t)>* active = nullptr;   ///< leaves to settle (null: all)
+  const std::function<void(uint32_t)>* touched = nullptr;  ///< told of every node a flip changes
+  /// The one-component pass looks at every leaf, not only the active ones (a sampled tree's
+  /// depth-capped leaves may hold two components anywhere).
+  bool one_component_everywhere = false;
+  bool spare_coarse = false;  ///< see enforce_one_component
+  std::function<bool(const Speck&)> keep_speck;  ///< specks to keep (null: remove them all)
+  SpeckSearch specks;
+};
+
+/// Islands and one component per leaf, alternated until both are quiet (at most 4 rounds);
+/// then specks; then cracks. `pinned`: points set earlier in this operation (sign hints).
+/// Returns how many leaves repair_cracks changed.
+size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned);
+
+/// Where a tree's signs may disagree between levels (islands, cracks): everywhere, or only
+/// within these unit-space boxes.
+struct SettleRegion {
+  bool everywhere = true;
+  std::vector<Box> boxes;
+};
+
+/// Settles a sampled tree whose signs may change inside uniform leaves (a winding number's
+/// level set can cross a cell without touching its corners): finer neighbours can then show
+/// islands and cracks on their faces. Visits the region, plus every leaf a flip touched.
+void settle_sampled(Octree& tree, const SettleRegion& region);
+
+}  // namespace pic::detail
