@@ -4,7 +4,7 @@
 BUILD ?= build
 JOBS  ?= 2
 
-.PHONY: setup build demo test bench fuzz clean
+.PHONY: setup build demo test test-sanitize bench fuzz clean
 
 setup:
 	bash scripts/setup.sh
@@ -18,6 +18,17 @@ demo: build
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
+
+# The test suite once more with AddressSanitizer, UndefinedBehaviorSanitizer and the internal
+# invariant checks (PIC_ENABLE_ASSERTS) in build-sanitize; CI runs it after `make test`.
+SAN_BUILD ?= build-sanitize
+test-sanitize: setup
+	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
+	  -DPIC_BUILD_TESTS=ON \
+	  -DPIC_SANITIZE=ON -DPIC_ENABLE_ASSERTS=ON
+	cmake --build $(SAN_BUILD) -j$(JOBS)
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  ctest --test-dir $(SAN_BUILD) --output-on-failure -j$(JOBS)
 
 bench:
 	bash scripts/setup.sh --bench

@@ -4,6 +4,7 @@
 #include "sample/sampler.h"
 #include "sample/sources.h"
 #include "mesh/clean.h"
+#include "signs/invariants.h"
 #include "signs/settle.h"
 #include "geometry/vec3.h"
 
@@ -238,6 +239,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     *stats = st;
   }
+  PIC_CHECK_OCTREE(tree, "sampling a mesh");
   return tree;
 }
 
@@ -283,6 +285,7 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
     stats->depth = opt.depth;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  PIC_CHECK_OCTREE(tree, "sampling a point cloud");
   return tree;
 }
 

@@ -1,42 +1,18 @@
-// Evaluates an OpenSCAD CSG tree on PIC octrees. Two passes:
-//  1. lower: the parsed .csg tree becomes a tree of Booleans over closed meshes in world
-//     coordinates (transforms pushed into the leaves; 2D subtrees under an extrusion become
-//     extruded leaves combined with the same Booleans, since extrusion commutes with them);
-//  2. evaluate: one root cube around every leaf, each leaf sampled into it, the Booleans run on
-//     the octrees bottom-up -- n-ary unions balanced, independent subtrees in parallel (TBB).
-#include <tbb/parallel_invoke.h>
-
+// Lowering an OpenSCAD CSG tree to Booleans over closed meshes: see lower.h.
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <mutex>
 #include <numbers>
 #include <optional>
-#include <sstream>
-#include <unistd.h>
+#include <string>
 
 #include "pic/primitives.h"
-#include "pic/scad.h"
-#include "scad/scad_detail.h"
+#include "scad/lower.h"
 
-namespace pic {
+namespace pic::detail::scad {
 namespace {
 
-using namespace detail::scad;
 using Node = detail::scad::Node;  // not pic::Node (an octree cell)
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-/// The lowered tree: Booleans over closed meshes (3D) ...
-struct Solid {
-  enum class Kind { Empty, Mesh, Union, Intersect, Difference, Hull };
-  Kind kind = Kind::Empty;
-  TriMesh mesh;
-  std::vector<Solid> children;
-};
 /// ... and over even-odd filled rings (2D, below an extrusion).
 struct Shape {
   enum class Kind { Empty, Rings, Union, Intersect, Difference };
@@ -609,265 +585,14 @@ class Lowering {
   }
 };
 
-void bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& tris) {
-  if (s.kind == Solid::Kind::Mesh) {
-    ++leaves;
-    tris += s.mesh.triangles.size();
-    for (const Vec3& p : s.mesh.positions)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  }
-  for (const Solid& c : s.children) bounds(c, lo, hi, leaves, tris);
-}
-
-// Hull input: the vertices of the leaves, when the subtree is only unions (and hulls) of them.
-bool hull_points(const Solid& s, std::vector<Vec3>& out) {
-  switch (s.kind) {
-    case Solid::Kind::Empty: return true;
-    case Solid::Kind::Mesh: out.insert(out.end(), s.mesh.positions.begin(), s.mesh.positions.end()); return true;
-    case Solid::Kind::Union:
-    case Solid::Kind::Hull:
-      for (const Solid& c : s.children)
-        if (!hull_points(c, out)) return false;
-      return true;
-    default: return false;
-  }
-}
-
-class Evaluator {
- public:
-  Evaluator(const EvalOptions& o, const Cube& cube, size_t leaves) : opt_(o), cube_(cube), total_(leaves) {
-    t0_ = Clock::now();
-    last_ = t0_;
-  }
-  std::atomic<size_t> booleans{0};
-
-  std::optional<Octree> eval(const Solid& s) {
-    switch (s.kind) {
-      case Solid::Kind::Empty: return std::nullopt;
-      case Solid::Kind::Mesh: {
-        auto t = sample_leaf(s.mesh);
-        ++done_;
-        report();
-        return t;
-      }
-      case Solid::Kind::Union: return balanced(s.children, 0, s.children.size(), CsgOp::Union);
-      case Solid::Kind::Intersect: return balanced(s.children, 0, s.children.size(), CsgOp::Intersect);
-      case Solid::Kind::Difference: {
-        std::optional<Octree> a, b;
-        invoke([&] { a = eval(s.children[0]); },
-               [&] { b = balanced(s.children, 1, s.children.size(), CsgOp::Union); });
-        if (!a || !b) return a;
-        return boolean(std::move(*a), *b, CsgOp::Subtract);
-      }
-      case Solid::Kind::Hull: {
-        std::vector<Vec3> pts;
-        bool direct = true;
-        for (const Solid& c : s.children) direct = direct && hull_points(c, pts);
-        if (!direct) {
-          // A difference or intersection below the hull: take the vertices of its contour
-          // (within a finest cell of the exact result).
-          pts.clear();
-          auto u = balanced(s.children, 0, s.children.size(), CsgOp::Union);
-          if (!u) return std::nullopt;
-          pts = unsplit_contour(*u).positions;
-        }
-        TriMesh h = detail::scad::convex_hull(pts);
-        if (h.triangles.empty()) return std::nullopt;
-        return sample_leaf(h);
-      }
-    }
-    return std::nullopt;
-  }
-
- private:
-  const EvalOptions& opt_;
-  Cube cube_;
-  size_t total_;
-  std::atomic<size_t> done_{0};
-  Clock::time_point t0_, last_;
-  std::mutex mu_;
-
-  template <class A, class B>
-  void invoke(const A& a, const B& b) {
-    if (opt_.parallel) tbb::parallel_invoke(a, b);
-    else a(), b();
-  }
-  Octree sample_leaf(const TriMesh& m) {
-    SampleOptions so;
-    so.depth = opt_.depth;
-    so.error = opt_.error;
-    so.cube = cube_;
-    so.parallel = opt_.parallel;
-    return sample(m, so);
-  }
-  Octree boolean(Octree a, const Octree& b, CsgOp op) {
-    CsgOptions co;
-    co.error = opt_.error;
-    co.parallel = opt_.parallel;
-    csg_inplace(a, b, op, co);
-    ++booleans;
-    report();
-    return a;
-  }
-  // n-ary union/intersection in a balanced order: halves evaluated in parallel, then combined.
-  std::optional<Octree> balanced(const std::vector<Solid>& kids, size_t b, size_t e, CsgOp op) {
-    if (b >= e) return std::nullopt;
-    if (e - b == 1) return eval(kids[b]);
-    const size_t mid = b + (e - b) / 2;
-    std::optional<Octree> x, y;
-    invoke([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
-    if (op == CsgOp::Intersect && (!x || !y)) return std::nullopt;
-    if (!x) return y;
-    if (!y) return x;
-    return boolean(std::move(*x), *y, op);
-  }
-  void report() {
-    if (!opt_.progress) return;
-    std::lock_guard lock(mu_);
-    const auto now = Clock::now();
-    if (std::chrono::duration<double>(now - last_).count() < 1.0) return;
-    last_ = now;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%zu/%zu leaves sampled, %zu Booleans, %.1f s", done_.load(), total_,
-                  booleans.load(), since(t0_));
-    opt_.progress(buf);
-  }
-};
 
 }  // namespace
 
-Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* stats, const std::string& source) {
-  const auto t0 = Clock::now();
-  if (options.depth < 1 || options.depth > kMaxLevel)
-    throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
-  std::vector<detail::scad::Node> top;
-  try {
-    top = parse(text);
-  } catch (const InvalidInput& e) {
-    throw InvalidInput(source + ": " + e.what());
-  }
-  detail::scad::Node root;
-  root.name = "group";
-  root.children = std::move(top);
-  auto lower = [&](double cell, size_t* nodes) {
-    Lowering l(options, cell);
-    try {
-      Solid s = l.solid(root, kIdentity);
-      if (nodes) *nodes = l.nodes - 1;
-      return s;
-    } catch (const InvalidInput& e) {
-      throw InvalidInput(source + ": " + e.what());
-    }
-  };
-  EvalStats st;
-  EvalOptions first = options;
-  if (options.smooth) first.smooth = false;
-  Solid model = lower(0, &st.nodes);
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  bounds(model, lo, hi, st.leaves, st.triangles);
-  if (model.kind == Solid::Kind::Empty || st.leaves == 0) throw InvalidInput(source + ": the model is empty");
-  TriMesh corners;
-  corners.positions = {lo, hi};
-  st.cube = bounding_cube(corners);
-  if (options.smooth) {
-    // Second pass: tessellate against the finest cell of the cube found above.
-    model = lower(st.cube.size / double(int64_t{1} << options.depth), nullptr);
-    Vec3 lo2 = lo, hi2 = hi;
-    st.leaves = st.triangles = 0;
-    bounds(model, lo2, hi2, st.leaves, st.triangles);
-    corners.positions = {lo2, hi2};
-    st.cube = bounding_cube(corners);
-  }
-  st.mesh_seconds = since(t0);
-  if (options.progress)
-    options.progress("sampling " + std::to_string(st.leaves) + " leaves (" + std::to_string(st.triangles) +
-                     " triangles) at depth " + std::to_string(options.depth));
-  const auto t1 = Clock::now();
-  Evaluator ev(options, st.cube, st.leaves);
-  std::optional<Octree> out = ev.eval(model);
-  st.octree_seconds = since(t1);
-  st.booleans = ev.booleans.load();
-  st.seconds = since(t0);
-  if (!out || out->vertices.empty()) throw InvalidInput(source + ": the model is empty");
-  if (stats) *stats = st;
-  return std::move(*out);
+Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes) {
+  Lowering l(options, finest_cell);
+  Solid s = l.solid(root, kIdentity);
+  if (nodes) *nodes = l.nodes - 1;
+  return s;
 }
 
-Octree eval_csg_file(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot read " + path.string());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  EvalOptions o = options;
-  if (o.base_dir.empty()) o.base_dir = path.parent_path();
-  return eval_csg(ss.str(), o, stats, path.string());
-}
-
-namespace {
-bool on_path(const std::string& prog) {
-  const char* p = std::getenv("PATH");
-  std::stringstream ss(p ? p : "");
-  std::string dir;
-  while (std::getline(ss, dir, ':'))
-    if (!dir.empty() && ::access((std::filesystem::path(dir) / prog).c_str(), X_OK) == 0) return true;
-  return false;
-}
-std::string shell_quote(const std::string& s) {
-  std::string o = "'";
-  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return o + "'";
-}
-}  // namespace
-
-Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".csg") return eval_csg_file(path, options, stats);
-  if (ext != ".scad") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
-  if (!std::filesystem::exists(path)) throw IoError("cannot read " + path.string());
-  if (!on_path("openscad"))
-    throw InvalidInput("the 'openscad' program is needed for .scad input: install it (Debian: apt-get install "
-                       "openscad, or scripts/setup.sh) or pass a .csg file exported by OpenSCAD");
-  const auto t0 = Clock::now();
-  // OpenSCAD resolves a relative output path against the input's directory: give it an
-  // absolute temporary path.
-  char tmpl[] = "/tmp/pic-scad-XXXXXX";
-  const char* dir = ::mkdtemp(tmpl);
-  if (!dir) throw IoError("cannot create a temporary directory");
-  const std::filesystem::path tmp_dir = dir, csg = tmp_dir / "model.csg", log = tmp_dir / "openscad.log";
-  const std::string cmd = "openscad -o " + shell_quote(csg.string()) + " " +
-                          shell_quote(std::filesystem::absolute(path).string()) + " >" +
-                          shell_quote(log.string()) + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  const double openscad_seconds = since(t0);
-  if (rc != 0 || !std::filesystem::exists(csg)) {
-    std::string msg;
-    std::ifstream l(log);
-    for (std::string line; std::getline(l, line);)
-      if (line.find("ERROR") != std::string::npos) {
-        msg = line;
-        break;
-      }
-    std::filesystem::remove_all(tmp_dir);
-    throw InvalidInput("openscad could not export " + path.string() + (msg.empty() ? "" : ": " + msg));
-  }
-  EvalOptions o = options;
-  if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
-  try {
-    std::ifstream in(csg, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    std::filesystem::remove_all(tmp_dir);
-    Octree t = eval_csg(ss.str(), o, stats, path.string());
-    if (stats) {
-      stats->openscad_seconds = openscad_seconds;
-      stats->seconds += openscad_seconds;
-    }
-    return t;
-  } catch (...) {
-    std::filesystem::remove_all(tmp_dir);
-    throw;
-  }
-}
-
-}  // namespace pic
+}  // namespace pic::detail::scad

@@ -1,0 +1,328 @@
+// The paired recursion over A's and B's cells (paper section 5.2), writing the result into
+// fragments that land in A once every task is done. See combine.h.
+#include "csg/combine.h"
+
+#include "csg/gray_cell.h"
+
+namespace pic::detail {
+
+namespace {
+
+
+/// Levels whose cells split into parallel tasks when both operands are subdivided there.
+constexpr int kParallelLevels = 4;
+
+/// What one task of the combine step builds, kept apart from A (which every task reads) until
+/// the tasks are done: new nodes and vertices, and writes into A's existing slots. Indices with
+/// kLocal set point into the fragment's own arrays; the others into A's.
+struct Fragment {
+  static constexpr uint32_t kLocal = 1u << 31;
+  std::vector<Node> nodes;
+  std::vector<std::array<float, 3>> vertices;
+  std::vector<std::pair<uint32_t, Node>> pending;  // A's slot -> node
+  std::vector<SignHint> hints;                      // see sign_hint()
+
+  static bool is_local(uint32_t index) { return (index & kLocal) != 0; }
+  /// `n` with its fragment-local index moved to where the fragment's arrays land (bases
+  /// possibly local themselves, when merging into a parent fragment).
+  static Node relocate(Node n, uint32_t node_base, uint32_t vertex_base) {
+    if (n.kind == CellKind::Internal && is_local(n.index)) n.index = node_base + (n.index & ~kLocal);
+    if (n.kind == CellKind::Gray && is_local(n.index)) n.index = vertex_base + (n.index & ~kLocal);
+    return n;
+  }
+  /// Appends `f` to this fragment; returns `root` (a node of f) relocated.
+  Node absorb(const Fragment& f, Node root) {
+    const uint32_t nb = kLocal | uint32_t(nodes.size()), vb = kLocal | uint32_t(vertices.size());
+    for (const Node& n : f.nodes) nodes.push_back(relocate(n, nb, vb));
+    vertices.insert(vertices.end(), f.vertices.begin(), f.vertices.end());
+    for (const auto& [slot, n] : f.pending) pending.push_back({slot, relocate(n, nb, vb)});
+    hints.insert(hints.end(), f.hints.begin(), f.hints.end());
+    return relocate(root, nb, vb);
+  }
+};
+
+/// What the recursion counts; each task counts its own, summed when the tasks merge.
+struct CombineCounts {
+  size_t cells_visited = 0, gray_pairs = 0, forced_subdivisions = 0;
+  CombineCounts& operator+=(const CombineCounts& o) {
+    cells_visited += o.cells_visited;
+    gray_pairs += o.gray_pairs;
+    forced_subdivisions += o.forced_subdivisions;
+    return *this;
+  }
+};
+
+/// Builds nodes and vertices into one task's Fragment (new slots are fragment-local).
+class FragmentWriter {
+ public:
+  explicit FragmentWriter(Fragment& out) : out_(out) {}
+
+  void hint(const SignHint& h) { out_.hints.push_back(h); }
+  void set(uint32_t slot, const Node& n) {
+    if (Fragment::is_local(slot)) out_.nodes[slot & ~Fragment::kLocal] = n;
+    else out_.pending.push_back({slot, n});
+  }
+  uint32_t alloc8() {
+    const auto first = static_cast<uint32_t>(out_.nodes.size());
+    out_.nodes.resize(first + 8);
+    return Fragment::kLocal | first;
+  }
+  Node gray(const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
+    Node n = add_gray(out_.vertices, cell, signs, x, flags);
+    n.index |= Fragment::kLocal;
+    return n;
+  }
+  static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
+
+  /// Copies a subtree of `src` into the output, complemented if `invert`.
+  Node copy_subtree(const Octree& src, uint32_t node, bool invert) {
+    const Node n = src.nodes[node];
+    switch (n.kind) {
+      case CellKind::White:
+      case CellKind::Black: return uniform((n.kind == CellKind::Black) != invert);
+      case CellKind::Gray:
+        out_.vertices.push_back(src.vertices[n.index]);
+        return Node{Fragment::kLocal | static_cast<uint32_t>(out_.vertices.size() - 1), CellKind::Gray,
+                    invert ? uint8_t(~n.signs) : n.signs, n.flags, 0};
+      case CellKind::Internal: {
+        const uint32_t first = alloc8();
+        for (int c = 0; c < 8; ++c) set(first + c, copy_subtree(src, n.index + c, invert));
+        return Node{first, CellKind::Internal, 0, 0, 0};
+      }
+    }
+    return n;
+  }
+
+  /// Appends a freshly sampled subtree; returns its root.
+  Node append(const Builder& sub) {
+    const size_t from = out_.nodes.size();
+    Node root = append_subtree(out_.nodes, out_.vertices, sub);
+    auto mark = [](Node& n) {
+      if (n.kind == CellKind::Internal || n.kind == CellKind::Gray) n.index |= Fragment::kLocal;
+    };
+    for (size_t k = from; k < out_.nodes.size(); ++k) mark(out_.nodes[k]);
+    mark(root);
+    return root;
+  }
+
+  /// Appends another task's fragment; returns its root relocated.
+  Node absorb(const Fragment& f, Node root) { return out_.absorb(f, root); }
+
+ private:
+  Fragment& out_;
+};
+
+/// The paired recursion over A's and B's cells (paper 5.2): trivial cases, GraycellCSG where
+/// both are gray, forced subdivision (resampling a leaf's partial contour) where one is finer.
+class Combiner {
+ public:
+  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
+           int parallel_levels, bool parallel, CombineCounts& stats)
+      : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
+        parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
+
+  /// The result's root node (its index may be fragment-local).
+  Node run() {
+    Side sa = side_of(a_, 0, Cell{});
+    Side sb = side_of(b_, 0, Cell{});
+    return combine(Cell{}, sa, sb);
+  }
+
+ private:
+  static Node uniform(bool inside) { return FragmentWriter::uniform(inside); }
+
+  /// Resamples a (virtual) gray cell of operand x from its partial contour.
+  Node resample(Operand& x, const Cell& cell, const Side& s, bool invert) {
+    FanSource src(x);
+    SampleParams p;
+    p.max_depth = max_depth_;
+    p.error = error_;
+    p.invert = invert;
+    Builder sub;
+    sub.nodes.resize(1);
+    size_t capped = 0;
+    sample_cell(src, p, cell, s.signs, s.idx, sub, 0, capped);
+    ++stats_.forced_subdivisions;
+    return out_.append(sub);
+  }
+
+  /// An operand's cell as the result (complemented if `invert`): A's own nodes stay in place.
+  Node copy_side(Operand& x, const Side& s, const Cell& cell, bool invert, bool is_a) {
+    switch (s.kind) {
+      case Side::Uniform: return uniform(s.inside != invert);
+      case Side::Internal:
+        if (is_a && !invert) return x.t.nodes[s.node];  // unchanged subtree of A, in place
+        return out_.copy_subtree(x.t, s.node, invert);
+      case Side::Gray:
+        if (s.real) {
+          if (is_a && !invert) return x.t.nodes[s.node];
+          return out_.copy_subtree(x.t, s.node, invert);
+        }
+        return resample(x, cell, s, invert);
+    }
+    return uniform(false);
+  }
+
+  Node combine(const Cell& cell, const Side& a, const Side& b) {
+    ++stats_.cells_visited;
+    if (a.kind == Side::Uniform) {
+      if (b.kind == Side::Uniform) return uniform(apply(op_, a.inside, b.inside));
+      // white | X = X, black & X = X, black - X = not X; the rest are uniform.
+      if (op_ == CsgOp::Union) return a.inside ? uniform(true) : copy_side(b_, b, cell, false, false);
+      if (op_ == CsgOp::Intersect) return a.inside ? copy_side(b_, b, cell, false, false) : uniform(false);
+      return a.inside ? copy_side(b_, b, cell, true, false) : uniform(false);
+    }
+    if (b.kind == Side::Uniform) {
+      if (op_ == CsgOp::Union) return b.inside ? uniform(true) : copy_side(a_, a, cell, false, true);
+      if (op_ == CsgOp::Intersect) return b.inside ? copy_side(a_, a, cell, false, true) : uniform(false);
+      return b.inside ? uniform(false) : copy_side(a_, a, cell, false, true);
+    }
+    if (a.kind == Side::Internal || b.kind == Side::Internal) return subdivide(cell, a, b);
+    return gray_cell(cell, a, b);
+  }
+
+  Node subdivide(const Cell& cell, const Side& a, const Side& b) {
+    // Children of A's internal node are written in place; otherwise new slots.
+    uint32_t first;
+    if (a.kind == Side::Internal) {
+      first = a_.t.nodes[a.node].index;
+    } else {
+      first = out_.alloc8();
+      if (a.kind == Side::Gray && a.real) ++stats_.forced_subdivisions;
+    }
+    if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
+    std::array<Node, 8> kids;
+    if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) kids = split_in_tasks(cell, a, b);
+    else
+      for (int c = 0; c < 8; ++c) kids[c] = combine(cell.child(c), child_side(a_, a, cell, c), child_side(b_, b, cell, c));
+    bool all_uniform = true;
+    for (int c = 0; c < 8; ++c) {
+      out_.set(first + c, kids[c]);
+      all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
+                    kids[c].kind == kids[0].kind;
+    }
+    if (all_uniform) return uniform(kids[0].kind == CellKind::Black);  // collapse
+    return Node{first, CellKind::Internal, 0, 0, 0};
+  }
+
+  /// Near the root, each child is a task with its own fragment and caches, merged in child
+  /// order: the same bytes whether the tasks run in parallel or not.
+  std::array<Node, 8> split_in_tasks(const Cell& cell, const Side& a, const Side& b) {
+    std::array<Node, 8> kids;
+    std::array<Fragment, 8> frags;
+    std::array<CombineCounts, 8> sub_stats;
+    auto task = [&](int c) {
+      Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
+      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
+      kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c), child_side(cb, b, cell, c));
+    };
+    if (parallel_) tbb::parallel_for(0, 8, task);
+    else for (int c = 0; c < 8; ++c) task(c);
+    for (int c = 0; c < 8; ++c) {
+      kids[c] = out_.absorb(frags[c], kids[c]);
+      stats_ += sub_stats[c];
+    }
+    return kids;
+  }
+
+  /// GraycellCSG: both operands gray over the cell. A leaf when the cell resolves (culled to
+  /// one operand or uniform, or a new vertex where the surfaces meet); else split.
+  Node gray_cell(const Cell& cell, const Side& a, const Side& b) {
+    ++stats_.gray_pairs;
+    const uint8_t sr = apply_mask(op_, a.signs, b.signs);
+    // The same PIC in both operands (A op A, or untouched common history): nothing to compute.
+    if (a.real && b.real && a.signs == b.signs &&
+        a_.t.vertices[a_.t.nodes[a.node].index] == b_.t.vertices[b_.t.nodes[b.node].index]) {
+      if (op_ == CsgOp::Subtract) return uniform(false);
+      return copy_side(a_, a, cell, false, true);
+    }
+    const bool at_cap = cell.level >= max_depth_;
+    if (!unresolved(a) && !unresolved(b)) {
+      const EdgeVerdict ev = edge_verdict(op_, a_, a, b_, b, cell);
+      if (!ev.must_split)
+        if (const std::optional<Node> leaf = gray_leaf(cell, a, b, sr, ev, at_cap)) return *leaf;
+    }
+    if (at_cap) {
+      if (sr == 0 || sr == 0xff) return uniform(sr != 0);
+      const CellQefs q = cell_qefs(a_, a, b_, b, cell);
+      if (!one_component(sr))
+        if (const std::optional<SignHint> h = sign_hint(op_, a_, b_, cell, sr)) out_.hint(*h);
+      return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr).position, kFlagCapped);
+    }
+    return subdivide(cell, a, b);
+  }
+
+  /// The cell as one leaf, if it may be one: triangle-fan culling where the surfaces do not
+  /// meet, Q_sum's vertex where they do (paper eq. 3); nothing when the cell must split.
+  std::optional<Node> gray_leaf(const Cell& cell, const Side& a, const Side& b, uint8_t sr, const EdgeVerdict& ev,
+                                bool at_cap) {
+    const bool simple = at_cap || refinement_is_simple(op_, a_, a, b_, b, cell, sr);
+    if (!simple) return std::nullopt;
+    if (!surfaces_meet(a_, a, b_, b, cell)) {
+      // The surfaces do not meet here, so the result is one operand's cell, or uniform, when
+      // the signs agree.
+      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
+      if (!ev.vis_a && !ev.vis_b && (sr == 0 || sr == 0xff)) return uniform(sr != 0);
+      if (ev.vis_a && !ev.vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
+      if (ev.vis_b && !ev.vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
+      return std::nullopt;
+    }
+    // Q_sum = Q_A + Q_B minimized from the average of the two vertices.
+    const CellQefs q = cell_qefs(a_, a, b_, b, cell);
+    const Vec3 va = operand_vertex(a_, a, q.a, cell), vb = operand_vertex(b_, b, q.b, cell);
+    const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
+    const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
+    Qef::Solution sol = q.sum.solve_in_box(seed, lo, hi);
+    if (!inside_cell(sol.position, cell)) sol = cell_vertex(q.sum, cell, sr);
+    if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
+        feature_is_local(a_, b_, cell, sol.position, error_, scratch_))
+      return out_.gray(cell, sr, sol.position, 0);
+    return std::nullopt;
+  }
+
+  FragmentWriter out_;
+  Operand& a_;
+  Operand& b_;
+  CsgOp op_;
+  double error_;
+  int max_depth_;
+  uint32_t stamp_;
+  int parallel_levels_;
+  bool parallel_;
+  CombineCounts& stats_;
+  std::vector<uint32_t> scratch_;
+};
+
+}  // namespace
+
+/// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
+/// A's, and A's own slots are written only once all tasks are done.
+std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, const Stamps& sb, const PartialContour& pa,
+                                      const PartialContour& pb, CsgOp op, const CsgOptions& options, int depth,
+                                      uint32_t stamp, CsgStats& stats) {
+  Fragment f;
+  Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
+  CombineCounts counts;
+  Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
+  const Node root = comb.run();
+  stats.cells_visited = counts.cells_visited;
+  stats.gray_pairs = counts.gray_pairs;
+  stats.forced_subdivisions = counts.forced_subdivisions;
+  const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
+  for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
+  a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
+  sa.resize(a.nodes.size(), stamp);
+  // A slot written here is part of the result this operation made, even where the tag step
+  // left it unstamped (A uniform there, B's subtree copied in): the clean-up must see it, or
+  // B's own defects there pass into the result unchecked (an island a sampled tool carries —
+  // a small sphere's pole piercing a lattice plane beside a coarse leaf — became a sculpting
+  // stroke's pinched vertex). Cleaning these parts too costs sculpting about 2-3 ms a stroke.
+  for (const auto& [slot, n] : f.pending) {
+    a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+    sa[slot] = stamp;
+  }
+  a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
+  return std::move(f.hints);
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,218 @@
+// GraycellCSG's predicates (paper Figure 3): whether the summed QEF's vertex may stand for the
+// result in a cell, or the cell must be subdivided. See gray_cell.h.
+#include "csg/gray_cell.h"
+
+namespace pic::detail {
+
+namespace {
+
+/// Corners i and j of a cell joined by a cube edge.
+bool adjacent_corners(int i, int j) { return std::popcount(unsigned(i ^ j)) == 1; }
+
+/// The result's signs between a finest cell's corners, from the two operands (their signs at
+/// the finer lattice points half-way).
+struct HalfwaySigns {
+  CsgOp op;
+  Operand& xa;
+  Operand& xb;
+  const Cell& cell;
+  bool between(int i, int j) const {
+    const Lat p = cell.corner(i), q = cell.corner(j);
+    const Lat m{(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2};
+    return apply(op, xa.sign(m), xb.sign(m));
+  }
+};
+
+/// Whether all the corners of sign `inside` are one component once the result's sign half-way
+/// between two of them (a face or body diagonal) may join them.
+bool joined_halfway(const HalfwaySigns& h, uint8_t sr, bool inside) {
+  std::array<int, 8> comp;  // union-find over the corners
+  for (int i = 0; i < 8; ++i) comp[i] = i;
+  auto root = [&](int i) {
+    while (comp[i] != i) i = comp[i];
+    return i;
+  };
+  auto has = [&](int i) { return bool((sr >> i) & 1) == inside; };
+  for (int i = 0; i < 8; ++i)
+    for (int j = i + 1; j < 8; ++j)
+      if (has(i) && has(j) && adjacent_corners(i, j)) comp[root(j)] = root(i);
+  for (int i = 0; i < 8; ++i)
+    for (int j = i + 1; j < 8; ++j)
+      if (has(i) && has(j) && root(i) != root(j) && h.between(i, j) == inside) comp[root(j)] = root(i);
+  int first = -1;
+  for (int i = 0; i < 8; ++i)
+    if (has(i)) {
+      if (first < 0) first = i;
+      if (root(i) != root(first)) return false;
+    }
+  return true;
+}
+
+/// The corner of the other sign whose flip to `inside` leaves the cell one component, with the
+/// most of its edges' midpoints on the `inside` side; -1 when no flip does.
+int corner_to_join(const HalfwaySigns& h, uint8_t sr, bool inside) {
+  int best = -1, best_score = -1;
+  for (int k = 0; k < 8; ++k) {
+    if (bool((sr >> k) & 1) == inside) continue;
+    const uint8_t flipped = uint8_t(sr ^ (1 << k));
+    if (flipped != 0 && flipped != 0xff && !one_component(flipped)) continue;
+    int score = 0;
+    for (int a = 0; a < 3; ++a) score += h.between(k, k ^ (1 << a)) == inside;
+    if (score > best_score) {
+      best_score = score;
+      best = k;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+/// A finest leaf whose corner signs make more than one component (corners of one sign meeting
+/// only diagonally): the clean-up must flip a corner, and its default (flip the minority sign)
+/// erases a solid or a gap about a cell thick lying obliquely to the lattice, whose lattice
+/// points meet only diagonally (harness seed 30: a box face and a torus meeting at a shallow
+/// angle, a slab 1-2 cells thick cut to pieces; seed 82). The operands know better: the
+/// result's sign half-way between two such corners says whether the solid (or the gap) joins
+/// them. When it joins all the corners of one sign, the hint flips a corner of the other sign
+/// to it. Nothing when it joins neither (a feature thinner than a cell).
+std::optional<SignHint> sign_hint(CsgOp op, Operand& xa, Operand& xb, const Cell& cell, uint8_t sr) {
+  const HalfwaySigns h{op, xa, xb, cell};
+  for (const bool inside : {true, false}) {
+    if (!joined_halfway(h, sr, inside)) continue;
+    if (const int k = corner_to_join(h, sr, inside); k >= 0) return SignHint{cell.corner(k), inside};
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+struct EdgeCrossing {
+  bool change;
+  double t;
+  int count;
+};
+EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axis, i64 len, int c0, int c1) {
+  EdgeCrossing r{(((s.signs >> c0) ^ (s.signs >> c1)) & 1) != 0, 0.5, 0};
+  for (uint32_t k : s.idx) {
+    if (crosses(x.tris[k], a, axis, len)) {
+      if (r.count == 0) r.t = crossing_param(x.tris[k], a, axis, len);
+      ++r.count;
+    }
+  }
+  return r;
+}
+
+
+}  // namespace
+
+/// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
+/// Table 1): two result crossings on one edge force a subdivision, as do two crossings of one
+/// operand on an edge of a virtual cell.
+EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b,
+                         const Cell& cell) {
+  EdgeVerdict v;
+  const I3 lo = lattice_to_grid(cell.lat);
+  const i64 len = lattice_to_grid(cell.span());
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
+    const EdgeCrossing ea = edge_crossing(xa, a, p, axis, len, c0, c1);
+    const EdgeCrossing eb = edge_crossing(xb, b, p, axis, len, c0, c1);
+    if ((!a.real && ea.count >= 2) || (!b.real && eb.count >= 2)) {
+      v.must_split = true;
+      return v;
+    }
+    if (!ea.change && !eb.change) continue;
+    const bool a0 = (a.signs >> c0) & 1, b0 = (b.signs >> c0) & 1;
+    auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
+    auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
+    int n_r = 0;
+    if (ea.change && eb.change && ea.t == eb.t) {
+      n_r = apply(op, a0, b0) != apply(op, !a0, !b0);
+      v.vis_a = v.vis_b = v.vis_a || n_r;
+    } else {
+      if (ea.change) {
+        const bool vis = apply(op, a0, in_b(ea.t)) != apply(op, !a0, in_b(ea.t));
+        n_r += vis;
+        v.vis_a = v.vis_a || vis;
+      }
+      if (eb.change) {
+        const bool vis = apply(op, in_a(eb.t), b0) != apply(op, in_a(eb.t), !b0);
+        n_r += vis;
+        v.vis_b = v.vis_b || vis;
+      }
+    }
+    if (n_r >= 2) {
+      v.must_split = true;
+      return v;
+    }
+  }
+  return v;
+}
+
+/// Whether the two operands' partial contours meet inside the cell.
+bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
+  for (uint32_t i : a.idx)
+    for (uint32_t j : b.idx)
+      if (triangles_meet_in_box(xa.tris[i], xb.tris[j], cell.box())) return true;
+  return false;
+}
+
+/// The new feature (where the two surfaces meet) must also fit one point or line over the
+/// cell grown by half its size on every side: dual contouring joins this vertex to its
+/// neighbours' by straight edges, so a curved intersection (a hole's rim) is refined until
+/// those edges follow it. Not in the paper, whose per-cell test lets big cells sit on a
+/// curved rim and chords cut across it.
+bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, const Vec3& x, double error,
+                      std::vector<uint32_t>& scratch) {
+  IBox g = cell.box();
+  const i64 h = lattice_to_grid(cell.span()) / 2;
+  for (int k = 0; k < 3; ++k) {
+    g.lo[k] = std::max<i64>(0, g.lo[k] - h);
+    g.hi[k] = std::min<i64>(i64{1} << kGridBits, g.hi[k] + h);
+  }
+  const double face = 4 * cell.size() * cell.size();
+  Qef q;
+  scratch.clear();
+  xa.bvh.query(xa.tris, g.lo, g.hi, scratch);
+  box_qef(xa.tris, scratch, g, face, q);
+  scratch.clear();
+  xb.bvh.query(xb.tris, g.lo, g.hi, scratch);
+  box_qef(xb.tris, scratch, g, face, q);
+  return q.solve(x).error < error;
+}
+
+/// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a
+/// leaf here would meet finer neighbours showing a second sheet on its faces.
+bool refinement_is_simple(CsgOp op, Operand& xa, const Side& a, Operand& xb, const Side& b, const Cell& cell,
+                          uint8_t sr) {
+  std::array<bool, 27> g{};
+  for (int k = 0; k < 8; ++k) g[grid_index_of_corner(k)] = (sr >> k) & 1;
+  const int64_t h = cell.span() / 2;
+  for (int i = 0; i < 27; ++i) {
+    const int x = i % 3, y = (i / 3) % 3, z = i / 9;
+    if (x != 1 && y != 1 && z != 1) continue;
+    const Lat p{cell.lat[0] + x * h, cell.lat[1] + y * h, cell.lat[2] + z * h};
+    g[i] = apply(op, xa.sign_in(p, a.node, a.leaf_cell), xb.sign_in(p, b.node, b.leaf_cell));
+  }
+  return grid_is_simple(g);
+}
+
+CellQefs cell_qefs(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
+  CellQefs q;
+  cell_qef(xa.tris, a.idx, cell, q.a);
+  cell_qef(xb.tris, b.idx, cell, q.b);
+  q.sum = q.a;
+  q.sum += q.b;
+  return q;
+}
+
+/// An operand's own vertex in the cell: the leaf's stored one, or the minimizer of its QEF in
+/// a virtual cell.
+Vec3 operand_vertex(const Operand& x, const Side& s, const Qef& q, const Cell& cell) {
+  if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
+  return cell_vertex(q, cell, s.signs).position;
+}
+
+}  // namespace pic::detail

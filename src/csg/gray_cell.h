@@ -1,0 +1,52 @@
+// GraycellCSG's predicates (paper section 5.2.3, Figure 3), each a question about one cell of
+// the paired recursion: what its edges say, whether the two surfaces meet in it, whether the
+// summed QEF's feature is local, whether the result's finer signs are simple, the sign hints
+// for the clean-up.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "csg/operand.h"
+
+namespace pic::detail {
+
+/// A finest leaf whose corner signs make more than one component (corners of one sign meeting
+/// only diagonally): the result's sign half-way between such corners says whether the solid
+/// (or the gap) joins them; when it joins all the corners of one sign, the hint asks the
+/// clean-up to flip a corner of the other sign. Nothing when it joins neither.
+std::optional<SignHint> sign_hint(CsgOp op, Operand& xa, Operand& xb, const Cell& cell, uint8_t sr);
+
+/// What the cell's edges say: whether either operand's surface is visible in the result
+/// there, and whether the cell must split.
+struct EdgeVerdict {
+  bool must_split = false;
+  bool vis_a = false, vis_b = false;
+};
+/// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3, Table 1).
+EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b,
+                         const Cell& cell);
+
+/// Whether the two operands' partial contours meet inside the cell.
+bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
+
+/// Whether the new feature (where the surfaces meet) fits one point or line over the cell
+/// grown by half its size on every side.
+bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, const Vec3& x, double error,
+                      std::vector<uint32_t>& scratch);
+
+/// Whether the result's signs on the cell's child grid are simple (grid_is_simple).
+bool refinement_is_simple(CsgOp op, Operand& xa, const Side& a, Operand& xb, const Side& b, const Cell& cell,
+                          uint8_t sr);
+
+/// The two operands' QEFs over the cell, and their sum.
+struct CellQefs {
+  Qef a, b, sum;
+};
+CellQefs cell_qefs(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
+
+/// An operand's own vertex in the cell: the leaf's stored one, or the minimizer of its QEF in
+/// a virtual cell.
+Vec3 operand_vertex(const Operand& x, const Side& s, const Qef& q, const Cell& cell);
+
+}  // namespace pic::detail

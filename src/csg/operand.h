@@ -1,0 +1,294 @@
+// One operand of a Boolean as the CSG sees it (paper section 5): its signs as a function of
+// the lattice point (stored corner signs; inside a gray leaf, crossing parity through its
+// partial contour), its partial contour, and its state over a cell of the recursion.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <tbb/parallel_for.h>
+
+#include "geometry/bvh.h"
+#include "contour/dual_walk.h"
+#include "csg/cleanup.h"
+#include "sample/sampler.h"
+#include "signs/passes.h"
+
+namespace pic::detail {
+
+using Lat = std::array<int64_t, 3>;
+using Clock = std::chrono::steady_clock;
+inline double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+
+inline bool apply(CsgOp op, bool a, bool b) {
+  switch (op) {
+    case CsgOp::Union: return a || b;
+    case CsgOp::Intersect: return a && b;
+    case CsgOp::Subtract: return a && !b;
+  }
+  return false;
+}
+inline uint8_t apply_mask(CsgOp op, uint8_t a, uint8_t b) {
+  switch (op) {
+    case CsgOp::Union: return a | b;
+    case CsgOp::Intersect: return a & b;
+    case CsgOp::Subtract: return a & uint8_t(~b);
+  }
+  return 0;
+}
+
+/// Lattice point -> sign, open addressing with linear probing: the sign lookups are the CSG's
+/// hottest map. A key uses 63 bits (3 x 21); the sign rides in bit 63.
+class SignMemo {
+ public:
+  /// The stored sign of `key`, or -1.
+  int find(uint64_t key) const {
+    if (slots_.empty()) return -1;
+    for (size_t i = home(key);; i = (i + 1) & mask_) {
+      const uint64_t v = slots_[i];
+      if (v == kEmpty) return -1;
+      if ((v & kKeyBits) == key) return int(v >> 63);
+    }
+  }
+  void insert(uint64_t key, bool sign) {
+    if (2 * (count_ + 1) > slots_.size()) grow();
+    for (size_t i = home(key);; i = (i + 1) & mask_) {
+      if (slots_[i] == kEmpty) {
+        slots_[i] = key | uint64_t(sign) << 63;
+        ++count_;
+        return;
+      }
+      if ((slots_[i] & kKeyBits) == key) return;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty = ~uint64_t{0};
+  static constexpr uint64_t kKeyBits = ~uint64_t{0} >> 1;
+  size_t home(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
+  void grow() {
+    std::vector<uint64_t> old = std::move(slots_);
+    const size_t n = old.empty() ? 1024 : 2 * old.size();
+    slots_.assign(n, kEmpty);
+    mask_ = n - 1;
+    shift_ = 64 - std::countr_zero(n);
+    count_ = 0;
+    for (uint64_t v : old)
+      if (v != kEmpty) insert(v & kKeyBits, v >> 63);
+  }
+  std::vector<uint64_t> slots_;
+  size_t mask_ = 0, count_ = 0;
+  int shift_ = 64;
+};
+
+/// An operand's partial contour (grid units), indexed for box queries. Read-only once built,
+/// shared by all the tasks of an operation.
+struct PartialContour {
+  std::vector<ITri> tris;
+  TriangleBvh bvh;
+  /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
+  /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
+  /// crossings keep to `tris`, the operation's own cells. Empty when there are none.
+  std::vector<ITri> parity_tris;
+  TriangleBvh parity_bvh;
+  /// Whether the parity walks cross more than `tris` (parity_tris holds tris and the rest).
+  bool wider() const { return !parity_tris.empty(); }
+};
+
+/// One operand as seen by one task of an operation: its tree, its partial contour, and the
+/// task's caches (sign memo, triangles and anchor corner per leaf).
+struct Operand {
+  const Octree& t;
+  const PartialContour& pc;
+  const std::vector<ITri>& tris;
+  const TriangleBvh& bvh;
+  const std::vector<ITri>& parity_tris;
+  const TriangleBvh& parity_bvh;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
+  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_parity_tris;  // the same, of parity_tris
+  SignMemo memo;                                                  // signs of non-corner points
+  std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
+
+  const Stamps& stamps;  // per node of t: the operation's stamp where it stamped it
+  uint32_t stamp = 0;
+
+  Operand(const Octree& tree, const Stamps& tree_stamps, const PartialContour& contour, uint32_t op_stamp)
+      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
+        parity_tris(contour.wider() ? contour.parity_tris : contour.tris),
+        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamps(tree_stamps), stamp(op_stamp) {}
+
+  /// The corner of a gray leaf farthest from its contour triangles. A corner within the
+  /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
+  /// from the farthest corner keeps fresh signs consistent with the contour everywhere except
+  /// right next to such corners (cached per leaf).
+  int anchor_corner(uint32_t leaf, const Cell& cell) {
+    if (const auto it = anchors.find(leaf); it != anchors.end()) return it->second;
+    const auto& idx = parity_triangles_in(leaf, cell);
+    int best = 0;
+    double best_d = -1;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
+      double d = 1e300;
+      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, parity_tris[k]));
+      if (d > best_d) {
+        best_d = d;
+        best = c;
+      }
+    }
+    anchors.emplace(leaf, best);
+    return best;
+  }
+
+  /// Partial-contour triangles meeting a leaf's cell (cached per leaf).
+  const std::vector<uint32_t>& triangles_in(uint32_t leaf, const Cell& cell) {
+    return cached_query(leaf_tris, tris, bvh, leaf, cell);
+  }
+  /// The same for the triangles the parity walks cross.
+  const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
+    if (&parity_tris == &tris) return triangles_in(leaf, cell);
+    return cached_query(leaf_parity_tris, parity_tris, parity_bvh, leaf, cell);
+  }
+  /// The triangles of `in` (indexed by `index`) meeting a leaf's cell, cached in `cache`.
+  static const std::vector<uint32_t>& cached_query(std::unordered_map<uint32_t, std::vector<uint32_t>>& cache,
+                                                   const std::vector<ITri>& in, const TriangleBvh& index,
+                                                   uint32_t leaf, const Cell& cell) {
+    auto [it, fresh] = cache.try_emplace(leaf);
+    if (fresh) {
+      const IBox b = cell.box();
+      index.query(in, b.lo, b.hi, it->second);
+      std::sort(it->second.begin(), it->second.end());  // deterministic order
+    }
+    return it->second;
+  }
+
+  struct Hit {
+    int state = 0;  // 0 none, 1 corner/uniform (sign known), 2 inside a gray leaf
+    bool sign = false;
+    uint32_t leaf = 0;
+    Cell cell;
+  };
+
+  static bool contains(const Cell& c, const Lat& p) {
+    const int64_t s = c.span();
+    for (int k = 0; k < 3; ++k)
+      if (p[k] < c.lat[k] || p[k] > c.lat[k] + s) return false;
+    return true;
+  }
+  Hit find(uint32_t node, const Cell& cell, const Lat& p) const {
+    const Node& n = t.nodes[node];
+    const int k = cell.corner_index(p);
+    if (k >= 0) {
+      if (n.kind == CellKind::Internal) return find(n.index + k, cell.child(k), p);
+      const bool s = n.kind == CellKind::Gray ? ((n.signs >> k) & 1) : n.kind == CellKind::Black;
+      return {1, s, node, cell};
+    }
+    if (n.kind == CellKind::White || n.kind == CellKind::Black) return {1, n.kind == CellKind::Black, node, cell};
+    if (n.kind == CellKind::Gray) return {2, false, node, cell};
+    // On a face shared by several gray leaves, prefer one stamped by this operation: only
+    // stamped leaves have their whole partial contour, which the parity walk needs.
+    Hit gray;
+    for (int c = 0; c < 8; ++c) {
+      const Cell cc = cell.child(c);
+      if (!contains(cc, p)) continue;
+      const Hit h = find(n.index + c, cc, p);
+      if (h.state == 1) return h;
+      if (h.state == 2 && (gray.state == 0 || (stamps[gray.leaf] != stamp && stamps[h.leaf] == stamp)))
+        gray = h;
+    }
+    return gray;
+  }
+
+  /// sign_X(p): single-valued by construction (a pure function of the tree and p).
+  bool sign(const Lat& p) {
+    // Every lattice point is asked for by up to 8 cells: remember all answers, not only the
+    // ones that needed a parity walk.
+    const uint64_t key = lattice_key(p);
+    if (const int m = memo.find(key); m >= 0) return m;
+    const Hit h = find(0, Cell{}, p);
+    if (h.state != 2) {
+      memo.insert(key, h.sign);
+      return h.sign;
+    }
+    return classify(p, h.leaf, h.cell);
+  }
+
+  /// sign_X(p) for p known to lie in the closed cell of gray leaf `leaf`: a point strictly
+  /// inside it needs no search from the root.
+  bool sign_in(const Lat& p, uint32_t leaf, const Cell& cell) {
+    const int64_t s = cell.span();
+    for (int k = 0; k < 3; ++k)
+      if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return sign(p);
+    if (const int m = memo.find(lattice_key(p)); m >= 0) return m;
+    return classify(p, leaf, cell);
+  }
+
+  /// Parity walk for p in gray leaf `leaf` (callers have checked the memo).
+  bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
+    const Hit h{2, false, leaf, cell};
+    const uint64_t key = lattice_key(p);
+    // Crossing parity along x, then y, then z from the leaf's most reliable corner.
+    const Node& n = t.nodes[h.leaf];
+    const auto& idx = parity_triangles_in(h.leaf, h.cell);
+    const int c = anchor_corner(h.leaf, h.cell);
+    bool s = (n.signs >> c) & 1;
+    I3 a = lattice_to_grid(h.cell.corner(c));
+    const I3 g = lattice_to_grid(p);
+    for (int axis = 0; axis < 3; ++axis) {
+      const i64 len = g[axis] - a[axis];
+      if (len > 0) s ^= count_crossings(parity_tris, idx, a, axis, len) & 1;
+      if (len < 0) {
+        I3 b = a;
+        b[axis] = g[axis];
+        s ^= count_crossings(parity_tris, idx, b, axis, -len) & 1;
+      }
+      a[axis] = g[axis];
+    }
+    memo.insert(key, s);
+    return s;
+  }
+};
+
+/// Sampler source over an operand's partial contour (forced subdivision, paper 5.2.3).
+class FanSource : public SurfaceSource {
+ public:
+  explicit FanSource(Operand& x) : x_(x) { tris_ = &x.tris; }
+  void child_grid_signs(const Cell& cell, const std::vector<uint32_t>&, std::array<bool, 27>& g,
+                        Wind27*) const override {
+    const int64_t h = cell.span() / 2;
+    for (int i = 0; i < 27; ++i) {
+      const int a = i % 3, b = (i / 3) % 3, c = i / 9;
+      if (a != 1 && b != 1 && c != 1) continue;  // parent corner, known
+      g[i] = x_.sign({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
+    }
+  }
+
+ private:
+  Operand& x_;
+};
+
+/// An operand's state over the current cell.
+struct Side {
+  enum Kind { Uniform, Internal, Gray } kind = Uniform;
+  bool inside = false;  // Uniform
+  uint32_t node = 0;    // Internal: the node; Gray: the leaf
+  bool real = false;    // Gray: the cell is the leaf's own cell
+  uint8_t signs = 0;    // Gray: signs at this cell's corners
+  std::vector<uint32_t> idx;  // Gray: partial-contour triangles overlapping this cell
+  Cell leaf_cell;             // Gray: the cell of the leaf `node`
+};
+
+/// The operand over `node` (cell `cell`): a uniform or internal node, or a gray leaf.
+Side side_of(Operand& x, uint32_t node, const Cell& cell);
+/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf.
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c);
+/// A virtual cell with no sign change that still holds surface: it must be refined until the
+/// surface shows in the signs.
+inline bool unresolved(const Side& s) { return !s.real && (s.signs == 0 || s.signs == 0xff); }
+
+}  // namespace pic::detail

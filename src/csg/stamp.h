@@ -1,0 +1,15 @@
+// Stamping (paper 5.2.1): the cells of both operands where their surfaces may meet, and the
+// partial contours around them that the combine step reads.
+#pragma once
+
+#include "csg/operand.h"
+
+namespace pic::detail {
+
+/// Stamps the cells where the operands' surfaces may meet (pairs where neither is uniform;
+/// under a gray leaf of A only B's cells that A's partial contour comes near) and builds both
+/// operands' partial contours. Sets stats.cells_stamped and the contour times.
+void stamp_overlap(const Octree& a, Stamps& sa, const Octree& b, Stamps& sb, uint32_t stamp, PartialContour& pa,
+                   PartialContour& pb, CsgStats& stats);
+
+}  // namespace pic::detail

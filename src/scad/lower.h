@@ -1,0 +1,27 @@
+// Lowering an OpenSCAD CSG tree: the parsed .csg tree becomes a tree of Booleans over closed
+// meshes in world coordinates (transforms pushed into the leaves; 2D subtrees under an
+// extrusion become extruded leaves combined with the same Booleans, since extrusion commutes
+// with them). evaluate.cpp then samples the leaves and runs the Booleans on octrees.
+#pragma once
+
+#include <vector>
+
+#include "pic/scad.h"
+#include "scad/scad_detail.h"
+
+namespace pic::detail::scad {
+
+/// The lowered tree: Booleans over closed meshes (3D) ...
+struct Solid {
+  enum class Kind { Empty, Mesh, Union, Intersect, Difference, Hull };
+  Kind kind = Kind::Empty;
+  TriMesh mesh;
+  std::vector<Solid> children;
+};
+
+/// Lowers `root`. `finest_cell` > 0 tessellates spheres, cylinders and circles against it
+/// (EvalOptions::smooth); 0 follows $fn/$fa/$fs. `nodes` (optional) gets the number of nodes.
+/// \throws InvalidInput for an unsupported node or bad arguments (naming the node's line).
+Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes);
+
+}  // namespace pic::detail::scad

@@ -1,0 +1,85 @@
+// `pic eval model.scad`: OpenSCAD exports the model's CSG tree, which evaluate.cpp evaluates.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "pic/scad.h"
+
+#include <chrono>
+
+namespace pic {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+bool on_path(const std::string& prog) {
+  const char* p = std::getenv("PATH");
+  std::stringstream ss(p ? p : "");
+  std::string dir;
+  while (std::getline(ss, dir, ':'))
+    if (!dir.empty() && ::access((std::filesystem::path(dir) / prog).c_str(), X_OK) == 0) return true;
+  return false;
+}
+std::string shell_quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+}  // namespace
+
+Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
+  std::string ext = path.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".csg") return eval_csg_file(path, options, stats);
+  if (ext != ".scad") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
+  if (!std::filesystem::exists(path)) throw IoError("cannot read " + path.string());
+  if (!on_path("openscad"))
+    throw InvalidInput("the 'openscad' program is needed for .scad input: install it (Debian: apt-get install "
+                       "openscad, or scripts/setup.sh) or pass a .csg file exported by OpenSCAD");
+  const auto t0 = Clock::now();
+  // OpenSCAD resolves a relative output path against the input's directory: give it an
+  // absolute temporary path.
+  char tmpl[] = "/tmp/pic-scad-XXXXXX";
+  const char* dir = ::mkdtemp(tmpl);
+  if (!dir) throw IoError("cannot create a temporary directory");
+  const std::filesystem::path tmp_dir = dir, csg = tmp_dir / "model.csg", log = tmp_dir / "openscad.log";
+  const std::string cmd = "openscad -o " + shell_quote(csg.string()) + " " +
+                          shell_quote(std::filesystem::absolute(path).string()) + " >" +
+                          shell_quote(log.string()) + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  const double openscad_seconds = since(t0);
+  if (rc != 0 || !std::filesystem::exists(csg)) {
+    std::string msg;
+    std::ifstream l(log);
+    for (std::string line; std::getline(l, line);)
+      if (line.find("ERROR") != std::string::npos) {
+        msg = line;
+        break;
+      }
+    std::filesystem::remove_all(tmp_dir);
+    throw InvalidInput("openscad could not export " + path.string() + (msg.empty() ? "" : ": " + msg));
+  }
+  EvalOptions o = options;
+  if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
+  try {
+    std::ifstream in(csg, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::filesystem::remove_all(tmp_dir);
+    Octree t = eval_csg(ss.str(), o, stats, path.string());
+    if (stats) {
+      stats->openscad_seconds = openscad_seconds;
+      stats->seconds += openscad_seconds;
+    }
+    return t;
+  } catch (...) {
+    std::filesystem::remove_all(tmp_dir);
+    throw;
+  }
+}
+
+}  // namespace pic
+
