@@ -17,11 +17,7 @@ using test::IsClosedManifold;
 
 constexpr double kPi = std::numbers::pi;
 
-TriMesh contour_split(const Octree& t) {
-  TriMesh m = unsplit_contour(t);
-  split_nonmanifold(m);
-  return m;
-}
+TriMesh contour_split(const Octree& t) { return contour(t); }
 
 Octree sample_depth(const TriMesh& m, int depth, SampleStats* st = nullptr, InsideMode mode = InsideMode::Auto,
                     std::optional<Cube> cube = std::nullopt) {
@@ -201,6 +197,42 @@ TEST(AnyInput, AFlatSheetEnclosesNoSolid) {
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("no solid"), std::string::npos) << e.what();
   }
+}
+
+// A real-size planar drawing (a jittered 60 x 60 grid: 6,962 triangles, all vertices on one
+// plane) has no solid either, lying along a lattice plane or tilted, open or with its two
+// sides doubled into a closed "shell" of zero thickness.
+TEST(AnyInput, FlatDrawingsAreRefused) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  const int n = 60;
+  TriMesh grid;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double x = (i + (i > 0 && i < n - 1 ? jitter(rng) : 0)) / (n - 1);
+      const double y = (j + (j > 0 && j < n - 1 ? jitter(rng) : 0)) / (n - 1);
+      grid.positions.push_back({0.1 + 0.8 * x, 0.1 + 0.8 * y, 0.5});
+    }
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const uint32_t a = j * n + i, b = a + 1, c = a + n, d = c + 1;
+      grid.triangles.push_back({a, b, d});
+      grid.triangles.push_back({a, d, c});
+    }
+  TriMesh doubled = grid;
+  for (const auto& t : grid.triangles) doubled.triangles.push_back({t[0], t[2], t[1]});
+  const TriMesh tilted = transformed(grid, rotation({1, 2, 3}, 0.7), {0.2, -0.1, 0.1});
+  for (const TriMesh* m : std::initializer_list<const TriMesh*>{&grid, &doubled, &tilted}) {
+    try {
+      sample_depth(*m, 9);
+      FAIL() << "a flat mesh of " << m->triangles.size() << " triangles was sampled";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("no solid"), std::string::npos) << e.what();
+    }
+  }
+  // A thin but real slab (2 finest cells thick) is still a solid.
+  const Octree slab = sample_depth(make_box({0.1, 0.1, 0.5}, {0.9, 0.9, 0.5 + 2.0 / 512}), 9);
+  EXPECT_GT(slab.vertices.size(), 0u);
 }
 
 TEST(AnyInput, PointCloudOfASphereGivesTheSphere) {

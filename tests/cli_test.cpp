@@ -106,6 +106,26 @@ void expect_json_object(const std::string& out) {
 
 std::string fandisk() { return quote(std::string(PIC_DATA_DIR) + "/fandisk.obj"); }
 
+// A mesh that is written but is not a valid solid never passes silently: the plain split of
+// fandisk at depth 10 keeps crossing triangles, which --json's exact check counts. The file is
+// written, the JSON says which count is off, one stderr line says so, and the exit code is 4.
+TEST_F(Cli, InvalidOutputIsReportedWithExitCode4) {
+  ASSERT_EQ(pic("sample " + fandisk() + " --depth 10 -o f.pic").code, 0);
+  const CliRun fast = pic("mesh f.pic -o fast.obj --fast --json");
+  EXPECT_EQ(fast.code, 4) << fast.err;
+  expect_json_object(fast.out);
+  EXPECT_GT(json_number(fast.out, "self_intersections"), 0);
+  EXPECT_EQ(fast.err_lines(), 1u) << fast.err;
+  EXPECT_NE(fast.err.find("fast.obj was written but is not a valid solid"), std::string::npos) << fast.err;
+  EXPECT_NE(fast.err.find("self-intersecting"), std::string::npos) << fast.err;
+  EXPECT_FALSE(read_mesh(path("fast.obj")).triangles.empty());
+  // The default contour of the same tree is valid: exit 0, nothing on stderr.
+  const CliRun clean = pic("mesh f.pic -o clean.obj --json");
+  EXPECT_EQ(clean.code, 0) << clean.err;
+  EXPECT_EQ(json_number(clean.out, "self_intersections"), 0);
+  EXPECT_TRUE(clean.err.empty()) << clean.err;
+}
+
 TEST_F(Cli, SampleMeshInfoPipelineJson) {
   const CliRun s = pic("sample " + fandisk() + " -o x.pic --json");
   ASSERT_EQ(s.code, 0) << s.err;

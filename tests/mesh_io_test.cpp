@@ -204,7 +204,8 @@ TEST(MeshIo, MalformedObjIsRejected) {
   TempDir dir;
   write_file(dir / "badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n");
   expect_input_error([&] { read_mesh(dir / "badindex.obj"); }, "badindex.obj", "face index out of range");
-  write_file(dir / "garbage.obj", std::string("\x01\x02\x03\xff\xfe garbage \x00 more", 24));
+  const char garbage[] = "\x01\x02\x03\xff\xfe garbage \x00 more";  // with its NUL inside
+  write_file(dir / "garbage.obj", std::string(garbage, sizeof garbage - 1));
   expect_input_error([&] { read_mesh(dir / "garbage.obj"); }, "garbage.obj", "binary garbage");
 }
 

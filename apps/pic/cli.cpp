@@ -64,6 +64,24 @@ Json& add_validity(Json& j, const MeshValidity& v) {
   return j.fields(v);
 }
 
+void require_valid(const WrittenMesh& m) {
+  std::string off;
+  auto count = [&](size_t n, const char* what) {
+    if (n) off += (off.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  count(m.topology.boundary_edges, "boundary edges");
+  count(m.topology.nonmanifold_edges, "non-manifold edges");
+  count(m.topology.nonmanifold_vertices, "non-manifold vertices");
+  count(m.topology.inconsistent_edges, "inconsistently oriented edges");
+  if (m.self_intersections) count(*m.self_intersections, "self-intersecting triangle pairs");
+  if (!off.empty()) throw InvalidOutput(m.path + " was written but is not a valid solid: " + off);
+}
+
+std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStats& s) {
+  if (!o.intersection_free) return std::nullopt;
+  return s.remaining_intersections;
+}
+
 std::string info_json(const Octree& tree, size_t file_bytes) {
   const auto s = analyze(tree);
   std::string levels = "[";

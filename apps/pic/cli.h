@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -57,6 +59,24 @@ std::string topology_json(const MeshTopology& t);
 std::string topology_words(const MeshTopology& t);
 /// A written mesh's validity (pic/fields.h); self_intersections is null when not checked.
 Json& add_validity(Json& j, const MeshValidity& v);
+
+/// The output was written, but it is not a valid solid (exit code 4).
+class InvalidOutput : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+/// What is known of a written mesh's validity: its topology, and the exact self-intersecting
+/// pairs when someone counted them (the intersection-free contour does; --json's check does).
+struct WrittenMesh {
+  std::string path;
+  MeshTopology topology;
+  std::optional<size_t> self_intersections;
+};
+/// Throws InvalidOutput naming the file and the counts that are off, unless it is closed,
+/// 2-manifold and (where counted) free of self-intersections.
+void require_valid(const WrittenMesh& m);
+/// The intersection-free contour's own count of crossings left (none when it did not look).
+std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStats& s);
 
 /// `pic info` as JSON and as a table.
 std::string info_json(const Octree& tree, size_t file_bytes);

@@ -55,14 +55,17 @@ void run(const CsgArgs& a) {
   j.add("pics", pics).add("seconds", since(t0)).raw("ops", steps);
   ContourOptions co;
   co.split_sheets = !a.no_split;
+  std::vector<WrittenMesh> written;
   if (is_mesh_path(a.out)) {
     ContourStats cs;
     const TriMesh mesh = contour(result, co, &cs);
     write_mesh(mesh, a.out);
+    const MeshTopology topo = analyze_topology(mesh);
+    written.push_back({a.out, topo, known_crossings(co, cs)});
     j.add("triangles", mesh.triangles.size())
         .add("split_vertices", cs.split_vertices)
         .add("volume", volume(mesh))
-        .raw("topology", topology_json(analyze_topology(mesh)));
+        .raw("topology", topology_json(topo));
   } else {
     save(result, a.out);
   }
@@ -70,13 +73,20 @@ void run(const CsgArgs& a) {
     ContourStats cs;
     const TriMesh mesh = contour(result, co, &cs);
     write_mesh(mesh, a.mesh);
+    const MeshTopology topo = analyze_topology(mesh);
+    written.push_back({a.mesh, topo, known_crossings(co, cs)});
     j.add("triangles", mesh.triangles.size())
         .add("split_vertices", cs.split_vertices)
-        .raw("topology", topology_json(analyze_topology(mesh)));
-    if (a.json) add_validity(j, check_validity(mesh, !a.no_check));
+        .raw("topology", topology_json(topo));
+    if (a.json) {
+      const MeshValidity v = check_validity(mesh, !a.no_check);
+      if (v.checked) written.back().self_intersections = v.self_intersections;
+      add_validity(j, v);
+    }
   }
   if (a.json) std::cout << j.str() << "\n";
   else std::printf("%zu PICs -> %s\n", pics, a.out.c_str());
+  for (const WrittenMesh& w : written) require_valid(w);
 }
 }  // namespace
 

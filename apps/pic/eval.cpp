@@ -31,6 +31,7 @@ void run(const EvalArgs& a) {
       .add("pics", analyze(tree).pics)
       .raw("cube", cube_json(tree.cube));
   std::string summary;
+  std::optional<WrittenMesh> written;
   if (is_mesh_path(a.out)) {
     const auto t1 = Clock::now();
     ContourOptions co;
@@ -40,6 +41,7 @@ void run(const EvalArgs& a) {
     const double secs = since(t1);
     write_mesh(mesh, a.out);
     const auto topo = analyze_topology(mesh);
+    written = WrittenMesh{a.out, topo, known_crossings(co, cs)};
     j.add("contour_seconds", secs)
         .add("triangles", mesh.triangles.size())
         .add("split_vertices", cs.split_vertices)
@@ -54,6 +56,7 @@ void run(const EvalArgs& a) {
   else
     std::printf("%zu leaves, %zu Booleans in %.3f s: %s -> %s\n", st.leaves, st.booleans, st.seconds, summary.c_str(),
                 a.out.c_str());
+  if (written) require_valid(*written);
 }
 }  // namespace
 

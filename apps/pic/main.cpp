@@ -1,5 +1,6 @@
 // `pic`: the command-line tool, thin over the library; one file per subcommand. Every failure
-// becomes one line on stderr and a non-zero exit: 1 usage, 2 bad input or I/O, 3 internal error.
+// becomes one line on stderr and a non-zero exit: 1 usage, 2 bad input or I/O, 3 internal error,
+// 4 an output written but not a valid solid (the line says which counts are off).
 #include <iostream>
 
 #include "cli.h"
@@ -15,6 +16,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const InvalidOutput& e) {
+    std::cerr << "pic: error: " << e.what() << "\n";
+    return 4;
   } catch (const pic::InvalidInput& e) {
     std::cerr << "pic: error: " << e.what() << "\n";
     return 2;

@@ -24,6 +24,7 @@ void run(const MeshArgs& a) {
   const double secs = since(t0);
   write_mesh(mesh, a.out);
   const auto topo = analyze_topology(mesh);
+  WrittenMesh written{a.out, topo, known_crossings(opt, st)};
   if (a.json) {
     Json j;
     j.add("vertices", mesh.positions.size())
@@ -34,11 +35,14 @@ void run(const MeshArgs& a) {
         .add("moved_vertices", st.moved_vertices)
         .add("volume", volume(mesh))
         .raw("topology", topology_json(topo));
-    std::cout << add_validity(j, check_validity(mesh, !a.no_check)).str() << "\n";
+    const MeshValidity v = check_validity(mesh, !a.no_check);
+    if (v.checked) written.self_intersections = v.self_intersections;
+    std::cout << add_validity(j, v).str() << "\n";
   } else {
     std::printf("%zu vertices, %zu triangles in %.4f s (%s) -> %s\n", mesh.positions.size(), mesh.triangles.size(),
                 secs, topology_words(topo).c_str(), a.out.c_str());
   }
+  require_valid(written);
 }
 }  // namespace
 

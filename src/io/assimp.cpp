@@ -19,6 +19,7 @@
 #include <assimp/scene.h>
 
 #include <poll.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -181,6 +182,13 @@ bool write_all(int fd, const void* p, size_t n) {
 }
 
 [[noreturn]] void child(Bytes bytes, const std::string& ext, int fd) {
+  // The child speaks through the pipe only: assimp's own messages, or the report of a crash
+  // inside it (the C library's or a sanitizer's), would otherwise reach the user's terminal
+  // beside pic's one-line error.
+  if (const int devnull = ::open("/dev/null", O_WRONLY); devnull >= 0) {
+    ::dup2(devnull, 2);
+    ::close(devnull);
+  }
 #if !defined(PIC_UNDER_ASAN)
   // Address space: what the process already maps plus 4 GiB plus 64 bytes per input byte.
   long pages = 0;
