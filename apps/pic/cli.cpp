@@ -82,6 +82,16 @@ std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStat
   return s.remaining_intersections;
 }
 
+ContourFile write_contour(const Octree& tree, const std::string& path, const ContourOptions& o) {
+  ContourFile f;
+  const auto t0 = Clock::now();
+  f.mesh = contour(tree, o, &f.stats);
+  f.seconds = since(t0);
+  write_mesh(f.mesh, path);
+  f.written = {path, analyze_topology(f.mesh), known_crossings(o, f.stats)};
+  return f;
+}
+
 std::string info_json(const Octree& tree, size_t file_bytes) {
   const auto s = analyze(tree);
   std::string levels = "[";

@@ -78,6 +78,16 @@ void require_valid(const WrittenMesh& m);
 /// The intersection-free contour's own count of crossings left (none when it did not look).
 std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStats& s);
 
+/// A contour written to a file, with what the CLI reports of it.
+struct ContourFile {
+  TriMesh mesh;
+  ContourStats stats;
+  double seconds = 0;  ///< contouring only, not writing
+  WrittenMesh written;
+};
+/// Contours `tree` with options `o` and writes the mesh to `path`.
+ContourFile write_contour(const Octree& tree, const std::string& path, const ContourOptions& o);
+
 /// `pic info` as JSON and as a table.
 std::string info_json(const Octree& tree, size_t file_bytes);
 void print_info_table(const Octree& tree, size_t file_bytes);

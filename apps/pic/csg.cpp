@@ -56,30 +56,20 @@ void run(const CsgArgs& a) {
   ContourOptions co;
   co.split_sheets = !a.no_split;
   std::vector<WrittenMesh> written;
-  if (is_mesh_path(a.out)) {
-    ContourStats cs;
-    const TriMesh mesh = contour(result, co, &cs);
-    write_mesh(mesh, a.out);
-    const MeshTopology topo = analyze_topology(mesh);
-    written.push_back({a.out, topo, known_crossings(co, cs)});
-    j.add("triangles", mesh.triangles.size())
-        .add("split_vertices", cs.split_vertices)
-        .add("volume", volume(mesh))
-        .raw("topology", topology_json(topo));
-  } else {
-    save(result, a.out);
-  }
+  auto write = [&](const std::string& path, bool with_volume) {
+    ContourFile f = write_contour(result, path, co);
+    j.add("triangles", f.mesh.triangles.size()).add("split_vertices", f.stats.split_vertices);
+    if (with_volume) j.add("volume", volume(f.mesh));
+    j.raw("topology", topology_json(f.written.topology));
+    written.push_back(f.written);
+    return f;
+  };
+  if (is_mesh_path(a.out)) write(a.out, true);
+  else save(result, a.out);
   if (!a.mesh.empty()) {
-    ContourStats cs;
-    const TriMesh mesh = contour(result, co, &cs);
-    write_mesh(mesh, a.mesh);
-    const MeshTopology topo = analyze_topology(mesh);
-    written.push_back({a.mesh, topo, known_crossings(co, cs)});
-    j.add("triangles", mesh.triangles.size())
-        .add("split_vertices", cs.split_vertices)
-        .raw("topology", topology_json(topo));
+    const ContourFile f = write(a.mesh, false);
     if (a.json) {
-      const MeshValidity v = check_validity(mesh, !a.no_check);
+      const MeshValidity v = check_validity(f.mesh, !a.no_check);
       if (v.checked) written.back().self_intersections = v.self_intersections;
       add_validity(j, v);
     }

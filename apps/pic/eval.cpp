@@ -33,21 +33,16 @@ void run(const EvalArgs& a) {
   std::string summary;
   std::optional<WrittenMesh> written;
   if (is_mesh_path(a.out)) {
-    const auto t1 = Clock::now();
     ContourOptions co;
     co.split_sheets = !a.no_split;
-    ContourStats cs;
-    const TriMesh mesh = contour(tree, co, &cs);
-    const double secs = since(t1);
-    write_mesh(mesh, a.out);
-    const auto topo = analyze_topology(mesh);
-    written = WrittenMesh{a.out, topo, known_crossings(co, cs)};
-    j.add("contour_seconds", secs)
-        .add("triangles", mesh.triangles.size())
-        .add("split_vertices", cs.split_vertices)
-        .add("volume", volume(mesh))
-        .raw("topology", topology_json(topo));
-    summary = std::to_string(mesh.triangles.size()) + " triangles (" + topology_words(topo) + ")";
+    const ContourFile f = write_contour(tree, a.out, co);
+    written = f.written;
+    j.add("contour_seconds", f.seconds)
+        .add("triangles", f.mesh.triangles.size())
+        .add("split_vertices", f.stats.split_vertices)
+        .add("volume", volume(f.mesh))
+        .raw("topology", topology_json(f.written.topology));
+    summary = std::to_string(f.mesh.triangles.size()) + " triangles (" + topology_words(f.written.topology) + ")";
   } else {
     save(tree, a.out);
     summary = std::to_string(analyze(tree).pics) + " PICs";

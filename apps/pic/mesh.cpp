@@ -15,24 +15,21 @@ struct MeshArgs {
 
 void run(const MeshArgs& a) {
   const Octree tree = load(a.in);
-  const auto t0 = Clock::now();
   ContourOptions opt;
   opt.intersection_free = !a.fast;
   opt.split_sheets = !a.no_split;
-  ContourStats st;
-  const TriMesh mesh = contour(tree, opt, &st);
-  const double secs = since(t0);
-  write_mesh(mesh, a.out);
-  const auto topo = analyze_topology(mesh);
-  WrittenMesh written{a.out, topo, known_crossings(opt, st)};
+  const ContourFile f = write_contour(tree, a.out, opt);
+  const TriMesh& mesh = f.mesh;
+  const MeshTopology& topo = f.written.topology;
+  WrittenMesh written = f.written;
   if (a.json) {
     Json j;
     j.add("vertices", mesh.positions.size())
         .add("triangles", mesh.triangles.size())
-        .add("seconds", secs)
-        .add("split_vertices", st.split_vertices)
-        .add("fans", st.fans)
-        .add("moved_vertices", st.moved_vertices)
+        .add("seconds", f.seconds)
+        .add("split_vertices", f.stats.split_vertices)
+        .add("fans", f.stats.fans)
+        .add("moved_vertices", f.stats.moved_vertices)
         .add("volume", volume(mesh))
         .raw("topology", topology_json(topo));
     const MeshValidity v = check_validity(mesh, !a.no_check);
@@ -40,7 +37,7 @@ void run(const MeshArgs& a) {
     std::cout << add_validity(j, v).str() << "\n";
   } else {
     std::printf("%zu vertices, %zu triangles in %.4f s (%s) -> %s\n", mesh.positions.size(), mesh.triangles.size(),
-                secs, topology_words(topo).c_str(), a.out.c_str());
+                f.seconds, topology_words(topo).c_str(), a.out.c_str());
   }
   require_valid(written);
 }

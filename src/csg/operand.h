@@ -17,7 +17,7 @@
 #include "contour/dual_walk.h"
 #include "csg/cleanup.h"
 #include "sample/sampler.h"
-#include "signs/passes.h"
+#include "signs/consistency.h"
 
 namespace pic::detail {
 

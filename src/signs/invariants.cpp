@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "octree/cell.h"
-#include "signs/passes.h"
+#include "signs/consistency.h"
 
 namespace pic::detail {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "geometry/box_tree.h"
-#include "signs/passes.h"
+#include "signs/consistency.h"
 
 namespace pic::detail {
 

@@ -1,4 +1,4 @@
-#include "signs/passes.h"
+#include "signs/consistency.h"
 
 #include "contour/dual_walk.h"
 #include "octree/cell_vertex.h"
