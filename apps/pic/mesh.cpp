@@ -10,7 +10,7 @@ namespace pic::cli {
 namespace {
 struct MeshArgs {
   std::string in, out;
-  bool json = false, no_split = false, no_check = false, fast = false;
+  bool json = false, no_split = false, no_check = false, fast = false, fans = false;
 };
 
 void run(const MeshArgs& a) {
@@ -18,6 +18,7 @@ void run(const MeshArgs& a) {
   ContourOptions opt;
   opt.intersection_free = !a.fast;
   opt.split_sheets = !a.no_split;
+  opt.fan_all = a.fans;
   const ContourFile f = write_contour(tree, a.out, opt);
   const TriMesh& mesh = f.mesh;
   const MeshTopology& topo = f.written.topology;
@@ -55,6 +56,9 @@ void add_mesh(CLI::App& app) {
   c->add_flag("--fast", a->fast,
               "Plain dual contouring split: no exact re-triangulation, so a few triangles may cross "
               "(slivers folded over a neighbour, long triangles at sharp creases)");
+  c->add_flag("--fans", a->fans,
+              "Experimental: every dual polygon a fan around a point of its edge, split at cell faces where "
+              "needed: intersection-free by construction, no search; about twice the triangles");
   c->callback([a] { run(*a); });
 }
 

@@ -302,7 +302,12 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   auto place = [&](uint32_t node, const Cell& cell) {
     const Node& n = tree.nodes[node];
     if (n.kind != CellKind::Gray) return;
-    pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, tree.vertices[n.index]));
+    std::array<float, 3> local = tree.vertices[n.index];
+    // The fan construction needs each vertex strictly inside its cell: one on the cell's
+    // border (a QEF minimum clamped to the cell) goes 1/1024 of the cell inside.
+    if (options.fan_all)
+      for (float& c : local) c = std::clamp(c, 1.0f / 1024, 1.0f - 1.0f / 1024);
+    pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, local));
     cell_of[n.index] = {unit_to_world(tree.cube, vertex_unit(cell, {0.5f, 0.5f, 0.5f})), 0.5 * cell.size() * tree.cube.size};
   };
   if (split) {
@@ -348,8 +353,14 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   for (auto& p : polys)
     for (int k = 0; k < p.count; ++k) p.v[k] = remap[p.v[k]];
   TriangulationStats ts;
-  out.triangles = triangulate_polygons(out.positions, cells, polys,
-                                       tree.cube.size / double(int64_t{1} << tree.max_depth), options.intersection_free, &ts);
+  if (options.fan_all) {
+    out.triangles = fan_triangulate(out.positions, cells, polys, nullptr);
+    ts.fans = polys.size();
+  } else {
+    out.triangles = triangulate_polygons(out.positions, cells, polys,
+                                         tree.cube.size / double(int64_t{1} << tree.max_depth),
+                                         options.intersection_free, &ts);
+  }
   if (stats) {
     stats->fans = ts.fans;
     stats->other_diagonal = ts.other_diagonal;

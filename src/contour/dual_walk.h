@@ -66,6 +66,15 @@ std::vector<std::array<uint32_t, 3>> triangulate_polygons(std::vector<Vec3>& x, 
                                                           const std::vector<MeshPolygon>& polys, double finest,
                                                           bool intersection_free, TriangulationStats* stats);
 
+/// A point of the common face of two cells (a side a b of a polygon, c the third corner of its
+/// triangle), kFanEdgeMargin of the face's side inside its border; false when the segment
+/// xa xb already crosses the face inside it (nothing to split) or the cells share no face.
+bool face_point(const VertexCell& ca, const VertexCell& cb, const Vec3& xa, const Vec3& xb, const Vec3& c, Vec3& f);
+/// Every polygon as a fan around its edge point, sides split at face points where needed
+/// (fan_contour.cpp). Edge and face points are appended to `x`.
+std::vector<std::array<uint32_t, 3>> fan_triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
+                                                     const std::vector<MeshPolygon>& polys, size_t* face_points);
+
 /// Splits a quad along the diagonal that folds most (keeps sharp creases whose two vertices
 /// lie on the crease); returns the 2 triangles as index triples into `quad`.
 std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p);

@@ -825,59 +825,8 @@ class Untangler {
     return merged_.xm[merged_.mid[polygons_.fan_base + i]];
   }
 
-  // A point f of the common face of a's and b's cells for side a b (c: the third corner of the
-  // side's triangle), kFanEdgeMargin of the face's side inside its border; false when the
-  // segment already crosses the face inside it (nothing to split) or the cells share no face.
   bool face_point(uint32_t a, uint32_t b, const Vec3& c, Vec3& f) const {
-    const VertexCell& ca = cells_[a];
-    const VertexCell& cb = cells_[b];
-    const Vec3& xa = merged_.xm[merged_.mid[a]];
-    const Vec3& xb = merged_.xm[merged_.mid[b]];
-    // The axis across the face: where the cells touch (centres half + half apart).
-    int axis = 0;
-    double best = -1e300;
-    for (int d = 0; d < 3; ++d) {
-      const double gap = std::abs(cb.center[d] - ca.center[d]) - (ca.half + cb.half);
-      if (gap > best) {
-        best = gap;
-        axis = d;
-      }
-    }
-    if (std::abs(best) > 1e-9 * (ca.half + cb.half)) return false;
-    const double plane = ca.center[axis] + (cb.center[axis] > ca.center[axis] ? ca.half : -ca.half);
-    const double den = xb[axis] - xa[axis];
-    const double t = den != 0 ? std::clamp((plane - xa[axis]) / den, 0.0, 1.0) : 0.5;
-    bool inside = true;
-    Vec3 lo, hi;
-    for (int d = 0; d < 3; ++d) {
-      f[d] = xa[d] + t * (xb[d] - xa[d]);
-      if (d == axis) continue;
-      lo[d] = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
-      hi[d] = std::min(ca.center[d] + ca.half, cb.center[d] + cb.half);
-      if (!(hi[d] > lo[d])) return false;  // the cells touch along an edge only
-      inside = inside && f[d] > lo[d] && f[d] < hi[d];
-    }
-    if (inside) return false;
-    f[axis] = plane;
-    // Off the face: slide along the line where the plane of the side's triangle (a, b, c)
-    // meets the face's plane (which the side's crossing is on), toward the face, so the
-    // point stays on the surface as far as the face allows; then into the face.
-    const Vec3 n = cross3(sub3(xb, xa), sub3(c, xa));
-    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-    const double nn = n[u] * n[u] + n[w] * n[w];
-    if (nn > 0) {
-      Vec3 mid = f;
-      for (int d : {u, w}) mid[d] = std::clamp(f[d], lo[d], hi[d]);
-      // Nearest point to the clamped one on the line n_u (x_u - f_u) + n_w (x_w - f_w) = 0.
-      const double s = (n[u] * (mid[u] - f[u]) + n[w] * (mid[w] - f[w])) / nn;
-      f[u] = mid[u] - s * n[u];
-      f[w] = mid[w] - s * n[w];
-    }
-    for (int d : {u, w}) {
-      const double margin = kFanEdgeMargin * (hi[d] - lo[d]);
-      f[d] = std::clamp(f[d], lo[d] + margin, hi[d] - margin);
-    }
-    return true;
+    return detail::face_point(cells_[a], cells_[b], merged_.xm[merged_.mid[a]], merged_.xm[merged_.mid[b]], c, f);
   }
 
   // Two polygons that cross may need to change together: try every pair of options with each
