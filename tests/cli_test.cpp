@@ -107,11 +107,11 @@ void expect_json_object(const std::string& out) {
 std::string fandisk() { return quote(std::string(PIC_DATA_DIR) + "/fandisk.obj"); }
 
 // A mesh that is written but is not a valid solid never passes silently: the plain split of
-// fandisk at depth 10 keeps crossing triangles, which --json's exact check counts. The file is
+// fandisk at depth 10 (`--plain`) keeps crossing triangles, which --json's exact check counts. The file is
 // written, the JSON says which count is off, one stderr line says so, and the exit code is 4.
 TEST_F(Cli, InvalidOutputIsReportedWithExitCode4) {
   ASSERT_EQ(pic("sample " + fandisk() + " --depth 10 -o f.pic").code, 0);
-  const CliRun fast = pic("mesh f.pic -o fast.obj --fast --json");
+  const CliRun fast = pic("mesh f.pic -o fast.obj --plain --json");
   EXPECT_EQ(fast.code, 4) << fast.err;
   expect_json_object(fast.out);
   EXPECT_GT(json_number(fast.out, "self_intersections"), 0);

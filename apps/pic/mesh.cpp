@@ -10,13 +10,13 @@ namespace pic::cli {
 namespace {
 struct MeshArgs {
   std::string in, out;
-  bool json = false, no_split = false, no_check = false, fast = false, fans = false;
+  bool json = false, no_split = false, no_check = false, fast = false, plain = false, fans = false;
 };
 
 void run(const MeshArgs& a) {
   const Octree tree = load(a.in);
   ContourOptions opt;
-  opt.intersection_free = !a.fast;
+  opt.intersection_free = !a.plain;
   opt.split_sheets = !a.no_split;
   opt.fan_all = a.fans;
   const ContourFile f = write_contour(tree, a.out, opt);
@@ -30,6 +30,8 @@ void run(const MeshArgs& a) {
         .add("seconds", f.seconds)
         .add("split_vertices", f.stats.split_vertices)
         .add("fans", f.stats.fans)
+        .add("other_diagonal", f.stats.other_diagonal)
+        .add("face_points", f.stats.face_points)
         .add("moved_vertices", f.stats.moved_vertices)
         .add("volume", volume(mesh))
         .raw("topology", topology_json(topo));
@@ -53,12 +55,11 @@ void add_mesh(CLI::App& app) {
   c->add_flag("--no-split", a->no_split,
               "Write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   c->add_flag("--no-check", a->no_check, "With --json: skip the exact self-intersection test (huge meshes)");
-  c->add_flag("--fast", a->fast,
-              "Plain dual contouring split: no exact re-triangulation, so a few triangles may cross "
-              "(slivers folded over a neighbour, long triangles at sharp creases)");
+  c->add_flag("--fast", a->fast, "Same as the default (the intersection-free contour is as fast as the plain one)");
+  c->add_flag("--plain", a->plain,
+              "Dual contouring's plain split everywhere, for comparison: slivers may fold through each other");
   c->add_flag("--fans", a->fans,
-              "Experimental: every dual polygon a fan around a point of its edge, split at cell faces where "
-              "needed: intersection-free by construction, no search; about twice the triangles");
+              "Every dual polygon a fan around a point of its edge, for comparison (about 2.4 times the triangles)");
   c->callback([a] { run(*a); });
 }
 

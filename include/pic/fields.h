@@ -48,6 +48,7 @@ void for_each_field(const ContourStats& s, F&& f) {
   f("split_vertices", s.split_vertices);
   f("fans", s.fans);
   f("other_diagonal", s.other_diagonal);
+  f("face_points", s.face_points);
   f("moved_vertices", s.moved_vertices);
   f("initial_intersections", s.initial_intersections);
   f("remaining_intersections", s.remaining_intersections);

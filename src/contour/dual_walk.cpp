@@ -1,4 +1,5 @@
 #include "contour/dual_walk.h"
+#include "contour/triangulate.h"
 #include "geometry/predicates.h"
 #include "geometry/vec3.h"
 
@@ -235,86 +236,12 @@ void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
   }
 }
 
-std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
-  // Unnormalized triangle normals: their signs against the quad's normal need no square root.
-  const Vec3 a0 = cross3(sub3(p[1], p[0]), sub3(p[2], p[0])), a1 = cross3(sub3(p[2], p[0]), sub3(p[3], p[0]));
-  const Vec3 b0 = cross3(sub3(p[1], p[0]), sub3(p[3], p[0])), b1 = cross3(sub3(p[2], p[1]), sub3(p[3], p[1]));
-  // The quad's own orientation: cross product of its diagonals (twice its vector area).
-  const Vec3 n = cross3(sub3(p[2], p[0]), sub3(p[3], p[1]));
-  const double da0 = dot3(a0, n), da1 = dot3(a1, n), db0 = dot3(b0, n), db1 = dot3(b1, n);
-  // A split whose triangle faces against the quad folds it back on itself (a non-convex
-  // quad split along its outer diagonal): never take it when the other split is clean.
-  const bool a_ok = da0 > 0 && da1 > 0, b_ok = db0 > 0 && db1 > 0;
-  auto len = [](const Vec3& x) {
-    const double l = std::sqrt(dot3(x, x));
-    return l > 0 ? l : 1.0;
-  };
-  bool use_a;
-  if (a_ok != b_ok) {
-    use_a = a_ok;
-  } else if (!a_ok) {
-    use_a = std::min(da0 / len(a0), da1 / len(a1)) >= std::min(db0 / len(b0), db1 / len(b1));
-  } else {
-    // Both clean: fold along the diagonal that bends most (smaller cosine between its two
-    // triangles), which keeps a crease whose two vertices lie on it.
-    // cos_a <= cos_b with cos = dot / sqrt(norms), compared by squares (signs first).
-    const double da = dot3(a0, a1), na = dot3(a0, a0) * dot3(a1, a1);
-    const double db = dot3(b0, b1), nb = dot3(b0, b0) * dot3(b1, b1);
-    if ((da < 0) != (db < 0)) use_a = da < 0;
-    else if (da >= 0) use_a = da * da * nb <= db * db * na;
-    else use_a = da * da * nb >= db * db * na;
-  }
-  if (use_a) return {{{0, 1, 2}, {0, 2, 3}}};
-  return {{{0, 1, 3}, {1, 2, 3}}};
-}
-
-Vec3 fan_point(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Vec3& e1) {
-  // Where the polygon's mean plane (centroid, vector-area normal) crosses the edge: on a
-  // smooth surface, near where the surface does. Kept off the edge's ends.
-  Vec3 c{0, 0, 0}, n{0, 0, 0};
-  for (int k = 0; k < count; ++k) {
-    for (int a = 0; a < 3; ++a) c[a] += p[k][a] / count;
-    const Vec3 x = cross3(p[k], p[(k + 1) % count]);
-    for (int a = 0; a < 3; ++a) n[a] += x[a];
-  }
-  const Vec3 d = sub3(e1, e0);
-  const double den = dot3(n, d);
-  double t = 0.5;
-  if (den != 0) t = dot3(n, sub3(c, e0)) / den;
-  if (!(t >= kFanEdgeMargin)) t = kFanEdgeMargin;  // also NaN
-  if (t > 1 - kFanEdgeMargin) t = 1 - kFanEdgeMargin;
-  Vec3 x = e0;
-  for (int a = 0; a < 3; ++a)
-    if (e0[a] != e1[a]) x[a] = e0[a] + t * d[a];  // the other two coordinates stay exact
-  return x;
-}
-
 }  // namespace pic::detail
 
-namespace pic {
+namespace pic::detail {
 
-TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats* stats) {
-  using namespace detail;
+std::vector<MeshPolygon> dual_polygons(const Octree& tree) {
   const bool split = tree.nodes[0].kind == CellKind::Internal;
-  // Each gray leaf's vertex in input coordinates, once (the walk meets it up to 12 times).
-  std::vector<Vec3> pos(tree.vertices.size());
-  std::vector<VertexCell> cell_of(tree.vertices.size());
-  auto place = [&](uint32_t node, const Cell& cell) {
-    const Node& n = tree.nodes[node];
-    if (n.kind != CellKind::Gray) return;
-    std::array<float, 3> local = tree.vertices[n.index];
-    // The fan construction needs each vertex strictly inside its cell: one on the cell's
-    // border (a QEF minimum clamped to the cell) goes 1/1024 of the cell inside.
-    if (options.fan_all)
-      for (float& c : local) c = std::clamp(c, 1.0f / 1024, 1.0f - 1.0f / 1024);
-    pos[n.index] = unit_to_world(tree.cube, vertex_unit(cell, local));
-    cell_of[n.index] = {unit_to_world(tree.cube, vertex_unit(cell, {0.5f, 0.5f, 0.5f})), 0.5 * cell.size() * tree.cube.size};
-  };
-  if (split) {
-    tbb::parallel_for(0, 8, [&](int c) { visit_leaves(tree, tree.nodes[0].index + c, Cell{}.child(c), place); });
-  } else {
-    visit_leaves(tree, 0, Cell{}, place);
-  }
   // Polygons found by 9 tasks — the 8 root children and the faces and edges between them —
   // each into its own list; concatenated in that fixed order they are exactly what a serial
   // walk finds.
@@ -334,44 +261,7 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
     polys.insert(polys.end(), part.begin(), part.end());
     std::vector<MeshPolygon>().swap(part);
   }
-  // Vertices numbered in the tree's vertex order, keeping those the polygons use.
-  std::vector<uint32_t> remap(tree.vertices.size(), 0);
-  for (const auto& p : polys)
-    for (int k = 0; k < p.count; ++k) remap[p.v[k]] = 1;
-  TriMesh out;
-  uint32_t used = 0;
-  for (uint32_t& r : remap) used += r;
-  out.positions.reserve(used);
-  std::vector<VertexCell> cells;
-  cells.reserve(used);
-  for (size_t i = 0; i < remap.size(); ++i)
-    if (remap[i]) {
-      remap[i] = static_cast<uint32_t>(out.positions.size());
-      out.positions.push_back(pos[i]);
-      cells.push_back(cell_of[i]);
-    }
-  for (auto& p : polys)
-    for (int k = 0; k < p.count; ++k) p.v[k] = remap[p.v[k]];
-  TriangulationStats ts;
-  if (options.fan_all) {
-    out.triangles = fan_triangulate(out.positions, cells, polys, nullptr);
-    ts.fans = polys.size();
-  } else {
-    out.triangles = triangulate_polygons(out.positions, cells, polys,
-                                         tree.cube.size / double(int64_t{1} << tree.max_depth),
-                                         options.intersection_free, &ts);
-  }
-  if (stats) {
-    stats->fans = ts.fans;
-    stats->other_diagonal = ts.other_diagonal;
-    stats->moved_vertices = ts.moved_vertices;
-    stats->initial_intersections = ts.initial_intersections;
-    stats->remaining_intersections = ts.remaining_intersections;
-    stats->rounds = ts.rounds;
-  }
-  const size_t split_vertices = options.split_sheets ? split_nonmanifold(out) : 0;
-  if (stats) stats->split_vertices = split_vertices;
-  return out;
+  return polys;
 }
 
-}  // namespace pic
+}  // namespace pic::detail

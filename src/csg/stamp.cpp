@@ -1,6 +1,7 @@
 // Stamping the overlap of two operands (paper 5.2.1) and building their partial contours.
 // See stamp.h.
 #include "csg/stamp.h"
+#include "contour/triangulate.h"
 
 namespace pic::detail {
 

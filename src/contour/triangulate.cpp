@@ -1,0 +1,591 @@
+// Triangulating the dual polygons so that no two triangles cross, by construction (after Ju
+// and Udeshi 2006, "Intersection-free contouring on an octree grid").
+//
+// The argument. Every vertex lies strictly inside its cell. Each polygon side a b crosses the
+// common face of a's and b's cells at one point Q (the segment's own crossing when that is
+// inside the face, else a face point: the side is then split there); all polygons with that
+// side share Q. A polygon dual to minimal edge e owns, in each cell c_i around e with vertex
+// v_i, the tetrahedra (v_i, Q, e) over the two faces of c_i next to e. Inside one cell these
+// are cones from v_i over the triangles (Q, e) of its faces, and those triangles tile the faces
+// without overlapping, so different polygons' regions meet only on their boundaries. A fan
+// around a point p strictly inside e, with triangles (p, v_i, Q) and (p, Q, v_i+1), lies in
+// its region. The plain split is kept when every side crosses its face and each of its
+// triangles lies in the region too, strictly inside except along the polygon's own sides:
+// with no face point the region is the ring of tetrahedra (e, v_i, v_i+1) around e, checked
+// wedge by wedge. So triangles of different polygons meet only in shared vertices and sides.
+#include "contour/triangulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+
+#include "geometry/vec3.h"
+
+namespace pic::detail {
+namespace {
+
+using Tri = std::array<uint32_t, 3>;
+using Split = std::array<std::array<int, 3>, 2>;
+constexpr uint32_t kNone = ~uint32_t{0};
+
+inline double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+
+// The closest points of segments p0 p1 and q0 q1: parameters s (on p) and t (on q) in [0, 1];
+// returns the squared distance.
+double closest_on_segments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t) {
+  const Vec3 d1 = sub3(p1, p0), d2 = sub3(q1, q0), r = sub3(p0, q0);
+  const double a = dot3(d1, d1), e = dot3(d2, d2), f = dot3(d2, r), c = dot3(d1, r), b = dot3(d1, d2);
+  const double den = a * e - b * b;
+  s = a > 0 && den > 1e-14 * a * e ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
+  t = e > 0 ? (b * s + f) / e : 0.0;
+  if (t < 0 || t > 1) {
+    t = std::clamp(t, 0.0, 1.0);
+    s = a > 0 ? std::clamp((b * t - c) / a, 0.0, 1.0) : 0.0;
+  }
+  Vec3 g;
+  for (int k = 0; k < 3; ++k) g[k] = p0[k] + s * d1[k] - q0[k] - t * d2[k];
+  return dot3(g, g);
+}
+
+// The common face of two cells that touch across a face: its axis, plane and extent.
+struct Face {
+  int axis = -1;  // -1: the cells share no face
+  double plane = 0;
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+};
+
+Face common_face(const VertexCell& ca, const VertexCell& cb) {
+  Face f;
+  // The axis across the face: where the cells touch (centres half + half apart).
+  int axis = 0;
+  double best = -1e300;
+  for (int d = 0; d < 3; ++d) {
+    const double gap = std::abs(cb.center[d] - ca.center[d]) - (ca.half + cb.half);
+    if (gap > best) {
+      best = gap;
+      axis = d;
+    }
+  }
+  if (std::abs(best) > 1e-9 * (ca.half + cb.half)) return f;
+  for (int d = 0; d < 3; ++d) {
+    if (d == axis) continue;
+    f.lo[d] = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
+    f.hi[d] = std::min(ca.center[d] + ca.half, cb.center[d] + cb.half);
+    if (!(f.hi[d] > f.lo[d])) return f;  // the cells touch along an edge only
+  }
+  f.axis = axis;
+  f.plane = ca.center[axis] + (cb.center[axis] > ca.center[axis] ? ca.half : -ca.half);
+  return f;
+}
+
+// Where segment xa xb meets the face's plane (q); true when that is strictly inside the face.
+bool crosses_inside(const Face& face, const Vec3& xa, const Vec3& xb, Vec3& q) {
+  const int axis = face.axis;
+  const double den = xb[axis] - xa[axis];
+  const double t = den != 0 ? std::clamp((face.plane - xa[axis]) / den, 0.0, 1.0) : 0.5;
+  bool inside = true;
+  for (int d = 0; d < 3; ++d) {
+    q[d] = xa[d] + t * (xb[d] - xa[d]);
+    if (d != axis) inside = inside && q[d] > face.lo[d] && q[d] < face.hi[d];
+  }
+  return inside;
+}
+
+// The point of the face (`margin` inside its border) nearest where the plain split of the
+// polygons `near` crosses the face's plane; among points where it crosses the face itself, the
+// one nearest q. Candidates better than (best_off, best_q) replace `best`.
+void plain_surface_in_face(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys,
+                           const std::vector<Split>& splits, const uint32_t* near, size_t count, const Face& face,
+                           double margin, const Vec3& q, Vec3& best, double& best_off, double& best_q) {
+  const int axis = face.axis, u = (axis + 1) % 3, w = (axis + 2) % 3;
+  const double lo[2] = {face.lo[u] + margin, face.lo[w] + margin}, hi[2] = {face.hi[u] - margin, face.hi[w] - margin};
+  const auto consider = [&](const double c[2], double off) {
+    const double dq = (c[0] - q[u]) * (c[0] - q[u]) + (c[1] - q[w]) * (c[1] - q[w]);
+    if (off < best_off || (off == best_off && dq < best_q)) {
+      best_off = off;
+      best_q = dq;
+      best[axis] = face.plane;
+      best[u] = c[0];
+      best[w] = c[1];
+    }
+  };
+  for (size_t k = 0; k < count; ++k) {
+    const MeshPolygon& p = polys[near[k]];
+    for (int i = 0; i < (p.count == 4 ? 2 : 1); ++i) {
+      std::array<Vec3, 3> t;
+      for (int m = 0; m < 3; ++m) t[m] = x[p.v[splits[near[k]][i][m]]];
+      // The triangle's chord on the face's plane (in face coordinates): where its sides cross.
+      double ends[2][2];
+      int found = 0;
+      for (int m = 0; m < 3 && found < 2; ++m) {
+        const Vec3 &a = t[m], &b = t[(m + 1) % 3];
+        const double sa = a[axis] - face.plane, sb = b[axis] - face.plane;
+        if ((sa < 0 && sb < 0) || (sa > 0 && sb > 0) || sa == sb) continue;
+        const double l = sa / (sa - sb);
+        ends[found][0] = a[u] + l * (b[u] - a[u]);
+        ends[found][1] = a[w] + l * (b[w] - a[w]);
+        ++found;
+      }
+      if (found < 2) continue;
+      const double dv[2] = {ends[1][0] - ends[0][0], ends[1][1] - ends[0][1]};
+      // Clipped to the face (Liang-Barsky): if any is left, its point nearest q.
+      double l0 = 0, l1 = 1;
+      for (int d = 0; d < 2; ++d) {
+        if (dv[d] == 0) {
+          if (ends[0][d] <= lo[d] || ends[0][d] >= hi[d]) l1 = -1;
+          continue;
+        }
+        double ta = (lo[d] - ends[0][d]) / dv[d], tb = (hi[d] - ends[0][d]) / dv[d];
+        if (ta > tb) std::swap(ta, tb);
+        l0 = std::max(l0, ta);
+        l1 = std::min(l1, tb);
+      }
+      const double len = dv[0] * dv[0] + dv[1] * dv[1];
+      if (l1 > l0) {
+        double l = len > 0 ? ((q[u] - ends[0][0]) * dv[0] + (q[w] - ends[0][1]) * dv[1]) / len : l0;
+        l = std::clamp(l, l0, l1);
+        const double c[2] = {ends[0][0] + l * dv[0], ends[0][1] + l * dv[1]};
+        consider(c, 0.0);
+        continue;
+      }
+      // Apart from the face: the nearest pair is a chord end clamped into the face, or a
+      // corner of the face and its nearest chord point.
+      for (int e = 0; e < 2; ++e) {
+        const double c[2] = {std::clamp(ends[e][0], lo[0], hi[0]), std::clamp(ends[e][1], lo[1], hi[1])};
+        consider(c, (c[0] - ends[e][0]) * (c[0] - ends[e][0]) + (c[1] - ends[e][1]) * (c[1] - ends[e][1]));
+      }
+      for (int corner = 0; corner < 4; ++corner) {
+        const double c[2] = {corner & 1 ? hi[0] : lo[0], corner & 2 ? hi[1] : lo[1]};
+        double l = len > 0 ? ((c[0] - ends[0][0]) * dv[0] + (c[1] - ends[0][1]) * dv[1]) / len : 0;
+        l = std::clamp(l, 0.0, 1.0);
+        const double px = ends[0][0] + l * dv[0] - c[0], py = ends[0][1] + l * dv[1] - c[1];
+        consider(c, px * px + py * py);
+      }
+    }
+  }
+}
+
+// A point of the face, `margin` inside its border, to split side a b of a polygon fanned
+// around edge point e (on the face's border) when the side crosses the face's plane at q
+// outside the face.
+Vec3 face_point(const Face& face, const Vec3& xa, const Vec3& xb, const Vec3& e, double margin, Vec3 f) {
+  const int axis = face.axis;
+  const Vec3 &lo = face.lo, &hi = face.hi;
+  const double plane = face.plane;
+  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+  Vec3 mlo = lo, mhi = hi;  // the face, `margin` inside its border
+  for (int d : {u, w}) {
+    mlo[d] += margin;
+    mhi[d] -= margin;
+  }
+  // The side crosses the face's plane beyond the fan's edge (across the line of the edge from
+  // the face): the surface crosses that line at e and goes on into the neighbouring face, so
+  // the point of this face nearest the surface is next to e.
+  for (int d : {u, w}) {
+    if (e[d] != lo[d] && e[d] != hi[d]) continue;  // not the coordinate across the edge
+    if ((e[d] == lo[d] && f[d] < lo[d]) || (e[d] == hi[d] && f[d] > hi[d])) {
+      Vec3 g = e;
+      for (int k : {u, w}) g[k] = std::clamp(g[k], mlo[k], mhi[k]);
+      g[axis] = plane;
+      return g;
+    }
+  }
+  // Off the face. The edge point e (on the face's border) and the crossing f are both on the
+  // plane of the fan triangle (e, a, b) and on the face's plane: on a flat surface the line
+  // e f is where the surface crosses the face's plane. Its point inside the face nearest f
+  // keeps the two triangles that replace (e, a, b) on the surface (when f lies beyond e, the
+  // point is just past e: this polygon's triangles thin out and its neighbours' take over).
+  double l0 = -1e300, l1 = 1e300;
+  for (int d : {u, w}) {
+    const double o = e[d], v = f[d] - e[d];
+    if (v == 0) {
+      if (o <= mlo[d] || o >= mhi[d]) l1 = -1;
+      continue;
+    }
+    double ta = (mlo[d] - o) / v, tb = (mhi[d] - o) / v;
+    if (ta > tb) std::swap(ta, tb);
+    l0 = std::max(l0, ta);
+    l1 = std::min(l1, tb);
+  }
+  if (l1 > l0 && (f[u] != e[u] || f[w] != e[w])) {
+    const double l = std::clamp(1.0, l0, l1);
+    for (int d : {u, w}) f[d] = e[d] + l * (f[d] - e[d]);
+    f[axis] = plane;
+    return f;
+  }
+  // Else the point of the face's border nearest the segment a b.
+  double best_d = 1e300;
+  for (int side = 0; side < 4; ++side) {
+    Vec3 c0, c1;
+    c0[axis] = c1[axis] = plane;
+    const int along = side < 2 ? u : w, across = side < 2 ? w : u;
+    c0[along] = lo[along];
+    c1[along] = hi[along];
+    c0[across] = c1[across] = side % 2 ? hi[across] : lo[across];
+    double s = 0, t = 0;
+    const double d = closest_on_segments(c0, c1, xa, xb, s, t);
+    if (d < best_d) {
+      best_d = d;
+      for (int k = 0; k < 3; ++k) f[k] = c0[k] + s * (c1[k] - c0[k]);
+    }
+  }
+  for (int d : {u, w}) f[d] = std::clamp(f[d], mlo[d], mhi[d]);
+  return f;
+}
+
+int axis_of(const Vec3& e0, const Vec3& e1) {
+  for (int a = 0; a < 3; ++a)
+    if (e0[a] != e1[a]) return a;
+  return 0;
+}
+
+// Where the line of edge (e0, e1) pierces triangle (a, b, c): the edge parameter, or NaN.
+double pierce(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e0, const Vec3& e1) {
+  const int ax = axis_of(e0, e1), u = (ax + 1) % 3, w = (ax + 2) % 3;
+  const double au = a[u] - e0[u], aw = a[w] - e0[w], bu = b[u] - e0[u], bw = b[w] - e0[w];
+  const double cu = c[u] - e0[u], cw = c[w] - e0[w];
+  const double la = cross2(bu, bw, cu, cw), lb = cross2(cu, cw, au, aw), lc = cross2(au, aw, bu, bw);
+  const double sum = la + lb + lc;
+  const bool in = sum > 0 ? (la >= 0 && lb >= 0 && lc >= 0) : (la <= 0 && lb <= 0 && lc <= 0);
+  if (sum == 0 || !in) return std::numeric_limits<double>::quiet_NaN();
+  const double h = (la * a[ax] + lb * b[ax] + lc * c[ax]) / sum;
+  return (h - e0[ax]) / (e1[ax] - e0[ax]);
+}
+
+// The edge parameter where the line of edge (e0, e1) pierces the plain split of the polygons
+// `near` (their triangles): inside the edge if it can, then nearest to `prefer`; NaN when the
+// line pierces none. The
+// plain dual contouring surface crosses a sign-changing edge within its own error of where
+// the sampled surface does, even where the edge's own polygon folds beside it.
+double pierce_near(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys, const std::vector<Split>& splits,
+                   const uint32_t* near, size_t count, const Vec3& e0, const Vec3& e1, double prefer) {
+  double best = std::numeric_limits<double>::quiet_NaN();
+  const auto key = [&](double t) { return std::pair(std::max({0.0, -t, t - 1}), std::abs(t - prefer)); };
+  for (size_t k = 0; k < count; ++k) {
+    const MeshPolygon& p = polys[near[k]];
+    const Split& sp = splits[near[k]];
+    for (int i = 0; i < (p.count == 4 ? 2 : 1); ++i) {
+      const double t = pierce(x[p.v[sp[i][0]]], x[p.v[sp[i][1]]], x[p.v[sp[i][2]]], e0, e1);
+      if (t == t && (best != best || key(t) < key(best))) best = t;
+    }
+  }
+  return best;
+}
+
+// Where the ring's mean plane (centroid, vector-area normal) crosses the edge, kept within the
+// heights of the ring's vertices along the edge: the fallback edge parameter.
+double mean_plane_height(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Vec3& e1) {
+  const int a = axis_of(e0, e1);
+  Vec3 c{0, 0, 0}, n{0, 0, 0};
+  double lo = 1e300, hi = -1e300;
+  for (int k = 0; k < count; ++k) {
+    for (int d = 0; d < 3; ++d) c[d] += p[k][d] / count;
+    const Vec3 x = cross3(p[k], p[(k + 1) % count]);
+    for (int d = 0; d < 3; ++d) n[d] += x[d];
+    const double t = (p[k][a] - e0[a]) / (e1[a] - e0[a]);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  const double den = dot3(n, sub3(e1, e0));
+  const double t = den != 0 ? dot3(n, sub3(c, e0)) / den : 0.5 * (lo + hi);
+  return std::clamp(t, lo, hi);
+}
+
+// The ring's mean height along the edge, as an edge parameter.
+double ring_height(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Vec3& e1) {
+  const int a = axis_of(e0, e1);
+  double sum = 0;
+  for (int k = 0; k < count; ++k) sum += p[k][a];
+  return (sum / count - e0[a]) / (e1[a] - e0[a]);
+}
+
+// The point at parameter t of edge (e0, e1), kept `margin` off its ends.
+Vec3 point_on_edge(const Vec3& e0, const Vec3& e1, double t, double margin) {
+  const int a = axis_of(e0, e1);
+  const double m = std::min(0.25, margin / std::abs(e1[a] - e0[a]));
+  if (!(t >= m)) t = m;  // also NaN
+  if (t > 1 - m) t = 1 - m;
+  Vec3 x = e0;
+  x[a] = e0[a] + t * (e1[a] - e0[a]);  // the other two coordinates stay exact
+  return x;
+}
+
+// A point of a clipped triangle: where it is, and which ring vertex it is (-1: none).
+struct ClipPoint {
+  Vec3 x;
+  int ring;
+};
+
+// Keeps the part of convex polygon `poly` where g >= 0 (g linear).
+template <class G>
+int clip(const ClipPoint* in, int n, ClipPoint* out, const G& g) {
+  int m = 0;
+  for (int k = 0; k < n; ++k) {
+    const ClipPoint &a = in[k], &b = in[(k + 1) % n];
+    const double ga = g(a.x), gb = g(b.x);
+    if (ga >= 0) out[m++] = a;
+    if ((ga < 0 && gb > 0) || (ga > 0 && gb < 0)) {
+      const double t = ga / (ga - gb);
+      ClipPoint c{a.x, -1};
+      for (int d = 0; d < 3; ++d) c.x[d] = a.x[d] + t * (b.x[d] - a.x[d]);
+      out[m++] = c;
+    }
+  }
+  return m;
+}
+
+// True when the triangles `tris` (index triples into ring `r`) lie in the ring of tetrahedra
+// (e0, e1, r_i, r_i+1) around the edge, strictly inside except at the ring's own sides. The
+// ring must wind once around the edge, each step turning the same way by less than half a
+// turn; then wedge i (between the half-planes through the edge and r_i, r_i+1) holds exactly
+// tetrahedron i, which is the part of the wedge above plane (e0, r_i, r_i+1) and below plane
+// (e1, r_i, r_i+1): each triangle's part in each wedge is checked against those two planes.
+bool inside_ring(const std::array<Vec3, 4>& r, int n, const Vec3& e0, const Vec3& e1,
+                 const std::array<std::array<int, 3>, 2>& tris, int ntris) {
+  const int ax = axis_of(e0, e1), u = (ax + 1) % 3, w = (ax + 2) % 3;
+  std::array<double, 4> du{}, dw{};
+  for (int i = 0; i < n; ++i) {
+    du[i] = r[i][u] - e0[u];
+    dw[i] = r[i][w] - e0[w];
+  }
+  double turn = 0;
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    const double c = cross2(du[i], dw[i], du[j], dw[j]);
+    if (c == 0 || (turn != 0 && (c > 0) != (turn > 0))) return false;
+    turn = c;
+  }
+  const double s = turn > 0 ? 1.0 : -1.0;
+  const double margin = 1e-9 * std::abs(e1[ax] - e0[ax]);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    // Planes of the tetrahedron's faces across from e1 and e0, unit normals pointing inside.
+    Vec3 nb = cross3(sub3(r[i], e0), sub3(r[j], e0)), nt = cross3(sub3(r[i], e1), sub3(r[j], e1));
+    const double sb = dot3(nb, sub3(e1, e0)), st = dot3(nt, sub3(e0, e1));
+    if (sb == 0 || st == 0) return false;
+    const double lb = std::copysign(1.0 / std::sqrt(dot3(nb, nb)), sb);
+    const double lt = std::copysign(1.0 / std::sqrt(dot3(nt, nt)), st);
+    for (int a = 0; a < 3; ++a) {
+      nb[a] *= lb;
+      nt[a] *= lt;
+    }
+    const auto g1 = [&](const Vec3& x) { return s * cross2(du[i], dw[i], x[u] - e0[u], x[w] - e0[w]); };
+    const auto g2 = [&](const Vec3& x) { return s * cross2(x[u] - e0[u], x[w] - e0[w], du[j], dw[j]); };
+    for (int k = 0; k < ntris; ++k) {
+      ClipPoint tri[3], half[4], part[5];
+      for (int m = 0; m < 3; ++m) tri[m] = {r[tris[k][m]], tris[k][m]};
+      const int nh = clip(tri, 3, half, g1);
+      const int np = clip(half, nh, part, g2);
+      for (int m = 0; m < np; ++m) {
+        if (part[m].ring == i || part[m].ring == j) continue;  // the ring's own side
+        const Vec3& x = part[m].x;
+        if (!(dot3(nb, sub3(x, e0)) > margin && dot3(nt, sub3(x, e1)) > margin)) return false;
+      }
+    }
+  }
+  return true;
+}
+
+// Both triangles of a quad split facing the quad's way (not folded back onto each other).
+bool faces_forward(const std::array<Vec3, 4>& p, const std::array<std::array<int, 3>, 2>& split) {
+  const Vec3 n = cross3(sub3(p[2], p[0]), sub3(p[3], p[1]));
+  for (const auto& t : split)
+    if (!(dot3(cross3(sub3(p[t[1]], p[t[0]]), sub3(p[t[2]], p[t[0]])), n) > 0)) return false;
+  return true;
+}
+
+// The plain split of a polygon that stays in its region, or 0 triangles when none does.
+int plain_split_in_region(const std::array<Vec3, 4>& q, int count, const Vec3& e0, const Vec3& e1,
+                          std::array<std::array<int, 3>, 2>& split, bool& other) {
+  other = false;
+  if (count == 3) return inside_ring(q, 3, e0, e1, split, 1) ? 1 : 0;
+  if (faces_forward(q, split) && inside_ring(q, 4, e0, e1, split, 2)) return 2;
+  const std::array<std::array<int, 3>, 2> alt =
+      split[0][2] == 2 ? std::array<std::array<int, 3>, 2>{{{0, 1, 3}, {1, 2, 3}}}
+                       : std::array<std::array<int, 3>, 2>{{{0, 1, 2}, {0, 2, 3}}};
+  if (faces_forward(q, alt) && inside_ring(q, 4, e0, e1, alt, 2)) {
+    split = alt;
+    other = true;
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
+  // Unnormalized triangle normals: their signs against the quad's normal need no square root.
+  const Vec3 a0 = cross3(sub3(p[1], p[0]), sub3(p[2], p[0])), a1 = cross3(sub3(p[2], p[0]), sub3(p[3], p[0]));
+  const Vec3 b0 = cross3(sub3(p[1], p[0]), sub3(p[3], p[0])), b1 = cross3(sub3(p[2], p[1]), sub3(p[3], p[1]));
+  // The quad's own orientation: cross product of its diagonals (twice its vector area).
+  const Vec3 n = cross3(sub3(p[2], p[0]), sub3(p[3], p[1]));
+  const double da0 = dot3(a0, n), da1 = dot3(a1, n), db0 = dot3(b0, n), db1 = dot3(b1, n);
+  // A split whose triangle faces against the quad folds it back on itself (a non-convex
+  // quad split along its outer diagonal): never take it when the other split is clean.
+  const bool a_ok = da0 > 0 && da1 > 0, b_ok = db0 > 0 && db1 > 0;
+  auto len = [](const Vec3& x) {
+    const double l = std::sqrt(dot3(x, x));
+    return l > 0 ? l : 1.0;
+  };
+  bool use_a;
+  if (a_ok != b_ok) {
+    use_a = a_ok;
+  } else if (!a_ok) {
+    use_a = std::min(da0 / len(a0), da1 / len(a1)) >= std::min(db0 / len(b0), db1 / len(b1));
+  } else {
+    // Both clean: fold along the diagonal that bends most (smaller cosine between its two
+    // triangles), which keeps a crease whose two vertices lie on it.
+    // cos_a <= cos_b with cos = dot / sqrt(norms), compared by squares (signs first).
+    const double da = dot3(a0, a1), na = dot3(a0, a0) * dot3(a1, a1);
+    const double db = dot3(b0, b1), nb = dot3(b0, b0) * dot3(b1, b1);
+    if ((da < 0) != (db < 0)) use_a = da < 0;
+    else if (da >= 0) use_a = da * da * nb <= db * db * na;
+    else use_a = da * da * nb >= db * db * na;
+  }
+  if (use_a) return {{{0, 1, 2}, {0, 2, 3}}};
+  return {{{0, 1, 3}, {1, 2, 3}}};
+}
+
+std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
+                             const std::vector<MeshPolygon>& polys, Triangulation how, double inset,
+                             TriangulationStats* stats) {
+  const size_t n = polys.size();
+  const auto ring_of = [&](size_t i) {
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < polys[i].count; ++k) q[k] = x[polys[i].v[k]];
+    return q;
+  };
+  // Dual contouring's split of every polygon.
+  std::vector<Split> splits(n, Split{{{0, 1, 2}, {0, 2, 3}}});
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    if (polys[i].count == 4) splits[i] = split_quad(ring_of(i));
+  });
+  std::vector<Tri> out;
+  out.reserve(n * 2);
+  const auto emit_split = [&](const MeshPolygon& p, const Split& sp, int ntris) {
+    for (int k = 0; k < ntris; ++k) out.push_back({p.v[sp[k][0]], p.v[sp[k][1]], p.v[sp[k][2]]});
+  };
+  if (how == Triangulation::kPlain) {
+    for (size_t i = 0; i < n; ++i) emit_split(polys[i], splits[i], polys[i].count == 4 ? 2 : 1);
+    if (stats) *stats = {};
+    return out;
+  }
+  // The polygons' sides, each once, and whether it crosses its cells' common face inside it.
+  std::vector<std::array<uint32_t, 4>> side_of(n);
+  std::vector<std::pair<uint32_t, uint32_t>> sides;
+  {
+    std::unordered_map<uint64_t, uint32_t> id;
+    id.reserve(n * 2);
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < polys[i].count; ++k) {
+        const uint32_t a = polys[i].v[k], b = polys[i].v[(k + 1) % polys[i].count];
+        const auto [it, fresh] = id.try_emplace(uint64_t(std::min(a, b)) << 32 | std::max(a, b), uint32_t(sides.size()));
+        if (fresh) sides.push_back({a, b});
+        side_of[i][k] = it->second;
+      }
+  }
+  std::vector<Face> faces(sides.size());
+  std::vector<uint8_t> crosses(sides.size());
+  tbb::parallel_for(size_t{0}, sides.size(), [&](size_t s) {
+    const auto [a, b] = sides[s];
+    faces[s] = common_face(cells[a], cells[b]);
+    Vec3 q;
+    crosses[s] = faces[s].axis < 0 || crosses_inside(faces[s], x[a], x[b], q);
+  });
+  // Which polygons keep a plain split (kept in `splits`; 0: fanned), and how many took the
+  // other diagonal.
+  std::vector<uint8_t> plain(n, 0);
+  if (how == Triangulation::kConstruct)
+    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+      const MeshPolygon& p = polys[i];
+      for (int k = 0; k < p.count; ++k)
+        if (!crosses[side_of[i][k]]) return;
+      bool other = false;
+      if (const int tris = plain_split_in_region(ring_of(i), p.count, p.e0, p.e1, splits[i], other))
+        plain[i] = uint8_t(tris + (other ? 4 : 0));
+    });
+  // Each fanned polygon's edge point: where its edge crosses the plain surface of the
+  // polygons around it (those sharing a vertex with it).
+  std::vector<uint32_t> first(x.size() + 1, 0), around;
+  for (const MeshPolygon& p : polys)
+    for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
+  for (size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
+  around.resize(first.back());
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = uint32_t(i);
+  }
+  const double margin = inset;
+  std::vector<Vec3> edge_at(n);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    if (plain[i]) return;
+    const MeshPolygon& p = polys[i];
+    const std::array<Vec3, 4> q = ring_of(i);
+    const double prefer = ring_height(q, p.count, p.e0, p.e1);
+    const auto better = [&](double a, double b) {
+      const double oa = std::max({0.0, -a, a - 1}), ob = std::max({0.0, -b, b - 1});
+      return oa < ob || (oa == ob && std::abs(a - prefer) < std::abs(b - prefer));
+    };
+    double t = std::numeric_limits<double>::quiet_NaN();
+    for (int k = 0; k < p.count; ++k) {
+      const uint32_t v = p.v[k];
+      const double h = pierce_near(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], p.e0, p.e1, prefer);
+      if (h == h && (t != t || better(h, t))) t = h;
+    }
+    // Else one ring further out (a fold can put the plain crossing a polygon away).
+    for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
+      for (uint32_t j = first[p.v[k]]; j < first[p.v[k] + 1]; ++j)
+        for (int m = 0; m < polys[around[j]].count; ++m) {
+          const uint32_t v = polys[around[j]].v[m];
+          const double h = pierce_near(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], p.e0, p.e1, prefer);
+          if (h == h && (t != t || better(h, t))) t = h;
+        }
+    if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
+    edge_at[i] = point_on_edge(p.e0, p.e1, t, margin);
+  });
+  // The triangles, in polygon order; edge points, and face points where a fan first needs
+  // them, appended to x.
+  TriangulationStats st;
+  std::vector<uint32_t> side_point(sides.size(), kNone);
+  for (size_t i = 0; i < n; ++i) {
+    const MeshPolygon& p = polys[i];
+    if (plain[i]) {
+      emit_split(p, splits[i], plain[i] & 3);
+      st.other_diagonal += plain[i] >> 2;
+      continue;
+    }
+    const auto ie = static_cast<uint32_t>(x.size());
+    x.push_back(edge_at[i]);
+    ++st.fans;
+    for (int k = 0; k < p.count; ++k) {
+      const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count], s = side_of[i][k];
+      if (crosses[s]) {
+        out.push_back({ie, a, b});
+        continue;
+      }
+      if (side_point[s] == kNone) {
+        Vec3 q, f;
+        crosses_inside(faces[s], x[a], x[b], q);
+        // Where the plain surface around the side crosses the face, else from the fan's plane.
+        double off = std::numeric_limits<double>::infinity(), dq = off;
+        for (const uint32_t v : {a, b})
+          plain_surface_in_face(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], faces[s], margin,
+                                q, f, off, dq);
+        if (!(off < std::numeric_limits<double>::infinity())) f = face_point(faces[s], x[a], x[b], edge_at[i], margin, q);
+        side_point[s] = static_cast<uint32_t>(x.size());
+        x.push_back(f);
+        ++st.face_points;
+      }
+      out.push_back({ie, a, side_point[s]});
+      out.push_back({ie, side_point[s], b});
+    }
+  }
+  if (stats) *stats = st;
+  return out;
+}
+
+}  // namespace pic::detail
