@@ -16,6 +16,7 @@
 #include "contour/triangulate.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -458,57 +459,37 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     for (int k = 0; k < polys[i].count; ++k) q[k] = x[polys[i].v[k]];
     return q;
   };
-  // Dual contouring's split of every polygon.
-  std::vector<Split> splits(n, Split{{{0, 1, 2}, {0, 2, 3}}});
-  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-    if (polys[i].count == 4) splits[i] = split_quad(ring_of(i));
-  });
-  std::vector<Tri> out;
-  out.reserve(n * 2);
-  const auto emit_split = [&](const MeshPolygon& p, const Split& sp, int ntris) {
-    for (int k = 0; k < ntris; ++k) out.push_back({p.v[sp[k][0]], p.v[sp[k][1]], p.v[sp[k][2]]});
+  const auto side = [&](size_t i, int k) {
+    const MeshPolygon& p = polys[i];
+    const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
+    return std::pair(std::min(a, b), std::max(a, b));  // one order, so both polygons agree
   };
-  if (how == Triangulation::kPlain) {
-    for (size_t i = 0; i < n; ++i) emit_split(polys[i], splits[i], polys[i].count == 4 ? 2 : 1);
-    if (stats) *stats = {};
-    return out;
-  }
-  // The polygons' sides, each once, and whether it crosses its cells' common face inside it.
-  std::vector<std::array<uint32_t, 4>> side_of(n);
-  std::vector<std::pair<uint32_t, uint32_t>> sides;
-  {
-    std::unordered_map<uint64_t, uint32_t> id;
-    id.reserve(n * 2);
-    for (size_t i = 0; i < n; ++i)
-      for (int k = 0; k < polys[i].count; ++k) {
-        const uint32_t a = polys[i].v[k], b = polys[i].v[(k + 1) % polys[i].count];
-        const auto [it, fresh] = id.try_emplace(uint64_t(std::min(a, b)) << 32 | std::max(a, b), uint32_t(sides.size()));
-        if (fresh) sides.push_back({a, b});
-        side_of[i][k] = it->second;
-      }
-  }
-  std::vector<Face> faces(sides.size());
-  std::vector<uint8_t> crosses(sides.size());
-  tbb::parallel_for(size_t{0}, sides.size(), [&](size_t s) {
-    const auto [a, b] = sides[s];
-    faces[s] = common_face(cells[a], cells[b]);
-    Vec3 q;
-    crosses[s] = faces[s].axis < 0 || crosses_inside(faces[s], x[a], x[b], q);
-  });
-  // Which polygons keep a plain split (kept in `splits`; 0: fanned), and how many took the
-  // other diagonal.
-  std::vector<uint8_t> plain(n, 0);
-  if (how == Triangulation::kConstruct)
-    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-      const MeshPolygon& p = polys[i];
-      for (int k = 0; k < p.count; ++k)
-        if (!crosses[side_of[i][k]]) return;
-      bool other = false;
-      if (const int tris = plain_split_in_region(ring_of(i), p.count, p.e0, p.e1, splits[i], other))
+  // Dual contouring's split of every polygon; then, unless plain, whether each side crosses
+  // its cells' common face inside it (bit k: side k does not), and whether the plain split
+  // provably stays in the polygon's region (`plain`: its triangle count, + 4 when it took the
+  // other diagonal; 0: fanned).
+  std::vector<Split> splits(n, Split{{{0, 1, 2}, {0, 2, 3}}});
+  std::vector<uint8_t> off_face(n, 0), plain(n, 0);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const MeshPolygon& p = polys[i];
+    const std::array<Vec3, 4> q = ring_of(i);
+    if (p.count == 4) splits[i] = split_quad(q);
+    if (how == Triangulation::kPlain) {
+      plain[i] = uint8_t(p.count == 4 ? 2 : 1);
+      return;
+    }
+    for (int k = 0; k < p.count; ++k) {
+      const auto [a, b] = side(i, k);
+      const Face f = common_face(cells[a], cells[b]);
+      Vec3 c;
+      if (f.axis >= 0 && !crosses_inside(f, x[a], x[b], c)) off_face[i] |= uint8_t(1 << k);
+    }
+    bool other = false;
+    if (how == Triangulation::kConstruct && !off_face[i])
+      if (const int tris = plain_split_in_region(q, p.count, p.e0, p.e1, splits[i], other))
         plain[i] = uint8_t(tris + (other ? 4 : 0));
-    });
-  // Each fanned polygon's edge point: where its edge crosses the plain surface of the
-  // polygons around it (those sharing a vertex with it).
+  });
+  // Each vertex's polygons (CSR): the plain surface around a polygon.
   std::vector<uint32_t> first(x.size() + 1, 0), around;
   for (const MeshPolygon& p : polys)
     for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
@@ -519,10 +500,43 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     for (size_t i = 0; i < n; ++i)
       for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = uint32_t(i);
   }
-  const double margin = inset;
-  std::vector<Vec3> edge_at(n);
+  const auto near = [&](uint32_t v) { return std::pair(around.data() + first[v], size_t(first[v + 1] - first[v])); };
+  // Numbering, in polygon order: fans' edge points, then face points (one per side off its
+  // face, numbered where a fan first uses it); the triangles each polygon writes.
+  TriangulationStats st;
+  const auto nv = static_cast<uint32_t>(x.size());
+  std::vector<uint32_t> edge_id(n, kNone), tri_at(n + 1, 0);
+  std::vector<std::array<uint32_t, 4>> face_id;  // per fan with sides off their faces
+  std::vector<uint32_t> face_slot(n, kNone);     // index into face_id
+  std::vector<std::pair<uint32_t, int>> face_owner;  // the fan and side that number each face point
+  std::unordered_map<uint64_t, uint32_t> face_of_side;
+  for (size_t i = 0; i < n; ++i) {
+    const MeshPolygon& p = polys[i];
+    if (plain[i]) {
+      tri_at[i + 1] = plain[i] & 3;
+      st.other_diagonal += plain[i] >> 2;
+      continue;
+    }
+    edge_id[i] = static_cast<uint32_t>(st.fans++);
+    tri_at[i + 1] = uint32_t(p.count + std::popcount(unsigned(off_face[i])));
+    if (!off_face[i]) continue;
+    face_slot[i] = static_cast<uint32_t>(face_id.size());
+    face_id.push_back({kNone, kNone, kNone, kNone});
+    for (int k = 0; k < p.count; ++k) {
+      if (!(off_face[i] >> k & 1)) continue;
+      const auto [a, b] = side(i, k);
+      const auto [it, fresh] = face_of_side.try_emplace(uint64_t(a) << 32 | b, uint32_t(face_owner.size()));
+      if (fresh) face_owner.push_back({uint32_t(i), k});
+      face_id.back()[k] = it->second;
+    }
+  }
+  st.face_points = face_owner.size();
+  for (size_t i = 0; i < n; ++i) tri_at[i + 1] += tri_at[i];
+  const uint32_t face_base = nv + uint32_t(st.fans);
+  x.resize(face_base + face_owner.size());
+  // Each fan's edge point: where its edge crosses the plain surface of the polygons around it.
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-    if (plain[i]) return;
+    if (edge_id[i] == kNone) return;
     const MeshPolygon& p = polys[i];
     const std::array<Vec3, 4> q = ring_of(i);
     const double prefer = ring_height(q, p.count, p.e0, p.e1);
@@ -531,59 +545,56 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       return oa < ob || (oa == ob && std::abs(a - prefer) < std::abs(b - prefer));
     };
     double t = std::numeric_limits<double>::quiet_NaN();
-    for (int k = 0; k < p.count; ++k) {
-      const uint32_t v = p.v[k];
-      const double h = pierce_near(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], p.e0, p.e1, prefer);
+    const auto look = [&](uint32_t v) {
+      const auto [list, count] = near(v);
+      const double h = pierce_near(x, polys, splits, list, count, p.e0, p.e1, prefer);
       if (h == h && (t != t || better(h, t))) t = h;
-    }
+    };
+    for (int k = 0; k < p.count; ++k) look(p.v[k]);
     // Else one ring further out (a fold can put the plain crossing a polygon away).
     for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
       for (uint32_t j = first[p.v[k]]; j < first[p.v[k] + 1]; ++j)
-        for (int m = 0; m < polys[around[j]].count; ++m) {
-          const uint32_t v = polys[around[j]].v[m];
-          const double h = pierce_near(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], p.e0, p.e1, prefer);
-          if (h == h && (t != t || better(h, t))) t = h;
-        }
+        for (int m = 0; m < polys[around[j]].count; ++m) look(polys[around[j]].v[m]);
     if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
-    edge_at[i] = point_on_edge(p.e0, p.e1, t, margin);
+    x[nv + edge_id[i]] = point_on_edge(p.e0, p.e1, t, inset);
   });
-  // The triangles, in polygon order; edge points, and face points where a fan first needs
-  // them, appended to x.
-  TriangulationStats st;
-  std::vector<uint32_t> side_point(sides.size(), kNone);
-  for (size_t i = 0; i < n; ++i) {
+  // Each face point: where the plain surface around its side crosses the face (or comes
+  // nearest it), else from the numbering fan's plane.
+  tbb::parallel_for(size_t{0}, face_owner.size(), [&](size_t j) {
+    const auto [i, k] = face_owner[j];
+    const auto [a, b] = side(i, k);
+    const Face face = common_face(cells[a], cells[b]);
+    Vec3 q, f;
+    crosses_inside(face, x[a], x[b], q);
+    double off = std::numeric_limits<double>::infinity(), dq = off;
+    for (const uint32_t v : {a, b}) {
+      const auto [list, count] = near(v);
+      plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
+    }
+    if (!(off < std::numeric_limits<double>::infinity())) f = face_point(face, x[a], x[b], x[nv + edge_id[i]], inset, q);
+    x[face_base + j] = f;
+  });
+  // The triangles.
+  std::vector<Tri> out(tri_at[n]);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const MeshPolygon& p = polys[i];
+    Tri* o = out.data() + tri_at[i];
     if (plain[i]) {
-      emit_split(p, splits[i], plain[i] & 3);
-      st.other_diagonal += plain[i] >> 2;
-      continue;
+      for (int k = 0; k < (plain[i] & 3); ++k) *o++ = {p.v[splits[i][k][0]], p.v[splits[i][k][1]], p.v[splits[i][k][2]]};
+      return;
     }
-    const auto ie = static_cast<uint32_t>(x.size());
-    x.push_back(edge_at[i]);
-    ++st.fans;
+    const uint32_t e = nv + edge_id[i];
     for (int k = 0; k < p.count; ++k) {
-      const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count], s = side_of[i][k];
-      if (crosses[s]) {
-        out.push_back({ie, a, b});
-        continue;
+      const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
+      if (!(off_face[i] >> k & 1)) {
+        *o++ = {e, a, b};
+      } else {
+        const uint32_t f = face_base + face_id[face_slot[i]][k];
+        *o++ = {e, a, f};
+        *o++ = {e, f, b};
       }
-      if (side_point[s] == kNone) {
-        Vec3 q, f;
-        crosses_inside(faces[s], x[a], x[b], q);
-        // Where the plain surface around the side crosses the face, else from the fan's plane.
-        double off = std::numeric_limits<double>::infinity(), dq = off;
-        for (const uint32_t v : {a, b})
-          plain_surface_in_face(x, polys, splits, around.data() + first[v], first[v + 1] - first[v], faces[s], margin,
-                                q, f, off, dq);
-        if (!(off < std::numeric_limits<double>::infinity())) f = face_point(faces[s], x[a], x[b], edge_at[i], margin, q);
-        side_point[s] = static_cast<uint32_t>(x.size());
-        x.push_back(f);
-        ++st.face_points;
-      }
-      out.push_back({ie, a, side_point[s]});
-      out.push_back({ie, side_point[s], b});
     }
-  }
+  });
   if (stats) *stats = st;
   return out;
 }

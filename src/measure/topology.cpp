@@ -1,9 +1,11 @@
 #include <algorithm>
-#include <map>
-#include <unordered_map>
+#include <array>
+#include <vector>
+
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
 
 #include "octree/cell.h"
-#include "geometry/union_find.h"
 
 namespace pic {
 
@@ -11,51 +13,84 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
   MeshTopology r;
   r.vertices = mesh.positions.size();
   r.triangles = mesh.triangles.size();
-  // Directed half-edge counts per undirected edge.
-  struct EdgeUse {
-    uint32_t forward = 0, backward = 0;
-  };
-  std::unordered_map<uint64_t, EdgeUse> edges;
-  edges.reserve(mesh.triangles.size() * 2);
+  const auto degenerate = [](const std::array<uint32_t, 3>& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; };
+  // Each vertex's triangles (CSR), with the corner it is at.
+  const size_t nv = mesh.positions.size();
+  std::vector<uint32_t> first(nv + 1, 0);
   for (const auto& t : mesh.triangles) {
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+    if (degenerate(t)) {
       ++r.degenerate_triangles;
       continue;
     }
-    for (int e = 0; e < 3; ++e) {
-      const uint64_t a = t[e], b = t[(e + 1) % 3];
-      auto& u = edges[std::min(a, b) << 32 | std::max(a, b)];
-      (a < b ? u.forward : u.backward)++;
+    for (uint32_t v : t) ++first[v + 1];
+  }
+  for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<uint32_t> corner(first.back());  // 3 * triangle + corner
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (uint32_t f = 0; f < mesh.triangles.size(); ++f)
+      if (!degenerate(mesh.triangles[f]))
+        for (uint32_t k = 0; k < 3; ++k) corner[fill[mesh.triangles[f][k]]++] = 3 * f + k;
+  }
+  // Per vertex v: its edges to higher vertices (counted once, here) and whether its triangles
+  // form one fan (joined across the edges at v).
+  struct Counts {
+    size_t boundary = 0, nonmanifold = 0, inconsistent = 0, pinched = 0;
+  };
+  tbb::combinable<Counts> counts;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    Counts& c = counts.local();
+    struct Spoke {
+      uint32_t other;  // the edge's other vertex
+      uint32_t slot;   // triangle within the fan
+      bool out;        // the triangle runs v -> other along this edge
+    };
+    std::vector<Spoke> spokes;
+    std::vector<uint32_t> parent;
+    for (size_t v = range.begin(); v < range.end(); ++v) {
+      const uint32_t n = first[v + 1] - first[v];
+      if (n == 0) continue;
+      spokes.clear();
+      for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t h = corner[first[v] + i], f = h / 3, k = h % 3;
+        const auto& t = mesh.triangles[f];
+        spokes.push_back({t[(k + 1) % 3], i, true});
+        spokes.push_back({t[(k + 2) % 3], i, false});
+      }
+      std::sort(spokes.begin(), spokes.end(), [](const Spoke& a, const Spoke& b) { return a.other < b.other; });
+      parent.resize(n);
+      for (uint32_t i = 0; i < n; ++i) parent[i] = i;
+      const auto root = [&](uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+      };
+      for (size_t i = 0; i < spokes.size();) {
+        size_t j = i;
+        uint32_t out = 0;
+        while (j < spokes.size() && spokes[j].other == spokes[i].other) {
+          out += spokes[j].out;
+          parent[root(spokes[j].slot)] = root(spokes[i].slot);
+          ++j;
+        }
+        if (spokes[i].other > v) {
+          const size_t uses = j - i;
+          if (uses == 1) ++c.boundary;
+          if (uses > 2) ++c.nonmanifold;
+          if (uses == 2 && out != 1) ++c.inconsistent;
+        }
+        i = j;
+      }
+      uint32_t roots = 0;
+      for (uint32_t i = 0; i < n; ++i) roots += root(i) == i;
+      c.pinched += roots > 1;
     }
-  }
-  for (const auto& [k, u] : edges) {
-    const uint32_t n = u.forward + u.backward;
-    if (n == 1) ++r.boundary_edges;
-    if (n > 2) ++r.nonmanifold_edges;
-    if (n == 2 && u.forward != 1) ++r.inconsistent_edges;
-  }
-  // Vertex fans: the triangles around a manifold vertex form one cycle through its edges.
-  std::vector<std::vector<uint32_t>> around(mesh.positions.size());
-  for (uint32_t f = 0; f < mesh.triangles.size(); ++f) {
-    const auto& t = mesh.triangles[f];
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-    for (uint32_t v : t) around[v].push_back(f);
-  }
-  for (uint32_t v = 0; v < around.size(); ++v) {
-    const auto& fan = around[v];
-    if (fan.empty()) continue;
-    // Union-find over the fan's triangles joined by shared edges at v.
-    std::map<uint32_t, std::vector<size_t>> by_other;
-    for (size_t i = 0; i < fan.size(); ++i)
-      for (uint32_t w : mesh.triangles[fan[i]])
-        if (w != v) by_other[w].push_back(i);
-    detail::UnionFind fans(fan.size());
-    for (const auto& [w, list] : by_other)
-      for (size_t i = 1; i < list.size(); ++i) fans.join(list[i], list[0]);
-    size_t roots = 0;
-    for (size_t i = 0; i < fan.size(); ++i) roots += fans.root(i) == i;
-    if (roots > 1) ++r.nonmanifold_vertices;
-  }
+  });
+  counts.combine_each([&](const Counts& c) {
+    r.boundary_edges += c.boundary;
+    r.nonmanifold_edges += c.nonmanifold;
+    r.inconsistent_edges += c.inconsistent;
+    r.nonmanifold_vertices += c.pinched;
+  });
   return r;
 }
 
