@@ -193,7 +193,7 @@ a & b (intersect), a - b (subtract) return new objects; a |= b, a &= b, a -= b e
       py::arg("intersection_free") = true, py::arg("split") = true, py::arg("stats") = py::none(),
       R"doc(The closed surface by dual contouring: (vertices float64 (n, 3), faces int64 (m, 3)).
 
-intersection_free: re-triangulate so that no two triangles cross (False: the plain split, `pic mesh --fast`).
+intersection_free: triangulate so that no two triangles can cross, by construction (False: the plain split, `pic mesh --plain`).
 split: give touching sheets their own vertex copies (pic::split_nonmanifold), as `pic mesh` writes.
 stats: a dict to fill with the contour's counts and seconds.)doc");
   c.def(

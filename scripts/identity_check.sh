@@ -17,7 +17,7 @@ for m in fandisk cad_part spot suzanne teapot stanford-bunny; do
   for d in 8 10; do
     "$PIC" sample "$ROOT/data/$m.obj" --depth $d -o "$OUT/$m.$d.pic" --json | strip > "$OUT/$m.$d.sample.json"
     "$PIC" mesh "$OUT/$m.$d.pic" -o "$OUT/$m.$d.obj" --json | strip > "$OUT/$m.$d.mesh.json"
-    "$PIC" mesh "$OUT/$m.$d.pic" -o "$OUT/$m.$d.fast.obj" --fast --no-split --json | strip > "$OUT/$m.$d.fast.json" || true
+    "$PIC" mesh "$OUT/$m.$d.pic" -o "$OUT/$m.$d.plain.obj" --plain --no-split --json | strip > "$OUT/$m.$d.plain.json" || true
     "$PIC" info "$OUT/$m.$d.pic" --json | strip > "$OUT/$m.$d.info.json"
   done
 done
