@@ -550,7 +550,11 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       const double h = pierce_near(x, polys, splits, list, count, p.e0, p.e1, prefer);
       if (h == h && (t != t || better(h, t))) t = h;
     };
-    for (int k = 0; k < p.count; ++k) look(p.v[k]);
+    // The polygon's own split first: where it pierces the edge, nothing else is needed.
+    const uint32_t self = uint32_t(i);
+    t = pierce_near(x, polys, splits, &self, 1, p.e0, p.e1, prefer);
+    if (!(t >= 0 && t <= 1))
+      for (int k = 0; k < p.count; ++k) look(p.v[k]);
     // Else one ring further out (a fold can put the plain crossing a polygon away).
     for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
       for (uint32_t j = first[p.v[k]]; j < first[p.v[k] + 1]; ++j)
@@ -567,10 +571,21 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     Vec3 q, f;
     crosses_inside(face, x[a], x[b], q);
     double off = std::numeric_limits<double>::infinity(), dq = off;
-    for (const uint32_t v : {a, b}) {
-      const auto [list, count] = near(v);
-      plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
+    // The polygons with this side first (the plain surface next to it), then all around.
+    uint32_t with_side[8];
+    size_t nside = 0;
+    const auto [la, ca] = near(a);
+    for (size_t m = 0; m < ca && nside < 8; ++m) {
+      const MeshPolygon& o = polys[la[m]];
+      for (int r = 0; r < o.count; ++r)
+        if (o.v[r] == b) with_side[nside++] = la[m];
     }
+    plain_surface_in_face(x, polys, splits, with_side, nside, face, inset, q, f, off, dq);
+    if (off != 0)
+      for (const uint32_t v : {a, b}) {
+        const auto [list, count] = near(v);
+        plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
+      }
     if (!(off < std::numeric_limits<double>::infinity())) f = face_point(face, x[a], x[b], x[nv + edge_id[i]], inset, q);
     x[face_base + j] = f;
   });
