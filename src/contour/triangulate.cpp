@@ -571,21 +571,10 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     Vec3 q, f;
     crosses_inside(face, x[a], x[b], q);
     double off = std::numeric_limits<double>::infinity(), dq = off;
-    // The polygons with this side first (the plain surface next to it), then all around.
-    uint32_t with_side[8];
-    size_t nside = 0;
-    const auto [la, ca] = near(a);
-    for (size_t m = 0; m < ca && nside < 8; ++m) {
-      const MeshPolygon& o = polys[la[m]];
-      for (int r = 0; r < o.count; ++r)
-        if (o.v[r] == b) with_side[nside++] = la[m];
+    for (const uint32_t v : {a, b}) {
+      const auto [list, count] = near(v);
+      plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
     }
-    plain_surface_in_face(x, polys, splits, with_side, nside, face, inset, q, f, off, dq);
-    if (off != 0)
-      for (const uint32_t v : {a, b}) {
-        const auto [list, count] = near(v);
-        plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
-      }
     if (!(off < std::numeric_limits<double>::infinity())) f = face_point(face, x[a], x[b], x[nv + edge_id[i]], inset, q);
     x[face_base + j] = f;
   });
