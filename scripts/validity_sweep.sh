@@ -3,7 +3,8 @@
 # and its difference, when THINGI_DIR holds them) sampled at DEPTH, written by `pic mesh` /
 # `pic csg --mesh`, with the exact checks PIC reports itself (self-intersections, non-manifold
 # vertices and edges, components). With MESHCHECK set to the shared tools' meshcheck, also the
-# two-sided Hausdorff distance to the input mesh.
+# two-sided Hausdorff distance to the input mesh. The last column: `pic mesh --plain --no-check`'s
+# seconds (dual contouring's plain split, which may cross itself) on the same .pic.
 #   scripts/validity_sweep.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 BUILD=${1:-build}
@@ -21,17 +22,20 @@ row() {  # name, json file, input mesh (or "")
   if [[ -n "$MESHCHECK" && -n "$3" ]]; then
     haus=$("$MESHCHECK" "$OUT/$1.obj" "$3" --no-si --samples 100000 | json "'%.3g' % max(d['hausdorff_ab'], d['hausdorff_ba'])")
   fi
-  echo "| $1 | $fields | $haus | $(json "'%.2f' % d['seconds']" < "$2") |"
+  local plain=""
+  [[ -f "$OUT/$1.plain.json" ]] && plain=$(json "'%.3f' % d['seconds']" < "$OUT/$1.plain.json")
+  echo "| $1 | $fields | $haus | $(json "'%.3f' % d['seconds']" < "$2") | $plain |"
 }
 
-echo "| mesh | self-intersecting pairs | non-manifold vertices | non-manifold edges | components | triangles | Hausdorff | seconds |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| mesh | self-intersecting pairs | non-manifold vertices | non-manifold edges | components | triangles | Hausdorff | seconds | plain split s |"
+echo "|---|---|---|---|---|---|---|---|---|"
 inputs=()
 for m in data/*.obj; do inputs+=("$m"); done
 [[ -f "$THINGI_DIR/thingi10k-1706459.obj" ]] && inputs+=("$THINGI_DIR/thingi10k-1706459.obj" "$THINGI_DIR/thingi10k-1514499.obj")
 for m in "${inputs[@]}"; do
   name=$(basename "$m" .obj)
   "$PIC" sample "$m" -o "$OUT/$name.pic" --depth "$DEPTH" > /dev/null
+  "$PIC" mesh "$OUT/$name.pic" -o "$OUT/$name.plain.obj" --plain --json --no-check > "$OUT/$name.plain.json" 2>/dev/null
   "$PIC" mesh "$OUT/$name.pic" -o "$OUT/$name.obj" --json > "$OUT/$name.json"
   row "$name" "$OUT/$name.json" "$m"
 done
