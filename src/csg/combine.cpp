@@ -267,6 +267,12 @@ class Combiner {
       if (ev.vis_b && !ev.vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
       return std::nullopt;
     }
+    if (surfaces_coincide(a_, a, b_, b, cell)) {
+      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
+      if (sr == 0 || sr == 0xff) return uniform(sr != 0);
+      if (sr == a.signs) return copy_side(a_, a, cell, false, true);
+      if (sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
+    }
     // Q_sum = Q_A + Q_B minimized from the average of the two vertices.
     const CellQefs q = cell_qefs(a_, a, b_, b, cell);
     const Vec3 va = operand_vertex(a_, a, q.a, cell), vb = operand_vertex(b_, b, q.b, cell);

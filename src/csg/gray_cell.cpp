@@ -1,6 +1,7 @@
 // GraycellCSG's predicates (paper Figure 3): whether the summed QEF's vertex may stand for the
 // result in a cell, or the cell must be subdivided. See gray_cell.h.
 #include "csg/gray_cell.h"
+#include "geometry/vec3.h"
 
 namespace pic::detail {
 
@@ -157,6 +158,23 @@ bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Si
     for (uint32_t j : b.idx)
       if (triangles_meet_in_box(xa.tris[i], xb.tris[j], cell.box())) return true;
   return false;
+}
+
+bool surfaces_coincide(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
+  if (a.idx.empty() || b.idx.empty()) return false;
+  const ITri& ref = xa.tris[a.idx.front()];
+  // Within a millionth of the cell: the operands' float vertices on one exact plane.
+  const double tol = 1e-6 * cell.size();
+  const auto on_ref = [&](const ITri& t) {
+    const double c = dot3(ref.unit_normal, t.unit_normal);
+    if (std::abs(std::abs(c) - 1) > 1e-9) return false;
+    return std::abs((c > 0 ? t.plane : -t.plane) - ref.plane) <= tol;
+  };
+  for (uint32_t i : a.idx)
+    if (!on_ref(xa.tris[i])) return false;
+  for (uint32_t j : b.idx)
+    if (!on_ref(xb.tris[j])) return false;
+  return true;
 }
 
 /// The new feature (where the two surfaces meet) must also fit one point or line over the

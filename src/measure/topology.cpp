@@ -40,12 +40,9 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
   tbb::combinable<Counts> counts;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
     Counts& c = counts.local();
-    struct Spoke {
-      uint32_t other;  // the edge's other vertex
-      uint32_t slot;   // triangle within the fan
-      bool out;        // the triangle runs v -> other along this edge
-    };
-    std::vector<Spoke> spokes;
+    // A spoke: the edge's other vertex (high 32 bits), the triangle within the fan, and whether
+    // the triangle runs v -> other along it (low bit); sorted by other vertex.
+    std::vector<uint64_t> spokes;
     std::vector<uint32_t> parent;
     for (size_t v = range.begin(); v < range.end(); ++v) {
       const uint32_t n = first[v + 1] - first[v];
@@ -54,25 +51,29 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
       for (uint32_t i = 0; i < n; ++i) {
         const uint32_t h = corner[first[v] + i], f = h / 3, k = h % 3;
         const auto& t = mesh.triangles[f];
-        spokes.push_back({t[(k + 1) % 3], i, true});
-        spokes.push_back({t[(k + 2) % 3], i, false});
+        spokes.push_back(uint64_t(t[(k + 1) % 3]) << 32 | uint64_t(i) << 1 | 1);
+        spokes.push_back(uint64_t(t[(k + 2) % 3]) << 32 | uint64_t(i) << 1);
       }
-      std::sort(spokes.begin(), spokes.end(), [](const Spoke& a, const Spoke& b) { return a.other < b.other; });
+      // Fans are small: insertion sort.
+      for (size_t i = 1; i < spokes.size(); ++i)
+        for (size_t j = i; j > 0 && spokes[j - 1] > spokes[j]; --j) std::swap(spokes[j - 1], spokes[j]);
       parent.resize(n);
       for (uint32_t i = 0; i < n; ++i) parent[i] = i;
       const auto root = [&](uint32_t x) {
         while (parent[x] != x) x = parent[x] = parent[parent[x]];
         return x;
       };
+      const auto other = [](uint64_t s) { return uint32_t(s >> 32); };
+      const auto slot = [](uint64_t s) { return uint32_t(s) >> 1; };
       for (size_t i = 0; i < spokes.size();) {
         size_t j = i;
         uint32_t out = 0;
-        while (j < spokes.size() && spokes[j].other == spokes[i].other) {
-          out += spokes[j].out;
-          parent[root(spokes[j].slot)] = root(spokes[i].slot);
+        while (j < spokes.size() && other(spokes[j]) == other(spokes[i])) {
+          out += uint32_t(spokes[j] & 1);
+          parent[root(slot(spokes[j]))] = root(slot(spokes[i]));
           ++j;
         }
-        if (spokes[i].other > v) {
+        if (other(spokes[i]) > v) {
           const size_t uses = j - i;
           if (uses == 1) ++c.boundary;
           if (uses > 2) ++c.nonmanifold;
