@@ -258,9 +258,9 @@ double pierce(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e0, const
 
 // The edge parameter where the line of edge (e0, e1) pierces the plain split of the polygons
 // `near` (their triangles): inside the edge if it can, then nearest to `prefer`; NaN when the
-// line pierces none. The
-// plain dual contouring surface crosses a sign-changing edge within its own error of where
-// the sampled surface does, even where the edge's own polygon folds beside it.
+// line pierces none. The plain dual contouring surface crosses a sign-changing edge within its
+// own error of where the sampled surface does, even where the edge's own polygon folds beside
+// it.
 double pierce_near(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys, const std::vector<Split>& splits,
                    const uint32_t* near, size_t count, const Vec3& e0, const Vec3& e1, double prefer) {
   double best = std::numeric_limits<double>::quiet_NaN();
