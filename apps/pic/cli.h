@@ -75,8 +75,9 @@ struct WrittenMesh {
 /// Throws InvalidOutput naming the file and the counts that are off, unless it is closed,
 /// 2-manifold and (where counted) free of self-intersections.
 void require_valid(const WrittenMesh& m);
-/// The intersection-free contour's own count of crossings left (none when it did not look).
-std::optional<size_t> known_crossings(const ContourOptions& o, const ContourStats& s);
+/// Crossings known without the exact test: 0 for the intersection-free construction, none
+/// (unknown) for the plain split.
+std::optional<size_t> known_crossings(const ContourOptions& o);
 
 /// A contour written to a file, with what the CLI reports of it.
 struct ContourFile {

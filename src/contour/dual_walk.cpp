@@ -1,5 +1,4 @@
 #include "contour/dual_walk.h"
-#include "contour/triangulate.h"
 #include "geometry/predicates.h"
 #include "geometry/vec3.h"
 
@@ -235,10 +234,6 @@ void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
     DualWalker<CellRef, CallbackVisitor<false>>(t, v).cell_proc({0, Cell{}});
   }
 }
-
-}  // namespace pic::detail
-
-namespace pic::detail {
 
 std::vector<MeshPolygon> dual_polygons(const Octree& tree) {
   const bool split = tree.nodes[0].kind == CellKind::Internal;

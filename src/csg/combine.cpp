@@ -258,21 +258,21 @@ class Combiner {
                                 bool at_cap) {
     const bool simple = at_cap || refinement_is_simple(op_, a_, a, b_, b, cell, sr);
     if (!simple) return std::nullopt;
-    if (!surfaces_meet(a_, a, b_, b, cell)) {
-      // The surfaces do not meet here, so the result is one operand's cell, or uniform, when
-      // the signs agree.
-      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
-      if (!ev.vis_a && !ev.vis_b && (sr == 0 || sr == 0xff)) return uniform(sr != 0);
-      if (ev.vis_a && !ev.vis_b && sr == a.signs) return copy_side(a_, a, cell, false, true);
-      if (ev.vis_b && !ev.vis_a && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
+    // The result as uniform, or as one operand's cell, where the signs agree (and the caller
+    // allows that case).
+    const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
+    const auto culled = [&](bool uniform_ok, bool a_ok, bool b_ok) -> std::optional<Node> {
+      if (uniform_ok && (sr == 0 || sr == 0xff)) return uniform(sr != 0);
+      if (a_ok && sr == a.signs) return copy_side(a_, a, cell, false, true);
+      if (b_ok && sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
       return std::nullopt;
-    }
-    if (surfaces_coincide(a_, a, b_, b, cell)) {
-      const uint8_t sb_seen = op_ == CsgOp::Subtract ? uint8_t(~b.signs) : b.signs;
-      if (sr == 0 || sr == 0xff) return uniform(sr != 0);
-      if (sr == a.signs) return copy_side(a_, a, cell, false, true);
-      if (sr == sb_seen) return copy_side(b_, b, cell, op_ == CsgOp::Subtract, false);
-    }
+    };
+    // The surfaces do not meet here: the result is what the visible operand says.
+    if (!surfaces_meet(a_, a, b_, b, cell))
+      return culled(!ev.vis_a && !ev.vis_b, ev.vis_a && !ev.vis_b, ev.vis_b && !ev.vis_a);
+    // They coincide: one operand's face or none.
+    if (surfaces_coincide(a_, a, b_, b, cell))
+      if (std::optional<Node> n = culled(true, true, true)) return n;
     // Q_sum = Q_A + Q_B minimized from the average of the two vertices.
     const CellQefs q = cell_qefs(a_, a, b_, b, cell);
     const Vec3 va = operand_vertex(a_, a, q.a, cell), vb = operand_vertex(b_, b, q.b, cell);
