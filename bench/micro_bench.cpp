@@ -26,6 +26,7 @@
 #include "geometry/qef.h"
 #include "octree/cell.h"
 #include "geometry/winding.h"
+#include "../apps/common/allocator_settings.h"
 
 namespace {
 
@@ -236,4 +237,12 @@ void BM_SampleAnyInput(benchmark::State& state) {
 }
 BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-BENCHMARK_MAIN();
+// The allocator settings of the command-line tool, so both measure the same thing.
+int main(int argc, char** argv) {
+  pic::app::restart_with_allocator_settings(argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

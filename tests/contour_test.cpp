@@ -416,9 +416,10 @@ Octree random_octree(uint32_t seed, int depth) {
 
 // The construction never lets two triangles cross, on trees whose vertices sit anywhere in
 // their cells (on their borders too), nor does the all-fans variant; the plain split on the
-// same trees does (so the test can fail).
+// same trees does (so the test can fail). All three ways a polygon can go are exercised: plain
+// split, fan from a ring point, fan around an edge point.
 TEST(ContourConstruction, RandomOctreesHaveNoCrossingTriangles) {
-  size_t plain_crossings = 0, fans = 0;
+  size_t plain_crossings = 0, fans = 0, face_fans = 0;
   for (uint32_t seed = 1; seed <= 24; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const Octree t = random_octree(seed, 5 + seed % 3);
@@ -434,11 +435,12 @@ TEST(ContourConstruction, RandomOctreesHaveNoCrossingTriangles) {
       const TriMesh m = contour(t, o, &st);
       ASSERT_FALSE(m.triangles.empty());
       EXPECT_EQ(count_self_intersections(m), 0u) << (all ? "all fans" : "construction");
-      if (!all) fans += st.fans;
+      if (!all) fans += st.fans, face_fans += st.face_fans;
     }
   }
   EXPECT_GT(plain_crossings, 0u);
   EXPECT_GT(fans, 0u);
+  EXPECT_GT(face_fans, 0u);
 }
 
 // On sampled models the construction gives valid solids where the plain split crosses, with

@@ -32,6 +32,7 @@ void run(const MeshArgs& a) {
         .add("fans", f.stats.fans)
         .add("other_diagonal", f.stats.other_diagonal)
         .add("face_points", f.stats.face_points)
+        .add("face_fans", f.stats.face_fans)
         .add("moved_vertices", f.stats.moved_vertices)
         .add("volume", volume(mesh))
         .raw("topology", topology_json(topo));

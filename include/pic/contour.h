@@ -27,6 +27,7 @@ struct ContourStats {
   size_t fans = 0;            ///< polygons triangulated as a fan around a point on their edge
   size_t other_diagonal = 0;  ///< quads split along the other diagonal to stay in their region
   size_t face_points = 0;     ///< polygon sides split at a point of their cells' common face
+  size_t face_fans = 0;       ///< polygons with face points, fanned from a point of their own ring
   size_t split_vertices = 0;  ///< vertex copies added by split_sheets
   // Kept for readers of `pic mesh --json`: the construction moves no vertex and leaves no
   // crossing to resolve, so these stay 0.

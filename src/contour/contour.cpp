@@ -66,6 +66,7 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
     stats->fans = ts.fans;
     stats->other_diagonal = ts.other_diagonal;
     stats->face_points = ts.face_points;
+    stats->face_fans = ts.face_fans;
   }
   const size_t split_vertices = options.split_sheets ? split_nonmanifold(out) : 0;
   if (stats) stats->split_vertices = split_vertices;

@@ -9,10 +9,13 @@
 // are cones from v_i over the triangles (Q, e) of its faces, and those triangles tile the faces
 // without overlapping, so different polygons' regions meet only on their boundaries. A fan
 // around a point p strictly inside e, with triangles (p, v_i, Q) and (p, Q, v_i+1), lies in
-// its region. The plain split is kept when every side crosses its face and each of its
-// triangles lies in the region too, strictly inside except along the polygon's own sides:
-// with no face point the region is the ring of tetrahedra (e, v_i, v_i+1) around e, checked
-// wedge by wedge. So triangles of different polygons meet only in shared vertices and sides.
+// its region. Written as a ring of points around e (the vertices, with each side's face
+// point between its two), the region is the ring of tetrahedra (e, r_i, r_i+1): with no face
+// point, tetrahedra (v_i, Q, e) and (v_i+1, Q, e) make up (e, v_i, v_i+1) as Q lies on the
+// side. The plain split is kept when every side crosses its face and both its triangles lie
+// in that ring, strictly inside except along the polygon's own sides; a polygon with face
+// points becomes a fan from one of its ring's points when that fan lies in the ring; else a
+// fan around p. So triangles of different polygons meet only in shared vertices and sides.
 #include "contour/triangulate.h"
 
 #include <algorithm>
@@ -31,25 +34,9 @@ namespace {
 using Tri = std::array<uint32_t, 3>;
 using Split = std::array<std::array<int, 3>, 2>;
 constexpr uint32_t kNone = ~uint32_t{0};
+constexpr int kMaxRing = 8;  // a quad with all four sides split at face points
 
 inline double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
-
-// The closest points of segments p0 p1 and q0 q1: parameters s (on p) and t (on q) in [0, 1];
-// returns the squared distance.
-double closest_on_segments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t) {
-  const Vec3 d1 = sub3(p1, p0), d2 = sub3(q1, q0), r = sub3(p0, q0);
-  const double a = dot3(d1, d1), e = dot3(d2, d2), f = dot3(d2, r), c = dot3(d1, r), b = dot3(d1, d2);
-  const double den = a * e - b * b;
-  s = a > 0 && den > 1e-14 * a * e ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
-  t = e > 0 ? (b * s + f) / e : 0.0;
-  if (t < 0 || t > 1) {
-    t = std::clamp(t, 0.0, 1.0);
-    s = a > 0 ? std::clamp((b * t - c) / a, 0.0, 1.0) : 0.0;
-  }
-  Vec3 g;
-  for (int k = 0; k < 3; ++k) g[k] = p0[k] + s * d1[k] - q0[k] - t * d2[k];
-  return dot3(g, g);
-}
 
 // The common face of two cells that touch across a face: its axis, plane and extent.
 struct Face {
@@ -96,11 +83,13 @@ bool crosses_inside(const Face& face, const Vec3& xa, const Vec3& xb, Vec3& q) {
 }
 
 // The point of the face (`margin` inside its border) nearest where the plain split of the
-// polygons `near` crosses the face's plane; among points where it crosses the face itself, the
-// one nearest q. Candidates better than (best_off, best_q) replace `best`.
+// polygons `near` (but those with vertex `skip`) crosses the face's plane; among points where
+// it crosses the face itself, the one nearest q. Candidates better than (best_off, best_q)
+// replace `best`.
 void plain_surface_in_face(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys,
-                           const std::vector<Split>& splits, const uint32_t* near, size_t count, const Face& face,
-                           double margin, const Vec3& q, Vec3& best, double& best_off, double& best_q) {
+                           const std::vector<Split>& splits, const uint32_t* near, size_t count, uint32_t skip,
+                           const Face& face, double margin, const Vec3& q, Vec3& best, double& best_off,
+                           double& best_q) {
   const int axis = face.axis, u = (axis + 1) % 3, w = (axis + 2) % 3;
   const double lo[2] = {face.lo[u] + margin, face.lo[w] + margin}, hi[2] = {face.hi[u] - margin, face.hi[w] - margin};
   const auto consider = [&](const double c[2], double off) {
@@ -115,6 +104,7 @@ void plain_surface_in_face(const std::vector<Vec3>& x, const std::vector<MeshPol
   };
   for (size_t k = 0; k < count; ++k) {
     const MeshPolygon& p = polys[near[k]];
+    if (skip != kNone && std::find(p.v.begin(), p.v.begin() + p.count, skip) != p.v.begin() + p.count) continue;
     for (int i = 0; i < (p.count == 4 ? 2 : 1); ++i) {
       std::array<Vec3, 3> t;
       for (int m = 0; m < 3; ++m) t[m] = x[p.v[splits[near[k]][i][m]]];
@@ -167,74 +157,6 @@ void plain_surface_in_face(const std::vector<Vec3>& x, const std::vector<MeshPol
       }
     }
   }
-}
-
-// A point of the face, `margin` inside its border, to split side a b of a polygon fanned
-// around edge point e (on the face's border) when the side crosses the face's plane at q
-// outside the face.
-Vec3 face_point(const Face& face, const Vec3& xa, const Vec3& xb, const Vec3& e, double margin, Vec3 f) {
-  const int axis = face.axis;
-  const Vec3 &lo = face.lo, &hi = face.hi;
-  const double plane = face.plane;
-  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-  Vec3 mlo = lo, mhi = hi;  // the face, `margin` inside its border
-  for (int d : {u, w}) {
-    mlo[d] += margin;
-    mhi[d] -= margin;
-  }
-  // The side crosses the face's plane beyond the fan's edge (across the line of the edge from
-  // the face): the surface crosses that line at e and goes on into the neighbouring face, so
-  // the point of this face nearest the surface is next to e.
-  for (int d : {u, w}) {
-    if (e[d] != lo[d] && e[d] != hi[d]) continue;  // not the coordinate across the edge
-    if ((e[d] == lo[d] && f[d] < lo[d]) || (e[d] == hi[d] && f[d] > hi[d])) {
-      Vec3 g = e;
-      for (int k : {u, w}) g[k] = std::clamp(g[k], mlo[k], mhi[k]);
-      g[axis] = plane;
-      return g;
-    }
-  }
-  // Off the face. The edge point e (on the face's border) and the crossing f are both on the
-  // plane of the fan triangle (e, a, b) and on the face's plane: on a flat surface the line
-  // e f is where the surface crosses the face's plane. Its point inside the face nearest f
-  // keeps the two triangles that replace (e, a, b) on the surface (when f lies beyond e, the
-  // point is just past e: this polygon's triangles thin out and its neighbours' take over).
-  double l0 = -1e300, l1 = 1e300;
-  for (int d : {u, w}) {
-    const double o = e[d], v = f[d] - e[d];
-    if (v == 0) {
-      if (o <= mlo[d] || o >= mhi[d]) l1 = -1;
-      continue;
-    }
-    double ta = (mlo[d] - o) / v, tb = (mhi[d] - o) / v;
-    if (ta > tb) std::swap(ta, tb);
-    l0 = std::max(l0, ta);
-    l1 = std::min(l1, tb);
-  }
-  if (l1 > l0 && (f[u] != e[u] || f[w] != e[w])) {
-    const double l = std::clamp(1.0, l0, l1);
-    for (int d : {u, w}) f[d] = e[d] + l * (f[d] - e[d]);
-    f[axis] = plane;
-    return f;
-  }
-  // Else the point of the face's border nearest the segment a b.
-  double best_d = 1e300;
-  for (int side = 0; side < 4; ++side) {
-    Vec3 c0, c1;
-    c0[axis] = c1[axis] = plane;
-    const int along = side < 2 ? u : w, across = side < 2 ? w : u;
-    c0[along] = lo[along];
-    c1[along] = hi[along];
-    c0[across] = c1[across] = side % 2 ? hi[across] : lo[across];
-    double s = 0, t = 0;
-    const double d = closest_on_segments(c0, c1, xa, xb, s, t);
-    if (d < best_d) {
-      best_d = d;
-      for (int k = 0; k < 3; ++k) f[k] = c0[k] + s * (c1[k] - c0[k]);
-    }
-  }
-  for (int d : {u, w}) f[d] = std::clamp(f[d], mlo[d], mhi[d]);
-  return f;
 }
 
 int axis_of(const Vec3& e0, const Vec3& e1) {
@@ -314,43 +236,22 @@ Vec3 point_on_edge(const Vec3& e0, const Vec3& e1, double t, double margin) {
   return x;
 }
 
-// A point of a clipped triangle: where it is, and which ring vertex it is (-1: none).
-struct ClipPoint {
-  Vec3 x;
-  int ring;
-};
-
-// Keeps the part of convex polygon `poly` where g >= 0 (g linear).
-template <class G>
-int clip(const ClipPoint* in, int n, ClipPoint* out, const G& g) {
-  int m = 0;
-  for (int k = 0; k < n; ++k) {
-    const ClipPoint &a = in[k], &b = in[(k + 1) % n];
-    const double ga = g(a.x), gb = g(b.x);
-    if (ga >= 0) out[m++] = a;
-    if ((ga < 0 && gb > 0) || (ga > 0 && gb < 0)) {
-      const double t = ga / (ga - gb);
-      ClipPoint c{a.x, -1};
-      for (int d = 0; d < 3; ++d) c.x[d] = a.x[d] + t * (b.x[d] - a.x[d]);
-      out[m++] = c;
-    }
-  }
-  return m;
-}
-
 // True when the triangles `tris` (index triples into ring `r`) lie in the ring of tetrahedra
-// (e0, e1, r_i, r_i+1) around the edge, strictly inside except at the ring's own sides. The
+// (e0, e1, r_i, r_i+1) around the edge, strictly inside except at the ring's vertices. The
 // ring must wind once around the edge, each step turning the same way by less than half a
-// turn; then wedge i (between the half-planes through the edge and r_i, r_i+1) holds exactly
-// tetrahedron i, which is the part of the wedge above plane (e0, r_i, r_i+1) and below plane
-// (e1, r_i, r_i+1): each triangle's part in each wedge is checked against those two planes.
-bool inside_ring(const std::array<Vec3, 4>& r, int n, const Vec3& e0, const Vec3& e1,
-                 const std::array<std::array<int, 3>, 2>& tris, int ntris) {
+// turn. Seen along the edge, tetrahedron i then fills wedge i (between the rays through r_i
+// and r_i+1), between the plane (e0, r_i, r_i+1) below and (e1, r_i, r_i+1) above. Within a
+// wedge a triangle's height minus those planes is linear, so it suffices to check the corners
+// of the triangle's parts in the wedges: its own vertices (ring vertices), where its sides
+// cross the rays (strictly inside triangle (e0, e1, r_k) on ray k), and the edge itself, if
+// the edge pierces the triangle (strictly between e0 and e1).
+bool inside_ring(const Vec3* r, int n, const Vec3& e0, const Vec3& e1, const std::array<int, 3>* tris, int ntris) {
   const int ax = axis_of(e0, e1), u = (ax + 1) % 3, w = (ax + 2) % 3;
-  std::array<double, 4> du{}, dw{};
+  std::array<double, kMaxRing> du{}, dw{}, h{};
   for (int i = 0; i < n; ++i) {
     du[i] = r[i][u] - e0[u];
     dw[i] = r[i][w] - e0[w];
+    h[i] = r[i][ax];
   }
   double turn = 0;
   for (int i = 0; i < n; ++i) {
@@ -359,31 +260,34 @@ bool inside_ring(const std::array<Vec3, 4>& r, int n, const Vec3& e0, const Vec3
     if (c == 0 || (turn != 0 && (c > 0) != (turn > 0))) return false;
     turn = c;
   }
-  const double s = turn > 0 ? 1.0 : -1.0;
-  const double margin = 1e-9 * std::abs(e1[ax] - e0[ax]);
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    // Planes of the tetrahedron's faces across from e1 and e0, unit normals pointing inside.
-    Vec3 nb = cross3(sub3(r[i], e0), sub3(r[j], e0)), nt = cross3(sub3(r[i], e1), sub3(r[j], e1));
-    const double sb = dot3(nb, sub3(e1, e0)), st = dot3(nt, sub3(e0, e1));
-    if (sb == 0 || st == 0) return false;
-    const double lb = std::copysign(1.0 / std::sqrt(dot3(nb, nb)), sb);
-    const double lt = std::copysign(1.0 / std::sqrt(dot3(nt, nt)), st);
-    for (int a = 0; a < 3; ++a) {
-      nb[a] *= lb;
-      nt[a] *= lt;
-    }
-    const auto g1 = [&](const Vec3& x) { return s * cross2(du[i], dw[i], x[u] - e0[u], x[w] - e0[w]); };
-    const auto g2 = [&](const Vec3& x) { return s * cross2(x[u] - e0[u], x[w] - e0[w], du[j], dw[j]); };
-    for (int k = 0; k < ntris; ++k) {
-      ClipPoint tri[3], half[4], part[5];
-      for (int m = 0; m < 3; ++m) tri[m] = {r[tris[k][m]], tris[k][m]};
-      const int nh = clip(tri, 3, half, g1);
-      const int np = clip(half, nh, part, g2);
-      for (int m = 0; m < np; ++m) {
-        if (part[m].ring == i || part[m].ring == j) continue;  // the ring's own side
-        const Vec3& x = part[m].x;
-        if (!(dot3(nb, sub3(x, e0)) > margin && dot3(nt, sub3(x, e1)) > margin)) return false;
+  const double h0 = e0[ax], h1 = e1[ax], margin = 1e-9 * std::abs(h1 - h0);
+  // Height z at fraction rho of the way out along ray k: strictly between the lines from e0
+  // and from e1 to r_k.
+  const auto between = [&](double z, double rho, int k) {
+    const double a = h0 + rho * (h[k] - h0), b = h1 + rho * (h[k] - h1);
+    return z > std::min(a, b) + margin && z < std::max(a, b) - margin;
+  };
+  for (int t = 0; t < ntris; ++t) {
+    const auto [a, b, c] = tris[t];
+    // Where the edge's line meets the triangle (inside or on a side).
+    const double la = cross2(du[b], dw[b], du[c], dw[c]), lb = cross2(du[c], dw[c], du[a], dw[a]);
+    const double lc = cross2(du[a], dw[a], du[b], dw[b]), sum = la + lb + lc;
+    if (sum == 0) return false;  // seen along the edge, the triangle is a segment
+    if (la * sum >= 0 && lb * sum >= 0 && lc * sum >= 0 &&
+        !between((la * h[a] + lb * h[b] + lc * h[c]) / sum, 0.0, a))
+      return false;
+    for (const auto& [p, q] : {std::pair(a, b), std::pair(b, c), std::pair(c, a)}) {
+      for (int k = 0; k < n; ++k) {
+        if (k == p || k == q) continue;
+        const double sp = cross2(du[k], dw[k], du[p], dw[p]), sq = cross2(du[k], dw[k], du[q], dw[q]);
+        if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0)) continue;
+        if (sp == sq) return false;  // the side runs along ray k's line
+        const double l = sp / (sp - sq);
+        const double xu = du[p] + l * (du[q] - du[p]), xw = dw[p] + l * (dw[q] - dw[p]);
+        const double along = du[k] * xu + dw[k] * xw;
+        if (along < 0) continue;  // the ray's opposite half
+        const double rho = along / (du[k] * du[k] + dw[k] * dw[k]);
+        if (!(rho < 1) || !between(h[p] + l * (h[q] - h[p]), rho, k)) return false;
       }
     }
   }
@@ -402,17 +306,36 @@ bool faces_forward(const std::array<Vec3, 4>& p, const std::array<std::array<int
 int plain_split_in_region(const std::array<Vec3, 4>& q, int count, const Vec3& e0, const Vec3& e1,
                           std::array<std::array<int, 3>, 2>& split, bool& other) {
   other = false;
-  if (count == 3) return inside_ring(q, 3, e0, e1, split, 1) ? 1 : 0;
-  if (faces_forward(q, split) && inside_ring(q, 4, e0, e1, split, 2)) return 2;
+  if (count == 3) return inside_ring(q.data(), 3, e0, e1, split.data(), 1) ? 1 : 0;
+  if (faces_forward(q, split) && inside_ring(q.data(), 4, e0, e1, split.data(), 2)) return 2;
   const std::array<std::array<int, 3>, 2> alt =
       split[0][2] == 2 ? std::array<std::array<int, 3>, 2>{{{0, 1, 3}, {1, 2, 3}}}
                        : std::array<std::array<int, 3>, 2>{{{0, 1, 2}, {0, 2, 3}}};
-  if (faces_forward(q, alt) && inside_ring(q, 4, e0, e1, alt, 2)) {
+  if (faces_forward(q, alt) && inside_ring(q.data(), 4, e0, e1, alt.data(), 2)) {
     split = alt;
     other = true;
     return 2;
   }
   return 0;
+}
+
+// Whether the fan from ring point `apex` over the ring (a polygon with its face points) lies in
+// the polygon's region. Seen along the edge the ring is star-shaped around it (inside_ring
+// checks that); a fan whose triangles all turn the same way there tiles it, so they cannot
+// cross each other either.
+bool fan_in_region(const std::array<Vec3, kMaxRing>& r, int m, const Vec3& e0, const Vec3& e1, int apex) {
+  const int ax = axis_of(e0, e1), u = (ax + 1) % 3, w = (ax + 2) % 3;
+  std::array<std::array<int, 3>, kMaxRing - 2> tris;
+  double turn = 0;
+  for (int j = 1; j + 1 < m; ++j) {
+    const int b = (apex + j) % m, c = (apex + j + 1) % m;
+    tris[j - 1] = {apex, b, c};
+    const Vec3 &o = r[apex], &x = r[b], &y = r[c];
+    const double t = cross2(x[u] - o[u], x[w] - o[w], y[u] - o[u], y[w] - o[w]);
+    if (t == 0 || (turn != 0 && (t > 0) != (turn > 0))) return false;
+    turn = t;
+  }
+  return inside_ring(r.data(), m, e0, e1, tris.data(), m - 2);
 }
 
 }  // namespace
@@ -501,28 +424,18 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = uint32_t(i);
   }
   const auto near = [&](uint32_t v) { return std::pair(around.data() + first[v], size_t(first[v + 1] - first[v])); };
-  // Numbering, in polygon order: fans' edge points, then face points (one per side off its
-  // face, numbered where a fan first uses it); the triangles each polygon writes.
+  // Face points: one per side off its face, numbered in polygon order where first met.
   TriangulationStats st;
   const auto nv = static_cast<uint32_t>(x.size());
-  std::vector<uint32_t> edge_id(n, kNone), tri_at(n + 1, 0);
-  std::vector<std::array<uint32_t, 4>> face_id;  // per fan with sides off their faces
+  std::vector<std::array<uint32_t, 4>> face_id;  // per polygon with sides off their faces
   std::vector<uint32_t> face_slot(n, kNone);     // index into face_id
-  std::vector<std::pair<uint32_t, int>> face_owner;  // the fan and side that number each face point
+  std::vector<std::pair<uint32_t, int>> face_owner;  // the polygon and side that number each face point
   std::unordered_map<uint64_t, uint32_t> face_of_side;
   for (size_t i = 0; i < n; ++i) {
-    const MeshPolygon& p = polys[i];
-    if (plain[i]) {
-      tri_at[i + 1] = plain[i] & 3;
-      st.other_diagonal += plain[i] >> 2;
-      continue;
-    }
-    edge_id[i] = static_cast<uint32_t>(st.fans++);
-    tri_at[i + 1] = uint32_t(p.count + std::popcount(unsigned(off_face[i])));
     if (!off_face[i]) continue;
     face_slot[i] = static_cast<uint32_t>(face_id.size());
     face_id.push_back({kNone, kNone, kNone, kNone});
-    for (int k = 0; k < p.count; ++k) {
+    for (int k = 0; k < polys[i].count; ++k) {
       if (!(off_face[i] >> k & 1)) continue;
       const auto [a, b] = side(i, k);
       const auto [it, fresh] = face_of_side.try_emplace(uint64_t(a) << 32 | b, uint32_t(face_owner.size()));
@@ -531,9 +444,79 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     }
   }
   st.face_points = face_owner.size();
+  // Each face point: where the plain surface around its side crosses the face (or comes
+  // nearest it), else where the side meets the face's plane, moved into the face.
+  std::vector<Vec3> face_x(face_owner.size());
+  tbb::parallel_for(size_t{0}, face_owner.size(), [&](size_t j) {
+    const auto [i, k] = face_owner[j];
+    const auto [a, b] = side(i, k);
+    const Face face = common_face(cells[a], cells[b]);
+    Vec3 q;
+    crosses_inside(face, x[a], x[b], q);
+    Vec3 f = q;
+    double off = std::numeric_limits<double>::infinity(), dq = off;
+    for (const uint32_t v : {a, b}) {  // polygons around a, then those around b only
+      const auto [list, count] = near(v);
+      plain_surface_in_face(x, polys, splits, list, count, v == b ? a : kNone, face, inset, q, f, off, dq);
+    }
+    if (!(off < std::numeric_limits<double>::infinity())) {
+      f = q;
+      for (int d = 0; d < 3; ++d)
+        if (d != face.axis) f[d] = std::clamp(q[d], face.lo[d] + inset, face.hi[d] - inset);
+    }
+    face_x[j] = f;
+  });
+  // A polygon with face points: its ring (the sides split there) as a fan from one of its
+  // points when that stays in its region (`apex`: the ring index). Vertices are tried first:
+  // a fan from a face point reaches across the polygon, and cut a thin wedge of a CSG result
+  // a third of a cell shorter.
+  constexpr uint8_t kNoApex = 0xff;
+  const auto ring_with_face_points = [&](size_t i, std::array<uint32_t, kMaxRing>& ids) {
+    const MeshPolygon& p = polys[i];
+    int m = 0;
+    for (int k = 0; k < p.count; ++k) {
+      ids[m++] = p.v[k];
+      if (off_face[i] >> k & 1) ids[m++] = nv + face_id[face_slot[i]][k];  // face point j as nv + j, for now
+    }
+    return m;
+  };
+  std::vector<uint8_t> apex(n, kNoApex);
+  if (how == Triangulation::kConstruct) {
+    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+      if (!off_face[i]) return;
+      std::array<uint32_t, kMaxRing> ids;
+      std::array<Vec3, kMaxRing> r;
+      const int m = ring_with_face_points(i, ids);
+      for (int k = 0; k < m; ++k) r[k] = ids[k] < nv ? x[ids[k]] : face_x[ids[k] - nv];
+      for (const bool face : {false, true})
+        for (int k = 0; k < m; ++k)
+          if ((ids[k] >= nv) == face && fan_in_region(r, m, polys[i].e0, polys[i].e1, k)) {
+            apex[i] = uint8_t(k);
+            return;
+          }
+    });
+  }
+  // Numbering, in polygon order: the fans' edge points (after the vertices), then the face
+  // points; the triangles each polygon writes.
+  std::vector<uint32_t> edge_id(n, kNone), tri_at(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const MeshPolygon& p = polys[i];
+    const uint32_t ring = uint32_t(p.count + std::popcount(unsigned(off_face[i])));
+    if (plain[i]) {
+      tri_at[i + 1] = plain[i] & 3;
+      st.other_diagonal += plain[i] >> 2;
+    } else if (apex[i] != kNoApex) {
+      tri_at[i + 1] = ring - 2;
+      ++st.face_fans;
+    } else {
+      edge_id[i] = static_cast<uint32_t>(st.fans++);
+      tri_at[i + 1] = ring;
+    }
+  }
   for (size_t i = 0; i < n; ++i) tri_at[i + 1] += tri_at[i];
   const uint32_t face_base = nv + uint32_t(st.fans);
   x.resize(face_base + face_owner.size());
+  std::copy(face_x.begin(), face_x.end(), x.begin() + face_base);
   // Each fan's edge point: where its edge crosses the plain surface of the polygons around it.
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     if (edge_id[i] == kNone) return;
@@ -562,22 +545,6 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
     x[nv + edge_id[i]] = point_on_edge(p.e0, p.e1, t, inset);
   });
-  // Each face point: where the plain surface around its side crosses the face (or comes
-  // nearest it), else from the numbering fan's plane.
-  tbb::parallel_for(size_t{0}, face_owner.size(), [&](size_t j) {
-    const auto [i, k] = face_owner[j];
-    const auto [a, b] = side(i, k);
-    const Face face = common_face(cells[a], cells[b]);
-    Vec3 q, f;
-    crosses_inside(face, x[a], x[b], q);
-    double off = std::numeric_limits<double>::infinity(), dq = off;
-    for (const uint32_t v : {a, b}) {
-      const auto [list, count] = near(v);
-      plain_surface_in_face(x, polys, splits, list, count, face, inset, q, f, off, dq);
-    }
-    if (!(off < std::numeric_limits<double>::infinity())) f = face_point(face, x[a], x[b], x[nv + edge_id[i]], inset, q);
-    x[face_base + j] = f;
-  });
   // The triangles.
   std::vector<Tri> out(tri_at[n]);
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
@@ -587,17 +554,17 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       for (int k = 0; k < (plain[i] & 3); ++k) *o++ = {p.v[splits[i][k][0]], p.v[splits[i][k][1]], p.v[splits[i][k][2]]};
       return;
     }
-    const uint32_t e = nv + edge_id[i];
-    for (int k = 0; k < p.count; ++k) {
-      const uint32_t a = p.v[k], b = p.v[(k + 1) % p.count];
-      if (!(off_face[i] >> k & 1)) {
-        *o++ = {e, a, b};
-      } else {
-        const uint32_t f = face_base + face_id[face_slot[i]][k];
-        *o++ = {e, a, f};
-        *o++ = {e, f, b};
-      }
+    std::array<uint32_t, kMaxRing> ids;
+    const int m = ring_with_face_points(i, ids);
+    for (int k = 0; k < m; ++k)
+      if (ids[k] >= nv) ids[k] += face_base - nv;
+    if (apex[i] != kNoApex) {
+      const int a = apex[i];
+      for (int j = 1; j + 1 < m; ++j) *o++ = {ids[a], ids[(a + j) % m], ids[(a + j + 1) % m]};
+      return;
     }
+    const uint32_t e = nv + edge_id[i];
+    for (int k = 0; k < m; ++k) *o++ = {e, ids[k], ids[(k + 1) % m]};
   });
   if (stats) *stats = st;
   return out;

@@ -19,6 +19,7 @@ struct VertexCell {
 enum class Triangulation : uint8_t {
   kPlain,      // dual contouring's split (may cross where slivers fold)
   kConstruct,  // the plain split where it provably stays in its polygon's region, else a fan
+               // from one of its points or around a point of its edge
   kFanAll,     // every polygon a fan around a point of its edge
 };
 
@@ -26,6 +27,7 @@ struct TriangulationStats {
   size_t fans = 0;            // polygons fanned around a point on their edge
   size_t other_diagonal = 0;  // quads split along the diagonal split_quad did not prefer
   size_t face_points = 0;     // polygon sides split at a point of their cells' common face
+  size_t face_fans = 0;       // polygons with face points, fanned from a point of their own ring
 };
 
 /// Triangles of the dual polygons (vertex ids into `x`; edge and face points are appended to

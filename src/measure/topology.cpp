@@ -38,6 +38,39 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
     size_t boundary = 0, nonmanifold = 0, inconsistent = 0, pinched = 0;
   };
   tbb::combinable<Counts> counts;
+  // The common case, tested without sorting: every edge at v is used by exactly two of v's
+  // triangles, once each way. Then "next of i is previous of j" is a permutation of the
+  // triangles and its cycles are v's fans. Returns their count, or 0 if the case does not hold.
+  constexpr uint32_t kFastFan = 32;
+  const auto closed_fan_cycles = [&](size_t v, uint32_t n) {
+    std::array<uint32_t, kFastFan> next, prev, succ;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t h = corner[first[v] + i];
+      const auto& t = mesh.triangles[h / 3];
+      next[i] = t[(h % 3 + 1) % 3];
+      prev[i] = t[(h % 3 + 2) % 3];
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+      uint32_t matches = 0, twins = 0;
+      for (uint32_t j = 0; j < n; ++j) {
+        if (prev[j] == next[i]) {
+          succ[i] = j;
+          ++matches;
+        }
+        twins += next[j] == next[i];
+      }
+      if (matches != 1 || twins != 1) return 0;
+    }
+    // next values distinct and each matched once, so succ is a permutation.
+    int cycles = 0;
+    std::array<bool, kFastFan> seen{};
+    for (uint32_t i = 0; i < n; ++i) {
+      if (seen[i]) continue;
+      ++cycles;
+      for (uint32_t j = i; !seen[j]; j = succ[j]) seen[j] = true;
+    }
+    return cycles;
+  };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
     Counts& c = counts.local();
     // A spoke: the edge's other vertex (high 32 bits), the triangle within the fan, and whether
@@ -47,6 +80,13 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
     for (size_t v = range.begin(); v < range.end(); ++v) {
       const uint32_t n = first[v + 1] - first[v];
       if (n == 0) continue;
+      if (n <= kFastFan) {
+        const int cycles = closed_fan_cycles(v, n);
+        if (cycles > 0) {
+          c.pinched += cycles > 1;
+          continue;
+        }
+      }
       spokes.clear();
       for (uint32_t i = 0; i < n; ++i) {
         const uint32_t h = corner[first[v] + i], f = h / 3, k = h % 3;
@@ -54,9 +94,7 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
         spokes.push_back(uint64_t(t[(k + 1) % 3]) << 32 | uint64_t(i) << 1 | 1);
         spokes.push_back(uint64_t(t[(k + 2) % 3]) << 32 | uint64_t(i) << 1);
       }
-      // Fans are small: insertion sort.
-      for (size_t i = 1; i < spokes.size(); ++i)
-        for (size_t j = i; j > 0 && spokes[j - 1] > spokes[j]; --j) std::swap(spokes[j - 1], spokes[j]);
+      std::sort(spokes.begin(), spokes.end());
       parent.resize(n);
       for (uint32_t i = 0; i < n; ++i) parent[i] = i;
       const auto root = [&](uint32_t x) {
