@@ -7,6 +7,9 @@ set -euo pipefail
 
 pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev libpng-dev zlib1g-dev
       libcli11-dev libgtest-dev chromium libcgal-dev)
+# OpenSCAD's 2D nodes: Clipper for polygons and offset, FreeType/HarfBuzz/fontconfig for text
+# (OpenSCAD's default font, Liberation Sans).
+pkgs+=(libpolyclipping-dev libfreetype-dev libharfbuzz-dev libfontconfig-dev fonts-liberation2)
 # `pic eval model.scad` runs OpenSCAD to export its CSG tree (tests skip the .scad case without it).
 pkgs+=(openscad)
 # The `pic` Python module (pybind11) and its pytest suite; numpy arrays in and out.

@@ -15,6 +15,25 @@ struct EvalArgs {
   bool smooth = false, json = false, serial = false, no_split = false;
 };
 
+bool is_outline_path(const std::string& p) {
+  std::string ext = std::filesystem::path(p).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".svg" || ext == ".dxf";
+}
+
+// A 2D model's outline to SVG or DXF, as `openscad -o out.svg` writes it.
+void run_outline(const EvalArgs& a, const EvalOptions& eo) {
+  EvalStats st;
+  const std::optional<Outline> o = eval_outline(a.in, eo, &st);
+  if (!o) throw InvalidInput(a.in + ": a 3D model: write it as .pic or as a mesh (.stl, .obj, ...)");
+  write_outline(*o, a.out);
+  if (a.json) {
+    std::cout << Json().fields(st).add("area", area(*o)).add("rings", o->rings.size()).str() << "\n";
+  } else {
+    std::printf("%zu rings, area %.6g in %.3f s -> %s\n", o->rings.size(), area(*o), st.seconds, a.out.c_str());
+  }
+}
+
 void run(const EvalArgs& a) {
   EvalOptions eo;
   eo.depth = a.depth;
@@ -22,6 +41,7 @@ void run(const EvalArgs& a) {
   eo.smooth = a.smooth;
   eo.parallel = !a.serial;
   eo.progress = [](const std::string& m) { std::cerr << "pic: " << m << "\n"; };
+  if (is_outline_path(a.out)) return run_outline(a, eo);
   EvalStats st;
   const Octree tree = eval_scad(a.in, eo, &st);
   Json j;
@@ -59,7 +79,9 @@ void add_eval(CLI::App& app) {
   auto a = std::make_shared<EvalArgs>();
   auto* c = app.add_subcommand("eval", "Evaluate an OpenSCAD model (.scad via openscad, or its .csg export)");
   c->add_option("input", a->in, "OpenSCAD .scad or .csg file")->required();
-  c->add_option("-o,--output", a->out, "Output .pic, or a mesh (.stl, .obj, .ply, .off, .glb)")->required();
+  c->add_option("-o,--output", a->out,
+                 "Output .pic, or a mesh (.stl, .obj, .ply, .off, .glb); a 2D model's outline: .svg or .dxf")
+      ->required();
   c->add_option("--depth", a->depth, "Maximum octree level")->capture_default_str();
   c->add_option("--error", a->error, "QEF residual threshold (root-cube units squared)")->capture_default_str();
   c->add_flag("--smooth", a->smooth,

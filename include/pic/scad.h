@@ -4,9 +4,12 @@
 // octrees bottom-up.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "pic/octree.h"
 
@@ -39,6 +42,17 @@ struct EvalStats {
   Cube cube;
 };
 
+/// The result of a 2D model: closed outlines that do not cross, outer boundaries
+/// counter-clockwise and holes clockwise.
+struct Outline {
+  std::vector<std::vector<std::array<double, 2>>> rings;
+};
+/// Enclosed area (holes subtracted).
+double area(const Outline& outline);
+/// Writes an outline as SVG or DXF (by the extension), through a temporary file.
+/// \throws InvalidInput for another extension, IoError when it cannot be written.
+void write_outline(const Outline& outline, const std::filesystem::path& path);
+
 /// Evaluates OpenSCAD CSG-tree text (the .csg format). `source` names it in error messages.
 /// \throws InvalidInput for a syntax error or an unsupported node (the message names the node
 ///         and its line), or an empty model; IoError for an unreadable import.
@@ -52,5 +66,9 @@ Octree eval_csg_file(const std::filesystem::path& path, const EvalOptions& optio
 /// \throws InvalidInput when `openscad` is missing or rejects the file; as eval_csg_file.
 Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options = {},
                  EvalStats* stats = nullptr);
+/// A 2D model (.scad or .csg; one whose top level holds 2D objects only): its outline, as
+/// OpenSCAD's `-o out.svg` computes it. nullopt for a 3D model (eval_scad of a 2D model throws).
+std::optional<Outline> eval_outline(const std::filesystem::path& path, const EvalOptions& options = {},
+                                    EvalStats* stats = nullptr);
 
 }  // namespace pic

@@ -161,6 +161,8 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
   detail::scad::Node root;
   root.name = "group";
   root.children = std::move(top);
+  if (detail::scad::dimension(root) == 2)
+    throw InvalidInput(source + ": a 2D model: write its outline with -o out.svg or -o out.dxf");
   auto lower = [&](double cell, size_t* nodes) {
     try {
       return detail::scad::lower(root, options, cell, nodes);
@@ -200,6 +202,32 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
   if (!out || out->vertices.empty()) throw InvalidInput(source + ": the model is empty");
   if (stats) *stats = st;
   return std::move(*out);
+}
+
+std::optional<Outline> eval_csg_outline(const std::string& text, const EvalOptions& options, EvalStats* stats,
+                                        const std::string& source) {
+  const auto t0 = Clock::now();
+  detail::scad::Node root;
+  root.name = "group";
+  try {
+    root.children = parse(text);
+    if (detail::scad::dimension(root) != 2) return std::nullopt;
+    Outline out;
+    EvalStats st;
+    for (auto& ring : detail::scad::lower_2d(root, options, &st.nodes)) out.rings.push_back(std::move(ring));
+    if (out.rings.empty()) throw InvalidInput("the model is empty");
+    st.mesh_seconds = st.seconds = since(t0);
+    if (stats) *stats = st;
+    return out;
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(source + ": " + e.what());
+  }
+}
+
+double area(const Outline& outline) {
+  double a = 0;
+  for (const auto& r : outline.rings) a += detail::scad::signed_area(r);
+  return a;
 }
 
 Octree eval_csg_file(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {

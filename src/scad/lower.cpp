@@ -7,19 +7,13 @@
 
 #include "pic/primitives.h"
 #include "scad/lower.h"
+#include "scad/region.h"
+#include "scad/text.h"
 
 namespace pic::detail::scad {
 namespace {
 
 using Node = detail::scad::Node;  // not pic::Node (an octree cell)
-
-/// ... and over even-odd filled rings (2D, below an extrusion).
-struct Shape {
-  enum class Kind { Empty, Rings, Union, Intersect, Difference };
-  Kind kind = Kind::Empty;
-  std::vector<Ring> rings;
-  std::vector<Shape> children;
-};
 
 // Row-major 3x4 affine map.
 using Affine = std::array<double, 12>;
@@ -65,10 +59,18 @@ void apply(const Affine& m, TriMesh& mesh) {
   if (det3(m) < 0)
     for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
 }
+// A mirroring map reverses the ring, so outer boundaries stay counter-clockwise.
 Ring apply2(const Affine2& m, const Ring& r) {
   Ring out;
   out.reserve(r.size());
   for (const P2& p : r) out.push_back({m[0] * p[0] + m[1] * p[1] + m[2], m[3] * p[0] + m[4] * p[1] + m[5]});
+  if (m[0] * m[4] - m[1] * m[3] < 0) std::reverse(out.begin(), out.end());
+  return out;
+}
+Region apply2(const Affine2& m, const Region& r) {
+  Region out;
+  out.reserve(r.size());
+  for (const Ring& ring : r) out.push_back(apply2(m, ring));
   return out;
 }
 
@@ -109,7 +111,9 @@ void check_finite(const Node& n, std::initializer_list<double> xs) {
     if (!std::isfinite(x)) fail(n, "non-finite parameter");
 }
 
-bool is_2d_node(const std::string& s) { return s == "square" || s == "circle" || s == "polygon"; }
+bool is_2d_node(const std::string& s) {
+  return s == "square" || s == "circle" || s == "polygon" || s == "text" || s == "offset";
+}
 bool is_group(const std::string& s) {
   return s == "group" || s == "union" || s == "color" || s == "render";
 }
@@ -118,6 +122,8 @@ class Lowering {
  public:
   Lowering(const EvalOptions& o, double finest_cell) : opt_(o), cell_(finest_cell) {}
   size_t nodes = 0;
+
+  Region region(const Node& n) { return shape(n, kIdentity2); }
 
   Solid solid(const Node& n, const Affine& m) {
     ++nodes;
@@ -292,19 +298,17 @@ class Lowering {
     return read_mesh(p);
   }
 
-  // ---- 2D ----
-  Shape shape(const Node& n, const Affine2& m) {
+  // ---- 2D: regions through Clipper, as OpenSCAD evaluates them ----
+  Region shape(const Node& n, const Affine2& m) {
     ++nodes;
     const std::string& k = n.name;
-    if (is_group(k)) return combine2(Shape::Kind::Union, children2(n, m));
-    if (k == "difference") return combine2(Shape::Kind::Difference, children2(n, m));
-    if (k == "intersection") return combine2(Shape::Kind::Intersect, children2(n, m));
+    if (is_group(k)) return region_union(children2(n, m));
+    if (k == "difference") return region_difference(children2(n, m));
+    if (k == "intersection") return region_intersection(children2(n, m));
     if (k == "multmatrix") {
       const Affine a = matrix(n);
-      return combine2(Shape::Kind::Union, children2(n, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]})));
+      return region_union(children2(n, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]})));
     }
-    Shape s;
-    s.kind = Shape::Kind::Rings;
     if (k == "square") {
       double sx = 1, sy = 1;
       if (const Value* v = arg(n, "size")) {
@@ -316,130 +320,107 @@ class Lowering {
       if (!(sx > 0 && sy > 0)) return {};
       const bool c = flag(n, "center", false);
       const double x0 = c ? -sx / 2 : 0, y0 = c ? -sy / 2 : 0;
-      s.rings.push_back(apply2(m, {{x0, y0}, {x0 + sx, y0}, {x0 + sx, y0 + sy}, {x0, y0 + sy}}));
-    } else if (k == "circle") {
+      return {apply2(m, Ring{{x0, y0}, {x0 + sx, y0}, {x0 + sx, y0 + sy}, {x0, y0 + sy}})};
+    }
+    if (k == "circle") {
       const double r = radius(n, "r", "d", 1);
       check_finite(n, {r});
       if (!(r > 0)) return {};
-      s.rings.push_back(apply2(m, circle_ring(r, frags(n, r, stretch2(m) * stretch_3d_))));
-    } else if (k == "polygon") {
-      const Value* pv = arg(n, "points");
-      if (!pv || pv->kind == Value::Kind::Undef) return {};  // OpenSCAD: empty, with a warning
-      if (pv->kind != Value::Kind::Vector) fail(n, "points must be a vector");
-      Ring pts;
-      for (const Value& p : pv->items) {
-        const auto xs = numbers(n, p, "points");
-        if (xs.size() < 2) fail(n, "points must be [x, y]");
-        check_finite(n, {xs[0], xs[1]});
-        pts.push_back({xs[0], xs[1]});
-      }
-      const Value* paths = arg(n, "paths");
-      if (!paths || paths->kind != Value::Kind::Vector || paths->items.empty()) {
-        s.rings.push_back(apply2(m, pts));
-      } else {
-        for (const Value& path : paths->items) {
-          Ring r;
-          for (double x : numbers(n, path, "paths")) {
-            if (!(x >= 0 && x < double(pts.size()))) fail(n, "path index out of range");
-            r.push_back(pts[static_cast<size_t>(x)]);
-          }
-          s.rings.push_back(apply2(m, r));
-        }
-      }
-    } else if (k == "hull") {
+      return {apply2(m, circle_ring(r, frags(n, r, stretch2(m) * stretch_3d_)))};
+    }
+    if (k == "polygon") return apply2(m, region_even_odd(polygon_rings(n)));
+    if (k == "hull") {
       std::vector<P2> pts;
-      for (const Shape& c : children2(n, m)) collect_points(n, c, pts);
+      for (const Region& c : children2(n, m))
+        for (const Ring& r : c) pts.insert(pts.end(), r.begin(), r.end());
       Ring h = convex_hull_2d(pts);
       if (h.size() < 3) return {};
-      s.rings.push_back(std::move(h));
-    } else if (k == "import") {
-      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node 'import' of a 2D file (DXF, SVG)");
-    } else if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" ||
-               k == "linear_extrude" || k == "rotate_extrude") {
+      return {std::move(h)};
+    }
+    if (k == "offset") return offset(n, m);
+    if (k == "text") return apply2(m, text(n, stretch2(m) * stretch_3d_));
+    if (k == "import") fail(n, "2D import (DXF, SVG) is not supported yet");
+    if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" || k == "linear_extrude" ||
+        k == "rotate_extrude")
       fail(n, "a 3D object inside a 2D subtree");
-    } else {
-      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
-    }
-    return s;
+    throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
   }
-  static void collect_points(const Node& n, const Shape& s, std::vector<P2>& out) {
-    if (s.kind == Shape::Kind::Rings) {
-      for (const Ring& r : s.rings) out.insert(out.end(), r.begin(), r.end());
-    } else if (s.kind == Shape::Kind::Union) {
-      for (const Shape& c : s.children) collect_points(n, c, out);
-    } else if (s.kind != Shape::Kind::Empty) {
-      fail(n, "2D hull of a difference or intersection is not supported");
-    }
-  }
-  std::vector<Shape> children2(const Node& n, const Affine2& m) {
-    std::vector<Shape> out;
+  std::vector<Region> children2(const Node& n, const Affine2& m) {
+    std::vector<Region> out;
     for (const Node& c : n.children) out.push_back(shape(c, m));
     return out;
   }
-  static Shape combine2(Shape::Kind kind, std::vector<Shape> kids) {
-    Shape s;
-    if (kind == Shape::Kind::Difference) {
-      if (kids.empty() || kids[0].kind == Shape::Kind::Empty) return s;
-    } else if (kind == Shape::Kind::Intersect) {
-      for (const auto& c : kids)
-        if (c.kind == Shape::Kind::Empty) return s;
+  std::vector<Ring> polygon_rings(const Node& n) const {
+    const Value* pv = arg(n, "points");
+    if (!pv || pv->kind == Value::Kind::Undef) return {};  // OpenSCAD: empty, with a warning
+    if (pv->kind != Value::Kind::Vector) fail(n, "points must be a vector");
+    Ring pts;
+    for (const Value& p : pv->items) {
+      const auto xs = numbers(n, p, "points");
+      if (xs.size() < 2) fail(n, "points must be [x, y]");
+      check_finite(n, {xs[0], xs[1]});
+      pts.push_back({xs[0], xs[1]});
     }
-    std::vector<Shape> keep;
-    for (size_t i = 0; i < kids.size(); ++i)
-      if (kids[i].kind != Shape::Kind::Empty) keep.push_back(std::move(kids[i]));
-    if (keep.empty()) return s;
-    if (keep.size() == 1) return std::move(keep[0]);
-    s.kind = kind;
-    s.children = std::move(keep);
-    return s;
-  }
-
-  template <class F>
-  static void for_each_point(const Shape& s, const F& f) {
-    for (const Ring& r : s.rings)
-      for (const P2& p : r) f(p);
-    for (const Shape& c : s.children) for_each_point(c, f);
-  }
-  // x-range of the shape, conservatively: a difference spans its first child, an
-  // intersection the overlap of its children.
-  static void bounds2(const Shape& s, double& lo, double& hi) {
-    double l = 1e300, h = -1e300;
-    range2(s, l, h);
-    if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
-  }
-  static void range2(const Shape& s, double& lo, double& hi) {
-    for (const Ring& r : s.rings)
-      for (const P2& p : r) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
-    if (s.kind == Shape::Kind::Union) {
-      for (const Shape& c : s.children) range2(c, lo, hi);
-    } else if (s.kind == Shape::Kind::Difference && !s.children.empty()) {
-      range2(s.children[0], lo, hi);
-    } else if (s.kind == Shape::Kind::Intersect) {
-      double l = -1e300, h = 1e300;
-      for (const Shape& c : s.children) {
-        double cl = 1e300, ch = -1e300;
-        range2(c, cl, ch);
-        l = std::max(l, cl), h = std::min(h, ch);
-      }
-      if (l <= h) lo = std::min(lo, l), hi = std::max(hi, h);
-    }
-  }
-
-  // Even-odd rings -> Booleans of simple rings: each ring at even nesting depth minus the
-  // rings directly inside it (exact for rings that do not cross each other).
-  template <class Extrude>
-  Solid extrude(const Shape& s, const Extrude& ext) {
-    if (s.kind == Shape::Kind::Empty) return {};
-    if (s.kind != Shape::Kind::Rings) {
-      std::vector<Solid> kids;
-      for (const Shape& c : s.children) kids.push_back(extrude(c, ext));
-      return combine(s.kind == Shape::Kind::Union       ? Solid::Kind::Union
-                     : s.kind == Shape::Kind::Intersect ? Solid::Kind::Intersect
-                                                        : Solid::Kind::Difference,
-                     std::move(kids));
-    }
+    const Value* paths = arg(n, "paths");
+    if (!paths || paths->kind != Value::Kind::Vector || paths->items.empty()) return {pts};
     std::vector<Ring> rings;
-    for (const Ring& r : s.rings)
+    for (const Value& path : paths->items) {
+      Ring r;
+      for (double x : numbers(n, path, "paths")) {
+        if (!(x >= 0 && x < double(pts.size()))) fail(n, "path index out of range");
+        r.push_back(pts[static_cast<size_t>(x)]);
+      }
+      rings.push_back(std::move(r));
+    }
+    return rings;
+  }
+  // offset(r = ...) rounds, offset(delta = ...) mitres or, with chamfer, cuts the corners;
+  // applied in the children's frame (a uniform scale commutes with it, as OpenSCAD assumes).
+  Region offset(const Node& n, const Affine2& m) {
+    const Region in = region_union(children2(n, kIdentity2));
+    const Value* rv = arg(n, "r");
+    const bool by_r = rv && rv->kind == Value::Kind::Number;
+    const double amount = by_r ? rv->number : number(n, "delta", 1);
+    check_finite(n, {amount});
+    OffsetJoin join = flag(n, "chamfer", false) ? OffsetJoin::kChamfer : OffsetJoin::kMiter;
+    double tolerance = 0;
+    if (by_r) {
+      join = OffsetJoin::kRound;
+      // OpenSCAD: arcs of fragments_from_r(|r|) pieces per turn.
+      const int f = frags(n, std::abs(amount), stretch2(m) * stretch_3d_);
+      tolerance = std::abs(amount) * (1 - std::cos(std::numbers::pi / f));
+    }
+    return apply2(m, region_offset(in, amount, join, tolerance));
+  }
+  Region text(const Node& n, double st) const {
+    TextParams p;
+    const auto str = [&](const char* key, const std::string& fallback) {
+      const Value* v = arg(n, key);
+      return v && v->kind == Value::Kind::String && !v->text.empty() ? v->text : fallback;
+    };
+    p.text = str("text", "");
+    if (p.text.empty()) p.text = str("t", "");
+    p.size = number(n, "size", 10);
+    p.spacing = number(n, "spacing", 1);
+    check_finite(n, {p.size, p.spacing});
+    p.font = str("font", "");
+    p.halign = str("halign", "left");
+    p.valign = str("valign", "baseline");
+    p.direction = str("direction", "");
+    p.language = str("language", "en");
+    p.script = str("script", "");
+    // Straight pieces per curve of the outline: floor(fragments / 8) + 1 for the circle
+    // fragments of the text's size (counted on OpenSCAD 2021's exports for $fn 8 to 40).
+    p.segments = frags(n, p.size, st) / 8 + 1;
+    return text_region(p);
+  }
+
+  // A region's rings (which do not cross) -> Booleans of extruded simple rings: each ring at
+  // even nesting depth minus the rings directly inside it.
+  template <class Extrude>
+  Solid extrude(const Region& region, const Extrude& ext) {
+    std::vector<Ring> rings;
+    for (const Ring& r : region)
       if (r.size() >= 3 && signed_area(r) != 0) rings.push_back(r);
     const size_t n = rings.size();
     auto inside = [](const P2& p, const Ring& r) {
@@ -470,20 +451,19 @@ class Lowering {
     return combine(Solid::Kind::Union, std::move(outers));
   }
 
-  Shape shape_children(const Node& n, double st) {
+  Region shape_children(const Node& n, double st) {
     if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
       throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + n.name +
                          "' of a DXF file");
     stretch_3d_ = st;
-    std::vector<Shape> kids;
-    for (const Node& c : n.children) kids.push_back(shape(c, kIdentity2));
+    Region r = region_union(children2(n, kIdentity2));
     stretch_3d_ = 1;
-    return combine2(Shape::Kind::Union, std::move(kids));
+    return r;
   }
   double stretch_3d_ = 1;
 
   Solid linear_extrude(const Node& n, const Affine& m) {
-    const Shape s = shape_children(n, stretch(m));
+    const Region s = shape_children(n, stretch(m));
     LinearExtrude e;
     e.height = number(n, "height", 100);
     e.center = flag(n, "center", false);
@@ -504,11 +484,12 @@ class Lowering {
     if (slices <= 0) {
       const double fn = number(n, "$fn", 0), fs = number(n, "$fs", 2), fa = number(n, "$fa", 12);
       double r2 = 0, d2 = 0;
-      for_each_point(s, [&](const P2& p) {
-        r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
-        const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
-        d2 = std::max(d2, dx * dx + dy * dy);
-      });
+      for (const Ring& ring : s)
+        for (const P2& p : ring) {
+          r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
+          const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
+          d2 = std::max(d2, dx * dx + dy * dy);
+        }
       const double tw = std::abs(e.twist);
       slices = 1;
       if (tw > 0) {
@@ -540,8 +521,7 @@ class Lowering {
     }
     if (opt_.smooth && e.twist != 0) {
       // The walls follow helices: keep the chord of the largest radius below the tolerance.
-      double lo = 0, hi = 0;
-      bounds2(s, lo, hi);
+      const auto [lo, hi] = x_range(s);
       const double r = std::max(std::abs(lo), std::abs(hi)) * stretch(m);
       const int per_turn = frags(n, r, 1);
       slices = std::max(slices, static_cast<int>(std::ceil(per_turn * std::abs(e.twist) / 360)));
@@ -554,12 +534,11 @@ class Lowering {
   }
 
   Solid rotate_extrude(const Node& n, const Affine& m) {
-    const Shape s = shape_children(n, stretch(m));
+    const Region s = shape_children(n, stretch(m));
     double angle = number(n, "angle", 360);
     check_finite(n, {angle});
-    if (angle == 0 || s.kind == Shape::Kind::Empty) return {};
-    double lo = 0, hi = 0;
-    bounds2(s, lo, hi);
+    if (angle == 0 || s.empty()) return {};
+    const auto [lo, hi] = x_range(s);
     if (lo < 0 && hi > 0) fail(n, "all points must have the same x coordinate sign");
     // OpenSCAD 2021: fragments(max |x|) |angle| / 360, at least 1.
     int f = static_cast<int>(std::fmax(
@@ -579,6 +558,13 @@ class Lowering {
     return out;
   }
 
+  static std::pair<double, double> x_range(const Region& r) {
+    double lo = 0, hi = 0;  // OpenSCAD's bounds include the origin
+    for (const Ring& ring : r)
+      for (const P2& p : ring) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+    return {lo, hi};
+  }
+
   static void transform(Solid& s, const Affine& m) {
     if (s.kind == Solid::Kind::Mesh) apply(m, s.mesh);
     for (Solid& c : s.children) transform(c, m);
@@ -593,6 +579,33 @@ Solid lower(const Node& root, const EvalOptions& options, double finest_cell, si
   Solid s = l.solid(root, kIdentity);
   if (nodes) *nodes = l.nodes - 1;
   return s;
+}
+
+int dimension(const Node& n) {
+  const std::string& k = n.name;
+  if (is_2d_node(k) || k == "projection") return 2;
+  if (k == "import") {
+    const Value* f = arg(n, "file");
+    std::string ext = f && f->kind == Value::Kind::String ? std::filesystem::path(f->text).extension().string() : "";
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".dxf" || ext == ".svg" ? 2 : 3;
+  }
+  if (n.children.empty())
+    return k == "group" || k == "union" || k == "difference" || k == "intersection" || k == "multmatrix" ||
+                   k == "color" || k == "render" || k == "hull" || k == "minkowski" || k == "resize"
+               ? 0
+               : 3;
+  if (k == "linear_extrude" || k == "rotate_extrude") return 3;
+  for (const Node& c : n.children)
+    if (const int d = dimension(c)) return d;
+  return 0;
+}
+
+std::vector<Ring> lower_2d(const Node& root, const EvalOptions& options, size_t* nodes) {
+  Lowering l(options, 0);
+  Region r = l.region(root);
+  if (nodes) *nodes = l.nodes - 1;
+  return r;
 }
 
 }  // namespace pic::detail::scad

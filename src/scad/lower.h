@@ -4,6 +4,8 @@
 // with them). evaluate.cpp then samples the leaves and runs the Booleans on octrees.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "pic/scad.h"
@@ -24,4 +26,15 @@ struct Solid {
 /// \throws InvalidInput for an unsupported node or bad arguments (naming the node's line).
 Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes);
 
+/// 2 when the tree's objects are 2D (a 2D model), 3 when 3D, 0 when it has none.
+int dimension(const Node& n);
+/// Lowers a 2D model to its region. \throws as lower().
+std::vector<Ring> lower_2d(const Node& root, const EvalOptions& options, size_t* nodes);
+
 }  // namespace pic::detail::scad
+
+namespace pic {
+/// eval_outline() on .csg text: nullopt when the model is not 2D (evaluate.cpp).
+std::optional<Outline> eval_csg_outline(const std::string& text, const EvalOptions& options, EvalStats* stats,
+                                        const std::string& source);
+}  // namespace pic

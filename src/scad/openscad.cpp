@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pic/scad.h"
+#include "scad/lower.h"
 
 #include <chrono>
 
@@ -30,11 +31,22 @@ std::string shell_quote(const std::string& s) {
 }
 }  // namespace
 
-Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
+namespace {
+// The model's CSG tree as text: a .csg file as it is, a .scad file through `openscad -o
+// x.csg` (a temporary file). Sets the directory imports are relative to, and OpenSCAD's time.
+std::string csg_text(const std::filesystem::path& path, EvalOptions& o, double& openscad_seconds) {
   std::string ext = path.extension().string();
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".csg") return eval_csg_file(path, options, stats);
-  if (ext != ".scad") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
+  if (ext != ".scad" && ext != ".csg") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
+  if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
+  openscad_seconds = 0;
+  if (ext == ".csg") {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError("cannot read " + path.string());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
   if (!std::filesystem::exists(path)) throw IoError("cannot read " + path.string());
   if (!on_path("openscad"))
     throw InvalidInput("the 'openscad' program is needed for .scad input: install it (Debian: apt-get install "
@@ -50,7 +62,7 @@ Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, 
                           shell_quote(std::filesystem::absolute(path).string()) + " >" +
                           shell_quote(log.string()) + " 2>&1";
   const int rc = std::system(cmd.c_str());
-  const double openscad_seconds = since(t0);
+  openscad_seconds = since(t0);
   if (rc != 0 || !std::filesystem::exists(csg)) {
     std::string msg;
     std::ifstream l(log);
@@ -62,24 +74,36 @@ Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, 
     std::filesystem::remove_all(tmp_dir);
     throw InvalidInput("openscad could not export " + path.string() + (msg.empty() ? "" : ": " + msg));
   }
+  std::ifstream in(csg, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::filesystem::remove_all(tmp_dir);
+  return ss.str();
+}
+}  // namespace
+
+Octree eval_scad(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
   EvalOptions o = options;
-  if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
-  try {
-    std::ifstream in(csg, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    std::filesystem::remove_all(tmp_dir);
-    Octree t = eval_csg(ss.str(), o, stats, path.string());
-    if (stats) {
-      stats->openscad_seconds = openscad_seconds;
-      stats->seconds += openscad_seconds;
-    }
-    return t;
-  } catch (...) {
-    std::filesystem::remove_all(tmp_dir);
-    throw;
+  double openscad_seconds = 0;
+  const std::string text = csg_text(path, o, openscad_seconds);
+  Octree t = eval_csg(text, o, stats, path.string());
+  if (stats) {
+    stats->openscad_seconds = openscad_seconds;
+    stats->seconds += openscad_seconds;
   }
+  return t;
+}
+
+std::optional<Outline> eval_outline(const std::filesystem::path& path, const EvalOptions& options, EvalStats* stats) {
+  EvalOptions o = options;
+  double openscad_seconds = 0;
+  const std::string text = csg_text(path, o, openscad_seconds);
+  std::optional<Outline> out = eval_csg_outline(text, o, stats, path.string());
+  if (out && stats) {
+    stats->openscad_seconds = openscad_seconds;
+    stats->seconds += openscad_seconds;
+  }
+  return out;
 }
 
 }  // namespace pic
-

@@ -85,8 +85,11 @@ class Parser {
   Node statement() {
     Node n;
     n.line = line_;
-    // OpenSCAD modifiers (!, #, %, *) may survive in hand-written files; they change display only.
+    // OpenSCAD's modifiers: `%` (background) and `*` (disabled) leave the object out of the
+    // rendered model (its .csg export keeps them); `#` (highlight) and `!` change display only.
+    bool left_out = false;
     while (!at_end() && (s_[i_] == '!' || s_[i_] == '#' || s_[i_] == '%' || s_[i_] == '*')) {
+      left_out = left_out || s_[i_] == '%' || s_[i_] == '*';
       ++i_;
       skip();
     }
@@ -132,6 +135,11 @@ class Parser {
       n.children = statements(true);
     } else {
       fail("expected ';' or '{' after " + n.name + "(...)" + near());
+    }
+    if (left_out) {
+      n.name = "group";
+      n.args.clear();
+      n.children.clear();
     }
     return n;
   }

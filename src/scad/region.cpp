@@ -1,0 +1,102 @@
+// 2D regions through Clipper: see region.h. Each operation converts its operands to Clipper's
+// integers with a power-of-two scale fitted to them (about 30 bits across the operands' extent,
+// Clipper's fast 64-bit range), runs, and converts back.
+#include "scad/region.h"
+
+#include <polyclipping/clipper.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pic::detail::scad {
+namespace {
+
+namespace cl = ClipperLib;
+
+double fitted_scale(std::initializer_list<const Region*> regions) {
+  double extent = 0;
+  for (const Region* r : regions)
+    for (const Ring& ring : *r)
+      for (const P2& p : ring) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  if (!(extent > 0)) return 1;
+  return std::exp2(std::floor(std::log2(double(0x3FFFFFFF) / extent)));
+}
+
+cl::Paths to_paths(const Region& r, double scale) {
+  cl::Paths out;
+  out.reserve(r.size());
+  for (const Ring& ring : r) {
+    cl::Path path;
+    path.reserve(ring.size());
+    for (const P2& p : ring) path.push_back({cl::cInt(std::llround(p[0] * scale)), cl::cInt(std::llround(p[1] * scale))});
+    out.push_back(std::move(path));
+  }
+  return out;
+}
+
+Region from_paths(const cl::Paths& paths, double scale) {
+  Region out;
+  out.reserve(paths.size());
+  for (const cl::Path& path : paths) {
+    if (path.size() < 3) continue;
+    Ring ring;
+    ring.reserve(path.size());
+    for (const cl::IntPoint& p : path) ring.push_back({double(p.X) / scale, double(p.Y) / scale});
+    out.push_back(std::move(ring));
+  }
+  return out;
+}
+
+// Runs one Clipper operation: subject paths (filled by `subject_fill`) against clip paths.
+Region clip(const Region& subject, const Region& clip_region, cl::ClipType type, cl::PolyFillType subject_fill) {
+  const double scale = fitted_scale({&subject, &clip_region});
+  cl::Clipper c;
+  c.AddPaths(to_paths(subject, scale), cl::ptSubject, true);
+  c.AddPaths(to_paths(clip_region, scale), cl::ptClip, true);
+  cl::Paths out;
+  c.Execute(type, out, subject_fill, cl::pftNonZero);
+  return from_paths(out, scale);
+}
+
+}  // namespace
+
+Region region_even_odd(const std::vector<Ring>& rings) { return clip(rings, {}, cl::ctUnion, cl::pftEvenOdd); }
+
+Region region_union(const std::vector<Region>& parts) {
+  Region all;
+  for (const Region& p : parts) all.insert(all.end(), p.begin(), p.end());
+  return clip(all, {}, cl::ctUnion, cl::pftNonZero);
+}
+
+Region region_intersection(const std::vector<Region>& parts) {
+  if (parts.empty()) return {};
+  Region acc = parts[0];
+  for (size_t i = 1; i < parts.size() && !acc.empty(); ++i) acc = clip(acc, parts[i], cl::ctIntersection, cl::pftNonZero);
+  return acc;
+}
+
+Region region_difference(const std::vector<Region>& parts) {
+  if (parts.empty()) return {};
+  Region rest;
+  for (size_t i = 1; i < parts.size(); ++i) rest.insert(rest.end(), parts[i].begin(), parts[i].end());
+  return clip(parts[0], rest, cl::ctDifference, cl::pftNonZero);
+}
+
+Region region_offset(const Region& region, double amount, OffsetJoin join, double arc_tolerance) {
+  const double scale = fitted_scale({&region}) / 2;  // room for the region to grow
+  // OpenSCAD's miter limit for delta is effectively unbounded (sharp corners stay sharp).
+  cl::ClipperOffset co(join == OffsetJoin::kMiter ? 1e6 : 2.0, std::max(arc_tolerance, 1e-9) * scale);
+  const cl::JoinType jt = join == OffsetJoin::kRound ? cl::jtRound : join == OffsetJoin::kMiter ? cl::jtMiter : cl::jtSquare;
+  co.AddPaths(to_paths(region, scale), jt, cl::etClosedPolygon);
+  cl::Paths out;
+  co.Execute(out, amount * scale);
+  return from_paths(out, scale);
+}
+
+double region_area(const Region& region) {
+  double a = 0;
+  for (const Ring& r : region) a += signed_area(r);
+  return a;
+}
+
+}  // namespace pic::detail::scad

@@ -1,0 +1,179 @@
+// text(): see text.h.
+#include "scad/text.h"
+
+#include <fontconfig/fontconfig.h>
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include FT_OUTLINE_H
+#include <hb.h>
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+
+
+namespace pic::detail::scad {
+namespace {
+
+// OpenSCAD 2021's scale, measured on its exports (Liberation Sans, size 10): the em square is
+// size * 100 / 72 model units (a font size in points at 100 dpi), and the pen advances by
+// 1000 / 1024 of the glyphs' advance widths at that scale.
+constexpr double kEmPerSize = 100.0 / 72.0;
+constexpr double kAdvanceScale = 1000.0 / 1024.0;
+
+std::string font_file(const std::string& pattern) {
+  static std::mutex lock;  // fontconfig's configuration is not thread-safe
+  const std::lock_guard<std::mutex> guard(lock);
+  if (!FcInit()) throw InvalidInput("text: fontconfig could not start");
+  FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(pattern.empty() ? "Liberation Sans" : pattern.c_str()));
+  if (!pat) throw InvalidInput("text: bad font name '" + pattern + "'");
+  FcConfigSubstitute(nullptr, pat, FcMatchPattern);
+  FcDefaultSubstitute(pat);
+  FcResult result;
+  FcPattern* match = FcFontMatch(nullptr, pat, &result);
+  FcPatternDestroy(pat);
+  std::string file;
+  FcChar8* path = nullptr;
+  if (match && FcPatternGetString(match, FC_FILE, 0, &path) == FcResultMatch) file = reinterpret_cast<const char*>(path);
+  if (match) FcPatternDestroy(match);
+  if (file.empty()) throw InvalidInput("text: no font matches '" + pattern + "' (install fonts-liberation2)");
+  return file;
+}
+
+// Collects a glyph's outline as rings, each curve cut into `segments` straight pieces.
+struct OutlineSink {
+  std::vector<Ring> rings;
+  double unit = 1;  // model units per 26.6 outline unit
+  double dx = 0, dy = 0;
+  int segments = 1;
+  P2 last{0, 0};
+
+  P2 at(const FT_Vector* v) const { return {dx + v->x * unit, dy + v->y * unit}; }
+  void add(const P2& p) {
+    rings.back().push_back(p);
+    last = p;
+  }
+  static int move_to(const FT_Vector* to, void* self) {
+    auto* s = static_cast<OutlineSink*>(self);
+    s->rings.emplace_back();
+    s->add(s->at(to));
+    return 0;
+  }
+  static int line_to(const FT_Vector* to, void* self) {
+    auto* s = static_cast<OutlineSink*>(self);
+    s->add(s->at(to));
+    return 0;
+  }
+  static int conic_to(const FT_Vector* control, const FT_Vector* to, void* self) {
+    auto* s = static_cast<OutlineSink*>(self);
+    const P2 p0 = s->last, p1 = s->at(control), p2 = s->at(to);
+    for (int i = 1; i <= s->segments; ++i) {
+      const double t = double(i) / s->segments, u = 1 - t;
+      s->add({u * u * p0[0] + 2 * u * t * p1[0] + t * t * p2[0], u * u * p0[1] + 2 * u * t * p1[1] + t * t * p2[1]});
+    }
+    return 0;
+  }
+  static int cubic_to(const FT_Vector* c1, const FT_Vector* c2, const FT_Vector* to, void* self) {
+    auto* s = static_cast<OutlineSink*>(self);
+    const P2 p0 = s->last, p1 = s->at(c1), p2 = s->at(c2), p3 = s->at(to);
+    for (int i = 1; i <= s->segments; ++i) {
+      const double t = double(i) / s->segments, u = 1 - t;
+      const double a = u * u * u, b = 3 * u * u * t, c = 3 * u * t * t, d = t * t * t;
+      s->add({a * p0[0] + b * p1[0] + c * p2[0] + d * p3[0], a * p0[1] + b * p1[1] + c * p2[1] + d * p3[1]});
+    }
+    return 0;
+  }
+};
+
+hb_direction_t direction_of(const std::string& d) {
+  if (d == "ltr") return HB_DIRECTION_LTR;
+  if (d == "rtl") return HB_DIRECTION_RTL;
+  if (d == "ttb") return HB_DIRECTION_TTB;
+  if (d == "btt") return HB_DIRECTION_BTT;
+  return HB_DIRECTION_INVALID;
+}
+
+}  // namespace
+
+Region text_region(const TextParams& p) {
+  if (p.text.empty() || !(p.size > 0)) return {};
+  const std::string file = font_file(p.font);
+  FT_Library lib = nullptr;
+  if (FT_Init_FreeType(&lib)) throw InvalidInput("text: FreeType could not start");
+  const std::unique_ptr<FT_LibraryRec_, decltype(&FT_Done_FreeType)> lib_guard(lib, FT_Done_FreeType);
+  FT_Face face = nullptr;
+  if (FT_New_Face(lib, file.c_str(), 0, &face)) throw InvalidInput("text: cannot read font file " + file);
+  const std::unique_ptr<FT_FaceRec_, decltype(&FT_Done_Face)> face_guard(face, FT_Done_Face);
+  // Outlines in font units: no hinting, the em square at its design size.
+  const double unit = p.size * kEmPerSize / face->units_per_EM;
+  // HarfBuzz shapes with its own OpenType tables, in font units (its default scale).
+  hb_blob_t* blob = hb_blob_create_from_file(file.c_str());
+  hb_face_t* hb_face = hb_face_create(blob, 0);
+  hb_font_t* font = hb_font_create(hb_face);
+  hb_buffer_t* buf = hb_buffer_create();
+  hb_buffer_add_utf8(buf, p.text.c_str(), int(p.text.size()), 0, int(p.text.size()));
+  if (const hb_direction_t d = direction_of(p.direction); d != HB_DIRECTION_INVALID) hb_buffer_set_direction(buf, d);
+  if (!p.script.empty()) hb_buffer_set_script(buf, hb_script_from_string(p.script.c_str(), int(p.script.size())));
+  if (!p.language.empty()) hb_buffer_set_language(buf, hb_language_from_string(p.language.c_str(), int(p.language.size())));
+  hb_buffer_guess_segment_properties(buf);
+  hb_shape(font, buf, nullptr, 0);
+  unsigned count = 0;
+  const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buf, &count);
+  const hb_glyph_position_t* pos = hb_buffer_get_glyph_positions(buf, &count);
+  const bool vertical = HB_DIRECTION_IS_VERTICAL(hb_buffer_get_direction(buf));
+  OutlineSink sink;
+  sink.unit = unit;
+  sink.segments = std::max(1, p.segments);
+  FT_Outline_Funcs funcs{};
+  funcs.move_to = &OutlineSink::move_to;
+  funcs.line_to = &OutlineSink::line_to;
+  funcs.conic_to = &OutlineSink::conic_to;
+  funcs.cubic_to = &OutlineSink::cubic_to;
+  double pen_x = 0, pen_y = 0;
+  for (unsigned i = 0; i < count; ++i) {
+    if (FT_Load_Glyph(face, info[i].codepoint, FT_LOAD_NO_SCALE | FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP) == 0 &&
+        face->glyph->format == FT_GLYPH_FORMAT_OUTLINE) {
+      sink.dx = (pen_x + pos[i].x_offset * kAdvanceScale) * unit;
+      sink.dy = (pen_y + pos[i].y_offset * kAdvanceScale) * unit;
+      FT_Outline_Decompose(&face->glyph->outline, &funcs, &sink);
+    }
+    pen_x += pos[i].x_advance * kAdvanceScale * p.spacing;
+    pen_y += pos[i].y_advance * kAdvanceScale * p.spacing;
+  }
+  hb_buffer_destroy(buf);
+  hb_font_destroy(font);
+  hb_face_destroy(hb_face);
+  hb_blob_destroy(blob);
+  // FreeType's outer contours run clockwise (TrueType): reverse all, fill by non-zero winding.
+  for (Ring& r : sink.rings) std::reverse(r.begin(), r.end());
+  Region region = region_union({sink.rings});
+  // Alignment: along the line by the advance, across it by the outlines' extent, which
+  // OpenSCAD measures at the advances' scale too.
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const Ring& r : region)
+    for (const P2& q : r)
+      for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
+  if (region.empty()) return region;
+  for (int a = 0; a < 2; ++a) lo[a] *= kAdvanceScale, hi[a] *= kAdvanceScale;
+  double sx = 0, sy = 0;
+  if (!vertical) {
+    const double width = pen_x * unit;
+    if (p.halign == "center") sx = -width / 2;
+    else if (p.halign == "right") sx = -width;
+    if (p.valign == "top") sy = -hi[1];
+    else if (p.valign == "center") sy = -(lo[1] + hi[1]) / 2;
+    else if (p.valign == "bottom") sy = -lo[1];
+  } else {
+    if (p.halign == "center") sx = -(lo[0] + hi[0]) / 2;
+    else if (p.halign == "right") sx = -hi[0];
+    else if (p.halign == "left") sx = -lo[0];
+    const double height = pen_y * unit;
+    if (p.valign == "center") sy = -height / 2;
+    else if (p.valign == "bottom") sy = -height;
+  }
+  for (Ring& r : region)
+    for (P2& q : r) q[0] += sx, q[1] += sy;
+  return region;
+}
+
+}  // namespace pic::detail::scad

@@ -1,0 +1,177 @@
+// OpenSCAD's 2D side: regions through Clipper (Booleans, polygon paths, offset), text through
+// FreeType/HarfBuzz, 2D models written as outlines, and the `%`/`*` modifiers. Expected areas
+// are analytic, or OpenSCAD 2021.01's own exports of the same model (DXF, area by the shoelace
+// formula), stored here so the tests do not need `openscad`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "pic/pic.h"
+#include "pic/scad.h"
+#include "scad/region.h"
+#include "scad/text.h"
+#include "support/temp_dir.h"
+
+namespace pic {
+namespace {
+
+using detail::scad::Region;
+using detail::scad::Ring;
+
+// A .csg model evaluated as a 2D outline.
+Outline outline_of(const std::string& csg) {
+  test::TempDir dir("outline");
+  const auto path = dir / "model.csg";
+  std::ofstream(path) << csg;
+  const std::optional<Outline> o = eval_outline(path);
+  if (!o) throw std::runtime_error("not a 2D model");
+  return *o;
+}
+
+double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
+
+Ring square(double x0, double y0, double s) { return {{x0, y0}, {x0 + s, y0}, {x0 + s, y0 + s}, {x0, y0 + s}}; }
+
+TEST(Region, BooleansOfSquares) {
+  const Region a{square(0, 0, 10)}, b{square(5, 5, 10)};
+  EXPECT_NEAR(detail::scad::region_area(detail::scad::region_union({a, b})), 175, 1e-6);
+  EXPECT_NEAR(detail::scad::region_area(detail::scad::region_intersection({a, b})), 25, 1e-6);
+  EXPECT_NEAR(detail::scad::region_area(detail::scad::region_difference({a, b})), 75, 1e-6);
+  // A hole: the difference of a square and one inside it is two rings, the hole clockwise.
+  const Region framed = detail::scad::region_difference({a, {square(2, 2, 6)}});
+  ASSERT_EQ(framed.size(), 2u);
+  EXPECT_NEAR(detail::scad::region_area(framed), 64, 1e-6);
+}
+
+TEST(Region, OffsetByDeltaAndChamfer) {
+  using detail::scad::OffsetJoin;
+  const Region a{square(0, 0, 10)};
+  // Mitred corners stay square: (10 + 2)^2.
+  EXPECT_NEAR(detail::scad::region_area(detail::scad::region_offset(a, 1, OffsetJoin::kMiter, 0)), 144, 1e-6);
+  EXPECT_NEAR(detail::scad::region_area(detail::scad::region_offset(a, -1, OffsetJoin::kMiter, 0)), 64, 1e-6);
+  // Rounded corners: 10^2 + 4 * 10 * 2 + (a polygon just inside) pi 2^2.
+  const double round = detail::scad::region_area(detail::scad::region_offset(a, 2, OffsetJoin::kRound, 1e-3));
+  EXPECT_LT(round, 180 + 4 * std::numbers::pi);
+  EXPECT_GT(round, 180 + 4 * std::numbers::pi - 0.05);
+}
+
+// Each against OpenSCAD 2021.01's export of the same node.
+TEST(ScadOutline, OffsetMatchesOpenScad) {
+  const auto area_of = [](const std::string& node) { return area(outline_of(node)); };
+  EXPECT_LT(relative(area_of("offset(r = 2, $fn = 40) { square(size = [10, 10]); }"), 192.514714), 1e-4);
+  EXPECT_LT(relative(area_of("offset(delta = 1, $fn = 0, $fa = 12, $fs = 2) { circle(r = 5, $fn = 0, $fa = 12, $fs = 2); }"),
+                     110.933201),
+            1e-4);
+  EXPECT_LT(relative(area_of("offset(delta = 1, chamfer = true) { square(size = [5, 5]); }"), 48.313718), 1e-4);
+  EXPECT_NEAR(area_of("offset(r = -1, $fn = 24) { square(size = [10, 10]); }"), 64, 1e-6);
+}
+
+TEST(ScadOutline, PolygonPathsAreEvenOdd) {
+  const Outline o = outline_of(
+      "polygon(points = [[0, 0], [10, 0], [10, 10], [0, 10], [2, 2], [8, 2], [8, 8], [2, 8]], "
+      "paths = [[0, 1, 2, 3], [4, 5, 6, 7]]);");
+  EXPECT_EQ(o.rings.size(), 2u);
+  EXPECT_NEAR(area(o), 64, 1e-6);
+}
+
+TEST(ScadOutline, TwoDimensionalHullOfADifference) {
+  // The hull of a frame is the full square (the old hand-written 2D code refused this).
+  const Outline o = outline_of(
+      "hull() { difference() { square(size = [10, 10]); "
+      "multmatrix([[1, 0, 0, 2], [0, 1, 0, 2], [0, 0, 1, 0], [0, 0, 0, 1]]) { square(size = [6, 6]); } } }");
+  EXPECT_EQ(o.rings.size(), 1u);
+  EXPECT_NEAR(area(o), 100, 1e-6);
+}
+
+// Liberation Sans, OpenSCAD's default font (fonts-liberation2).
+TEST(ScadText, MatchesOpenScadsOutlines) {
+  const std::string csg = "text(text = \"PIC 0.1\", size = 10, spacing = 1, font = \"\", direction = \"ltr\", "
+                          "language = \"en\", script = \"Latn\", halign = \"left\", valign = \"baseline\", "
+                          "$fn = 0, $fa = 12, $fs = 2);";
+  const Outline o = outline_of(csg);
+  EXPECT_LT(relative(area(o), 114.327960), 0.005);
+  // Its extent along x, as OpenSCAD lays the glyphs out: P's left side to 1's right side.
+  double lo = 1e300, hi = -1e300;
+  for (const auto& r : o.rings)
+    for (const auto& p : r) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+  EXPECT_NEAR(lo, 1.1393, 1e-3);
+  EXPECT_NEAR(hi, 44.7357, 1e-3);
+}
+
+TEST(ScadText, LettersHaveTheirHolesAndParts) {
+  detail::scad::TextParams p;
+  p.size = 10;
+  p.segments = 4;
+  p.text = "A";
+  const Region a = detail::scad::text_region(p);
+  ASSERT_EQ(a.size(), 2u);  // the outline and one hole
+  EXPECT_NE(detail::scad::signed_area(a[0]) > 0, detail::scad::signed_area(a[1]) > 0);
+  EXPECT_LT(relative(detail::scad::region_area(a), 27.525522), 0.005);
+  p.text = "i";
+  const Region i = detail::scad::text_region(p);
+  ASSERT_EQ(i.size(), 2u);  // the stem and the dot, both filled
+  EXPECT_GT(detail::scad::signed_area(i[0]), 0);
+  EXPECT_GT(detail::scad::signed_area(i[1]), 0);
+  EXPECT_LT(relative(detail::scad::region_area(i), 10.380513), 0.005);
+}
+
+// Centred as OpenSCAD centres it: across the line by the outlines' extent measured at the
+// advances' scale, so not exactly symmetric (OpenSCAD 2021.01: x -13.9307 .. 14.1720,
+// y -4.80434 .. 5.02844).
+TEST(ScadText, CentredTextIsPlacedAsOpenScadPlacesIt) {
+  detail::scad::TextParams p;
+  p.text = "HOH";
+  p.segments = 4;
+  p.halign = "center";
+  p.valign = "center";
+  const Region r = detail::scad::text_region(p);
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const Ring& ring : r)
+    for (const auto& q : ring)
+      for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
+  EXPECT_NEAR(lo[0], -13.9307, 2e-3);
+  EXPECT_NEAR(hi[0], 14.1720, 2e-3);
+  EXPECT_NEAR(lo[1], -4.80434, 2e-3);
+  EXPECT_NEAR(hi[1], 5.02844, 2e-3);
+}
+
+// Extruded text (holes, separate parts) is a closed solid of its outline's area times height.
+TEST(ScadText, ExtrudedTextIsAValidSolid) {
+  EvalOptions o;
+  o.depth = 10;
+  const Octree t = eval_csg("linear_extrude(height = 2) { text(text = \"Agi\", size = 10); }", o);
+  const TriMesh m = contour(t);
+  const MeshTopology topo = analyze_topology(m);
+  EXPECT_TRUE(topo.closed() && topo.manifold());
+  const double a = area(outline_of("text(text = \"Agi\", size = 10);"));
+  EXPECT_LT(relative(volume(m), 2 * a), 0.01);
+}
+
+TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
+  EvalOptions o;
+  o.depth = 7;
+  const Octree t = eval_csg("cube(size = [1, 1, 1]); %cube(size = [5, 5, 5]); *sphere(r = 9);", o);
+  EXPECT_NEAR(volume(contour(t)), 1, 1e-3);
+}
+
+TEST(ScadModel, TwoDimensionalModelsAreOutlinesNotSolids) {
+  EXPECT_THROW(eval_csg("square(size = [2, 2]);"), InvalidInput);
+  test::TempDir dir;
+  std::ofstream(dir / "cube.csg") << "cube(size = [1, 1, 1]);";
+  EXPECT_FALSE(eval_outline(dir / "cube.csg").has_value());
+  // SVG and DXF outputs, written and re-read as text.
+  const Outline o = outline_of("square(size = [2, 3]);");
+  write_outline(o, dir / "out.svg");
+  write_outline(o, dir / "out.dxf");
+  std::ifstream svg(dir / "out.svg"), dxf(dir / "out.dxf");
+  const std::string s((std::istreambuf_iterator<char>(svg)), {}), d((std::istreambuf_iterator<char>(dxf)), {});
+  EXPECT_NE(s.find("<path"), std::string::npos);
+  EXPECT_NE(d.find("LWPOLYLINE"), std::string::npos);
+  EXPECT_THROW(write_outline(o, dir / "out.stl"), InvalidInput);
+}
+
+}  // namespace
+}  // namespace pic
