@@ -28,6 +28,11 @@ one() {
     echo "$? $(echo "$(date +%s.%N) - $t0" | bc)" >"$rc"
   }
   t "$d/pic.rc" 60 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
+  if grep -q "a 2D model" "$d/pic.err"; then  # its outline, against OpenSCAD's DXF export
+    t "$d/pic.rc" 60 "$pic" eval "$scad" -o "$d/pic.dxf" --json >"$d/pic.json" 2>"$d/pic.err"
+    t "$d/openscad.rc" 100 openscad -o "$d/ref.dxf" "$scad" >"$d/openscad.log" 2>&1
+    return 0
+  fi
   [[ $(cut -d' ' -f1 "$d/pic.rc") == 2 ]] && return
   t "$d/openscad.rc" 100 openscad -o "$d/ref.stl" "$scad" >"$d/openscad.log" 2>&1
   if [[ -s $d/x.csg && -e $manifold ]]; then
@@ -82,6 +87,27 @@ def load(p):
     try:
         with open(p) as f: return json.load(f)
     except Exception: return None
+def dxf_area(path):
+    # Shoelace area of a DXF's LINE and LWPOLYLINE entities (OpenSCAD writes LINEs, PIC
+    # LWPOLYLINEs), each ring oriented as its boundary runs.
+    try:
+        lines = [l.strip() for l in open(path).read().split("\n")]
+    except OSError:
+        return None
+    pairs, area, i = list(zip(lines[0::2], lines[1::2])), 0.0, 0
+    while i < len(pairs):
+        code, value = pairs[i]
+        i += 1
+        if code != "0" or value not in ("LINE", "LWPOLYLINE"): continue
+        xs, ys = [], []
+        while i < len(pairs) and pairs[i][0] != "0":
+            if pairs[i][0] in ("10", "11"): xs.append(float(pairs[i][1]))
+            if pairs[i][0] in ("20", "21"): ys.append(float(pairs[i][1]))
+            i += 1
+        n = len(xs)
+        if value == "LINE" and n == 2: area += (xs[0] * ys[1] - xs[1] * ys[0]) / 2
+        elif value == "LWPOLYLINE": area += sum(xs[k] * ys[(k + 1) % n] - xs[(k + 1) % n] * ys[k] for k in range(n)) / 2
+    return area
 rows, speed, ok_n, total_ref, total_pic = [], [], 0, 0.0, 0.0
 for name in sorted(os.listdir(out)):
     d = os.path.join(out, name)
@@ -100,6 +126,18 @@ for name in sorted(os.listdir(out)):
         rows.append(f"| {name} | no | {why} | | | | | | |")
         continue
     ok_n += 1
+    if "area" in pj:  # a 2D model: areas of the two DXF outlines
+        ref_area = dxf_area(f"{d}/ref.dxf") if orc == "0" else None
+        diff = f"{100 * (pj['area'] - ref_area) / ref_area:+.3f} % (area)" if ref_area else "–"
+        ref_ok = ref_area is not None
+        sp = ""
+        if ref_ok:
+            s = osec / psec
+            speed.append(s); total_ref += osec; total_pic += psec
+            sp = f"{s:.1f}x"
+        rows.append(f"| {name} | yes | 2D outline, {pj['rings']} rings | {osec:.2f}{'' if ref_ok else ' (failed)'} | "
+                    f"{psec:.2f} | {sp} | {diff} | – | – |")
+        continue
     cr, cm = load(f"{d}/cmp_ref.json"), load(f"{d}/cmp_manifold.json")
     topo = pj.get("topology", {})
     man = "yes" if topo.get("manifold") else ("closed" if topo.get("closed") else "no")

@@ -11,7 +11,7 @@ pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev libassimp-dev li
 # (OpenSCAD's default font, Liberation Sans).
 pkgs+=(libpolyclipping-dev libfreetype-dev libharfbuzz-dev libfontconfig-dev fonts-liberation2)
 # `pic eval model.scad` runs OpenSCAD to export its CSG tree (tests skip the .scad case without it).
-pkgs+=(openscad)
+pkgs+=(openscad openscad-mcad)
 # The `pic` Python module (pybind11) and its pytest suite; numpy arrays in and out.
 pkgs+=(pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest)
 if [[ "${1:-}" == "--bench" ]]; then

@@ -150,6 +150,155 @@ TEST(ScadText, ExtrudedTextIsAValidSolid) {
   EXPECT_LT(relative(volume(m), 2 * a), 0.01);
 }
 
+// A DXF drawing: a 10 x 10 square of LINEs on layer "a" (one side drawn backwards), a CIRCLE
+// hole on layer "a", and on layer "b" a block of one closed LWPOLYLINE inserted twice, once
+// rotated a quarter turn.
+constexpr const char* kDrawing = R"(0
+SECTION
+2
+BLOCKS
+0
+BLOCK
+2
+tri
+10
+0.0
+20
+0.0
+0
+LWPOLYLINE
+8
+b
+90
+3
+70
+1
+10
+0.0
+20
+0.0
+10
+4.0
+20
+0.0
+10
+0.0
+20
+2.0
+0
+ENDBLK
+0
+ENDSEC
+0
+SECTION
+2
+ENTITIES
+0
+LINE
+8
+a
+10
+0
+20
+0
+11
+10
+21
+0
+0
+LINE
+8
+a
+10
+10
+20
+0
+11
+10
+21
+10
+0
+LINE
+8
+a
+10
+0
+20
+10
+11
+10
+21
+10
+0
+LINE
+8
+a
+10
+0
+20
+10
+11
+0
+21
+0
+0
+CIRCLE
+8
+a
+10
+5
+20
+5
+40
+2
+0
+INSERT
+8
+0
+2
+tri
+10
+20
+20
+0
+0
+INSERT
+8
+0
+2
+tri
+10
+40
+20
+0
+50
+90
+0
+ENDSEC
+0
+EOF
+)";
+
+TEST(ScadImport, DxfLayersCirclesAndBlocks) {
+  test::TempDir dir("dxf");
+  const std::string file = (dir / "d.dxf").string();
+  std::ofstream(file) << kDrawing;
+  const auto import = [&](const std::string& layer) {
+    return outline_of("import(file = \"" + file + "\", layer = \"" + layer + "\", $fn = 64);");
+  };
+  // The square minus the circle's 64-gon (area (64 / 2) r^2 sin(2 pi / 64)).
+  EXPECT_NEAR(area(import("a")), 100 - 32 * 4 * std::sin(2 * std::numbers::pi / 64), 1e-6);
+  // Two copies of the block's triangle (area 4); the quarter-turned copy, inserted at x = 40,
+  // reaches back to x = 38.
+  const Outline b = import("b");
+  EXPECT_NEAR(area(b), 8, 1e-6);
+  double lo = 1e300;
+  for (const auto& r : b.rings)
+    if (r[0][0] > 30)  // the rotated copy
+      for (const auto& p : r) lo = std::min(lo, p[0]);
+  EXPECT_NEAR(lo, 38, 1e-9);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pic/primitives.h"
+#include "scad/dxf.h"
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "scad/text.h"
@@ -291,9 +292,7 @@ class Lowering {
     std::filesystem::path p = f->text;
     std::string ext = p.extension().string();
     for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".dxf" || ext == ".svg")
-      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node 'import' of a 2D " + ext +
-                         " file (only STL, OFF, OBJ, PLY meshes)");
+    if (ext == ".dxf" || ext == ".svg") fail(n, "a 2D drawing outside linear_extrude/rotate_extrude (the model must be 3D)");
     if (p.is_relative()) p = opt_.base_dir / p;
     return read_mesh(p);
   }
@@ -339,7 +338,7 @@ class Lowering {
     }
     if (k == "offset") return offset(n, m);
     if (k == "text") return apply2(m, text(n, stretch2(m) * stretch_3d_));
-    if (k == "import") fail(n, "2D import (DXF, SVG) is not supported yet");
+    if (k == "import") return apply2(m, import_2d(n));
     if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" || k == "linear_extrude" ||
         k == "rotate_extrude")
       fail(n, "a 3D object inside a 2D subtree");
@@ -392,6 +391,30 @@ class Lowering {
     }
     return apply2(m, region_offset(in, amount, join, tolerance));
   }
+  // import() of a DXF drawing (an SVG is refused), or the legacy `file` argument of an
+  // extrusion.
+  Region import_2d(const Node& n) const {
+    const Value* f = arg(n, "file");
+    if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
+    std::filesystem::path p = f->text;
+    std::string ext = p.extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".dxf") fail(n, "2D import of " + ext + " files is not supported (DXF is)");
+    if (p.is_relative()) p = opt_.base_dir / p;
+    DxfImport how;
+    if (const Value* v = arg(n, "layer"); v && v->kind == Value::Kind::String) how.layer = v->text;
+    if (const Value* v = arg(n, "origin"); v && v->kind == Value::Kind::Vector) {
+      const auto xs = numbers(n, *v, "origin");
+      if (xs.size() >= 2) how.origin = {xs[0], xs[1]};
+    }
+    how.scale = number(n, "scale", 1);
+    how.fn = number(n, "$fn", 0);
+    how.fs = number(n, "$fs", 2);
+    how.fa = number(n, "$fa", 12);
+    check_finite(n, {how.origin[0], how.origin[1], how.scale});
+    return read_dxf(p, how);
+  }
+
   Region text(const Node& n, double st) const {
     TextParams p;
     const auto str = [&](const char* key, const std::string& fallback) {
@@ -453,8 +476,7 @@ class Lowering {
 
   Region shape_children(const Node& n, double st) {
     if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
-      throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + n.name +
-                         "' of a DXF file");
+      return import_2d(n);
     stretch_3d_ = st;
     Region r = region_union(children2(n, kIdentity2));
     stretch_3d_ = 1;
