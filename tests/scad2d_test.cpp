@@ -299,6 +299,42 @@ TEST(ScadImport, DxfLayersCirclesAndBlocks) {
   EXPECT_NEAR(lo, 38, 1e-9);
 }
 
+TEST(ScadProjection, ShadowAndCutOfABox) {
+  // A box tilted about z only: its shadow and its section are the same 10 x 10 square.
+  const std::string box =
+      "multmatrix([[0.8, -0.6, 0, 0], [0.6, 0.8, 0, 0], [0, 0, 1, -5], [0, 0, 0, 1]]) { cube(size = [10, 10, 10]); }";
+  EXPECT_NEAR(area(outline_of("projection(cut = false) { " + box + " }")), 100, 1e-6);
+  EXPECT_NEAR(area(outline_of("projection(cut = true) { " + box + " }")), 100, 1e-6);
+  // A cut that misses the solid is empty.
+  EXPECT_THROW(outline_of("projection(cut = true) { cube(size = [1, 1, 1]); }"), InvalidInput);
+  // The shadow of a difference (evaluated on octrees, then projected): a 10 x 10 square with a
+  // 4 x 4 hole through it.
+  const Outline o = outline_of(
+      "projection() { difference() { cube(size = [10, 10, 2]); "
+      "multmatrix([[1, 0, 0, 3], [0, 1, 0, 3], [0, 0, 1, -1], [0, 0, 0, 1]]) { cube(size = [4, 4, 4]); } } }");
+  EXPECT_NEAR(area(o), 84, 0.5);
+}
+
+TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
+  EvalOptions o;
+  o.depth = 8;
+  // A box grown by a centred 2-cube: a 12-cube.
+  const double box = volume(contour(eval_csg(
+      "minkowski() { cube(size = [10, 10, 10]); cube(size = [2, 2, 2], center = true); }", o)));
+  EXPECT_NEAR(box, 1728, 1728 * 1e-6);
+  // An L of two bars (not convex, a union of convex parts) grown the same way, moved as a whole.
+  const double ell = volume(contour(eval_csg(
+      "multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) { minkowski() { union() { "
+      "cube(size = [10, 2, 2]); cube(size = [2, 10, 2]); } cube(size = [2, 2, 2], center = true); } }",
+      o)));
+  EXPECT_NEAR(ell, 12 * 4 * 4 + 4 * 12 * 4 - 4 * 4 * 4, 320 * 1e-6);
+  // A part that is not convex is refused, not approximated.
+  EXPECT_THROW(eval_csg("minkowski() { difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } "
+                        "sphere(r = 1); }",
+                        o),
+               InvalidInput);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

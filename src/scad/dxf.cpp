@@ -133,7 +133,6 @@ Map compose(const Map& a, const Map& b) {
           a[3] * b[0] + a[4] * b[3], a[3] * b[1] + a[4] * b[4], a[3] * b[2] + a[4] * b[5] + a[5]};
 }
 
-using Segment = std::array<P2, 2>;
 
 void arc_points(const P2& c, double r, double a0, double a1, const DxfImport& how, double stretch, std::vector<P2>& out) {
   while (a1 <= a0) a1 += 360;
@@ -203,47 +202,6 @@ void collect(const Drawing& d, const std::vector<Entity>& list, const Map& m, co
   }
 }
 
-// Chains segments whose ends meet (within `tol`) into rings. A chain that does not close is
-// closed by its last point joining its first, as OpenSCAD imports such paths.
-void chain(const std::vector<Segment>& segs, double tol, std::vector<Ring>& rings) {
-  const auto key = [&](const P2& p) { return std::pair(std::llround(p[0] / tol), std::llround(p[1] / tol)); };
-  std::multimap<std::pair<long long, long long>, size_t> ends;  // end point -> segment * 2 + which end
-  for (size_t i = 0; i < segs.size(); ++i)
-    for (int k = 0; k < 2; ++k) ends.emplace(key(segs[i][k]), 2 * i + size_t(k));
-  std::vector<bool> used(segs.size(), false);
-  // Extends the ring at its back with unused segments; true when it came back to its front.
-  const auto extend = [&](Ring& ring) {
-    const auto start = key(ring.front());
-    for (;;) {
-      const auto k = key(ring.back());
-      if (k == start) {
-        ring.pop_back();
-        return true;
-      }
-      bool extended = false;
-      const auto [lo, hi] = ends.equal_range(k);
-      for (auto it = lo; it != hi && !extended; ++it) {
-        const size_t seg = it->second / 2, end = it->second % 2;
-        if (used[seg]) continue;
-        used[seg] = true;
-        ring.push_back(segs[seg][1 - end]);
-        extended = true;
-      }
-      if (!extended) return false;
-    }
-  };
-  for (size_t s = 0; s < segs.size(); ++s) {
-    if (used[s]) continue;
-    used[s] = true;
-    Ring ring{segs[s][0], segs[s][1]};
-    if (!extend(ring)) {
-      std::reverse(ring.begin(), ring.end());
-      extend(ring);
-    }
-    if (ring.size() >= 3) rings.push_back(std::move(ring));
-  }
-}
-
 }  // namespace
 
 Region read_dxf(const std::filesystem::path& path, const DxfImport& how) {
@@ -257,7 +215,7 @@ Region read_dxf(const std::filesystem::path& path, const DxfImport& how) {
   double extent = 0;
   for (const Segment& s : segs)
     for (const P2& p : s) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
-  chain(segs, std::max(extent, 1.0) * 1e-9, rings);
+  for (Ring& r : rings_from_segments(segs, std::max(extent, 1.0) * 1e-9)) rings.push_back(std::move(r));
   return region_even_odd(rings);
 }
 

@@ -148,6 +148,24 @@ class Evaluator {
 
 }  // namespace
 
+namespace detail::scad {
+TriMesh solid_surface(const Solid& s, const EvalOptions& options) {
+  if (s.kind == Solid::Kind::Mesh) return s.mesh;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  size_t leaves = 0, tris = 0;
+  bounds(s, lo, hi, leaves, tris);
+  if (leaves == 0) return {};
+  TriMesh corners;
+  corners.positions = {lo, hi};
+  EvalOptions o = options;
+  o.progress = nullptr;
+  Evaluator ev(o, bounding_cube(corners), leaves);
+  const std::optional<Octree> t = ev.eval(s);
+  if (!t || t->vertices.empty()) return {};
+  return contour(*t);
+}
+}  // namespace detail::scad
+
 Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* stats, const std::string& source) {
   const auto t0 = Clock::now();
   if (options.depth < 1 || options.depth > kMaxLevel)

@@ -141,6 +141,11 @@ class Lowering {
       if (s.children.empty()) s.kind = Solid::Kind::Empty;
       return s;
     }
+    if (k == "minkowski") {  // of the operands where they are, then moved (a sum is not moved twice)
+      Solid s = scad::minkowski(children3(n, kIdentity), opt_);
+      transform(s, m);
+      return s;
+    }
     if (k == "cube") return leaf(cube(n), m);
     if (k == "sphere") {
       const double r = radius(n, "r", "d", 1);
@@ -337,11 +342,17 @@ class Lowering {
       return {std::move(h)};
     }
     if (k == "offset") return offset(n, m);
+    if (k == "projection") {
+      const Solid s = combine(Solid::Kind::Union, children3(n, kIdentity));
+      if (s.kind == Solid::Kind::Empty) return {};
+      return apply2(m, project(s.kind == Solid::Kind::Mesh ? s.mesh : solid_surface(s, opt_), flag(n, "cut", false)));
+    }
     if (k == "text") return apply2(m, text(n, stretch2(m) * stretch_3d_));
     if (k == "import") return apply2(m, import_2d(n));
     if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" || k == "linear_extrude" ||
         k == "rotate_extrude")
       fail(n, "a 3D object inside a 2D subtree");
+    if (k == "minkowski") fail(n, "2D minkowski is not supported");
     throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
   }
   std::vector<Region> children2(const Node& n, const Affine2& m) {

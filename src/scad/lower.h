@@ -26,6 +26,16 @@ struct Solid {
 /// \throws InvalidInput for an unsupported node or bad arguments (naming the node's line).
 Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes);
 
+/// The surface of a lowered 3D subtree: a leaf's own mesh, else its Booleans evaluated on
+/// octrees (options.depth, in the subtree's own cube) and contoured (evaluate.cpp).
+TriMesh solid_surface(const Solid& s, const EvalOptions& options);
+/// projection(): the shadow of a closed surface on z = 0 (union of its triangles' shadows), or,
+/// with `cut`, its section by that plane (projection.cpp).
+std::vector<Ring> project(const TriMesh& surface, bool cut);
+/// minkowski() of operands that are unions of convex parts: the union of the hulls of their
+/// parts' vertex sums. \throws InvalidInput for an operand with a non-convex part.
+Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options);
+
 /// 2 when the tree's objects are 2D (a 2D model), 3 when 3D, 0 when it has none.
 int dimension(const Node& n);
 /// Lowers a 2D model to its region. \throws as lower().

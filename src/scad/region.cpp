@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace pic::detail::scad {
 namespace {
@@ -39,6 +40,14 @@ Region from_paths(const cl::Paths& paths, double scale) {
   out.reserve(paths.size());
   for (const cl::Path& path : paths) {
     if (path.size() < 3) continue;
+    // A ring narrower than two grid units on average (area below its perimeter, in grid
+    // units) is rounding debris, such as a section's sliver; its extrusion would be flat.
+    double perimeter = 0;
+    for (size_t i = 0; i < path.size(); ++i) {
+      const cl::IntPoint &a = path[i], &b = path[(i + 1) % path.size()];
+      perimeter += std::hypot(double(b.X - a.X), double(b.Y - a.Y));
+    }
+    if (std::abs(cl::Area(path)) <= perimeter) continue;
     Ring ring;
     ring.reserve(path.size());
     for (const cl::IntPoint& p : path) ring.push_back({double(p.X) / scale, double(p.Y) / scale});
@@ -91,6 +100,47 @@ Region region_offset(const Region& region, double amount, OffsetJoin join, doubl
   cl::Paths out;
   co.Execute(out, amount * scale);
   return from_paths(out, scale);
+}
+
+std::vector<Ring> rings_from_segments(const std::vector<Segment>& segs, double tol) {
+  std::vector<Ring> rings;
+  const auto key = [&](const P2& p) { return std::pair(std::llround(p[0] / tol), std::llround(p[1] / tol)); };
+  std::multimap<std::pair<long long, long long>, size_t> ends;  // end point -> segment * 2 + which end
+  for (size_t i = 0; i < segs.size(); ++i)
+    for (int k = 0; k < 2; ++k) ends.emplace(key(segs[i][k]), 2 * i + size_t(k));
+  std::vector<bool> used(segs.size(), false);
+  // Extends the ring at its back with unused segments; true when it came back to its front.
+  const auto extend = [&](Ring& ring) {
+    const auto start = key(ring.front());
+    for (;;) {
+      const auto k = key(ring.back());
+      if (k == start) {
+        ring.pop_back();
+        return true;
+      }
+      bool extended = false;
+      const auto [lo, hi] = ends.equal_range(k);
+      for (auto it = lo; it != hi && !extended; ++it) {
+        const size_t seg = it->second / 2, end = it->second % 2;
+        if (used[seg]) continue;
+        used[seg] = true;
+        ring.push_back(segs[seg][1 - end]);
+        extended = true;
+      }
+      if (!extended) return false;
+    }
+  };
+  for (size_t s = 0; s < segs.size(); ++s) {
+    if (used[s]) continue;
+    used[s] = true;
+    Ring ring{segs[s][0], segs[s][1]};
+    if (!extend(ring)) {
+      std::reverse(ring.begin(), ring.end());
+      extend(ring);
+    }
+    if (ring.size() >= 3) rings.push_back(std::move(ring));
+  }
+  return rings;
 }
 
 double region_area(const Region& region) {

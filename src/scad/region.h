@@ -24,6 +24,11 @@ Region region_difference(const std::vector<Region>& parts);
 enum class OffsetJoin { kRound, kMiter, kChamfer };
 Region region_offset(const Region& region, double amount, OffsetJoin join, double arc_tolerance);
 
+/// Rings from line segments chained where their ends meet (within `tol`); a chain that does
+/// not close is closed by its last point joining its first, as OpenSCAD imports such paths.
+using Segment = std::array<P2, 2>;
+std::vector<Ring> rings_from_segments(const std::vector<Segment>& segs, double tol);
+
 /// Area (holes subtracted).
 double region_area(const Region& region);
 
