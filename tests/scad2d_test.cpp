@@ -11,6 +11,8 @@
 
 #include "pic/pic.h"
 #include "pic/scad.h"
+#include "pic/render.h"
+#include "scad/lower.h"
 #include "scad/region.h"
 #include "scad/text.h"
 #include "support/temp_dir.h"
@@ -333,6 +335,34 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
                         "sphere(r = 1); }",
                         o),
                InvalidInput);
+}
+
+// surface(): heights from a text matrix, and from a PNG's luminance (OpenSCAD 2021.01's export
+// of the same 3 x 2 image has these heights: white 100, green 71.52, red 21.26, ...).
+TEST(ScadSurface, HeightMapsFromTextAndImages) {
+  test::TempDir dir("surface");
+  std::ofstream(dir / "h.dat") << "# two rows\n1 2 3\n4 5 6\n";
+  // Cells of mean height 3 and 4 over a bottom at min - 1 = 0.
+  const TriMesh dat = detail::scad::surface_mesh(dir / "h.dat", false, false);
+  EXPECT_TRUE(analyze_topology(dat).manifold());
+  EXPECT_NEAR(volume(dat), 7, 1e-12);
+  Image img;
+  img.width = 3;
+  img.height = 2;
+  img.rgb = {255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128};
+  write_png(img, dir / "h.png");
+  const TriMesh png = detail::scad::surface_mesh(dir / "h.png", false, false);
+  EXPECT_TRUE(analyze_topology(png).manifold());
+  const auto height_at = [&](double x, double y) {
+    for (const Vec3& p : png.positions)
+      if (p[0] == x && p[1] == y && p[2] > -1) return p[2];
+    return -1e300;
+  };
+  EXPECT_NEAR(height_at(0, 1), 100, 1e-9);    // the image's top row is at y = 1
+  EXPECT_NEAR(height_at(2, 1), 21.26, 1e-9);  // red
+  EXPECT_NEAR(height_at(0, 0), 71.52, 1e-9);  // green
+  EXPECT_NEAR(height_at(2, 0), 100.0 * 128 / 255, 1e-9);
+  EXPECT_THROW(detail::scad::surface_mesh(dir / "missing.dat", false, false), IoError);
 }
 
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {

@@ -147,6 +147,14 @@ class Lowering {
       return s;
     }
     if (k == "cube") return leaf(cube(n), m);
+    if (k == "surface") {
+      const Value* f = arg(n, "file");
+      if (!f) f = arg(n, "0");
+      if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
+      std::filesystem::path p = f->text;
+      if (p.is_relative()) p = opt_.base_dir / p;
+      return leaf(surface_mesh(p, flag(n, "center", false), flag(n, "invert", false)), m);
+    }
     if (k == "sphere") {
       const double r = radius(n, "r", "d", 1);
       if (!(r > 0)) return {};

@@ -4,6 +4,7 @@
 // with them). evaluate.cpp then samples the leaves and runs the Booleans on octrees.
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ std::vector<Ring> project(const TriMesh& surface, bool cut);
 /// minkowski() of operands that are unions of convex parts: the union of the hulls of their
 /// parts' vertex sums. \throws InvalidInput for an operand with a non-convex part.
 Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options);
+
+/// surface(): the solid under a height map, a .dat text matrix or a PNG (surface.cpp).
+/// \throws IoError when unreadable, InvalidInput when malformed.
+TriMesh surface_mesh(const std::filesystem::path& path, bool center, bool invert);
 
 /// 2 when the tree's objects are 2D (a 2D model), 3 when 3D, 0 when it has none.
 int dimension(const Node& n);
