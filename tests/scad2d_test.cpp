@@ -365,6 +365,21 @@ TEST(ScadSurface, HeightMapsFromTextAndImages) {
   EXPECT_THROW(detail::scad::surface_mesh(dir / "missing.dat", false, false), IoError);
 }
 
+TEST(ScadResize, ToTheGivenSizeOrProportionally) {
+  // A 2 x 3 x 5 box made 10 x 10 x 4 where it stands, then moved.
+  EvalOptions o;
+  o.depth = 8;
+  const TriMesh box = contour(eval_csg(
+      "multmatrix([[1, 0, 0, 30], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) { "
+      "resize(newsize = [10, 10, 4], auto = [0, 0, 0]) { cube(size = [2, 3, 5]); } }",
+      o));
+  EXPECT_NEAR(volume(box), 400, 400 * 1e-6);
+  // A circle of radius 3 (a 30-gon) to width 10, its height following: area scales by (10/6)^2.
+  const double circle = area(outline_of("circle(r = 3, $fn = 30);"));
+  EXPECT_NEAR(area(outline_of("resize(newsize = [10, 0], auto = true) { circle(r = 3, $fn = 30); }")),
+              circle * 100 / 36, 1e-6);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

@@ -146,6 +146,18 @@ class Lowering {
       transform(s, m);
       return s;
     }
+    if (k == "resize") {  // sized where it is, then moved
+      const Solid s = combine(Solid::Kind::Union, children3(n, kIdentity));
+      if (s.kind == Solid::Kind::Empty) return s;
+      const TriMesh surface = solid_surface(s, opt_);
+      Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+      for (const Vec3& p : surface.positions)
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+      const auto f = resize_factors(n, {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}, 3);
+      Solid out = s;
+      transform(out, compose(m, Affine{f[0], 0, 0, 0, 0, f[1], 0, 0, 0, 0, f[2], 0}));
+      return out;
+    }
     if (k == "cube") return leaf(cube(n), m);
     if (k == "surface") {
       const Value* f = arg(n, "file");
@@ -350,6 +362,15 @@ class Lowering {
       return {std::move(h)};
     }
     if (k == "offset") return offset(n, m);
+    if (k == "resize") {
+      const Region r = region_union(children2(n, kIdentity2));
+      double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+      for (const Ring& ring : r)
+        for (const P2& p : ring)
+          for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+      const auto f = resize_factors(n, {hi[0] - lo[0], hi[1] - lo[1], 0}, 2);
+      return apply2(compose2(m, {f[0], 0, 0, 0, f[1], 0}), r);
+    }
     if (k == "projection") {
       const Solid s = combine(Solid::Kind::Union, children3(n, kIdentity));
       if (s.kind == Solid::Kind::Empty) return {};
@@ -363,6 +384,35 @@ class Lowering {
     if (k == "minkowski") fail(n, "2D minkowski is not supported");
     throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
   }
+  // resize(newsize, auto): per axis newsize / size where newsize > 0; an axis left at 0 keeps
+  // its size, or with `auto` takes the largest factor of the axes given.
+  std::array<double, 3> resize_factors(const Node& n, const std::array<double, 3>& size, int dims) const {
+    std::array<double, 3> want{0, 0, 0}, f{1, 1, 1};
+    std::array<bool, 3> automatic{false, false, false};
+    if (const Value* v = arg(n, "newsize")) {
+      const auto xs = numbers(n, *v, "newsize");
+      for (size_t a = 0; a < std::min<size_t>(3, xs.size()); ++a) want[a] = xs[a];
+    }
+    if (const Value* v = arg(n, "auto")) {
+      if (v->kind == Value::Kind::Vector) {
+        for (size_t a = 0; a < std::min<size_t>(3, v->items.size()); ++a) {
+          const Value& x = v->items[a];
+          automatic[a] = x.kind == Value::Kind::Bool ? x.boolean : x.kind == Value::Kind::Number && x.number != 0;
+        }
+      } else {
+        automatic.fill(flag(n, "auto", false));
+      }
+    }
+    double largest = 0;
+    for (int a = 0; a < dims; ++a) {
+      check_finite(n, {want[a]});
+      if (want[a] > 0 && size[a] > 0) largest = std::max(largest, f[a] = want[a] / size[a]);
+    }
+    for (int a = 0; a < dims; ++a)
+      if (!(want[a] > 0) && automatic[a] && largest > 0) f[a] = largest;
+    return f;
+  }
+
   std::vector<Region> children2(const Node& n, const Affine2& m) {
     std::vector<Region> out;
     for (const Node& c : n.children) out.push_back(shape(c, m));
