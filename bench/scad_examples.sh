@@ -77,7 +77,7 @@ examples=(/usr/share/openscad/examples/Old/*.scad /usr/share/openscad/examples/P
 if [[ -e $lock ]]; then
   until flock "$lock" bash -c 'batch "$@"' _ "${examples[@]}"; do :; done
 else
-  batch "${examples[@]}"
+  until batch "${examples[@]}"; do :; done
 fi
 
 python3 - "$out" <<'PY'

@@ -12,6 +12,7 @@
 #include "pic/pic.h"
 #include "pic/scad.h"
 #include "pic/render.h"
+#include "scad/dxf.h"
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "scad/text.h"
@@ -378,6 +379,19 @@ TEST(ScadResize, ToTheGivenSizeOrProportionally) {
   const double circle = area(outline_of("circle(r = 3, $fn = 30);"));
   EXPECT_NEAR(area(outline_of("resize(newsize = [10, 0], auto = true) { circle(r = 3, $fn = 30); }")),
               circle * 100 / 36, 1e-6);
+}
+
+// Malformed drawings are one clear error; a drawing with nothing closed in the layer is empty.
+TEST(ScadImport, MalformedDxfIsAnError) {
+  test::TempDir dir("baddxf");
+  const auto import = [&](const std::string& bytes) {
+    std::ofstream(dir / "x.dxf", std::ios::binary) << bytes;
+    return detail::scad::read_dxf(dir / "x.dxf", {});
+  };
+  EXPECT_THROW(import("0\nSECTION\n2\nENTITIES\n0\nLINE\n10\nabc\n"), InvalidInput);
+  EXPECT_THROW(import(std::string("\x00\xff\x13garbage\n\x01\n", 14)), InvalidInput);
+  EXPECT_TRUE(import("0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n0\n20\n0\n11\n1\n21\n0\n").empty());
+  EXPECT_THROW(detail::scad::read_dxf(dir / "missing.dxf", {}), IoError);
 }
 
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
