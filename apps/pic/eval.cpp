@@ -15,11 +15,7 @@ struct EvalArgs {
   bool smooth = false, json = false, serial = false, no_split = false;
 };
 
-bool is_outline_path(const std::string& p) {
-  std::string ext = std::filesystem::path(p).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".svg" || ext == ".dxf";
-}
+bool is_outline_path(const std::string& p) { return extension(p) == ".svg" || extension(p) == ".dxf"; }
 
 // A 2D model's outline to SVG or DXF, as `openscad -o out.svg` writes it.
 void run_outline(const EvalArgs& a, const EvalOptions& eo) {

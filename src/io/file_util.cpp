@@ -3,12 +3,19 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <fstream>
 #include <string>
 
 #include "pic/pic.h"
 
 namespace pic::detail {
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string e = path.extension().string();
+  for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
 
 std::filesystem::path temp_path_for(const std::filesystem::path& path) {
   static std::atomic<int> counter{0};

@@ -26,12 +26,6 @@
 namespace pic {
 namespace {
 
-std::string lower_ext(const std::filesystem::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-
 bool finite(const Vec3& p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
 
 // Exact welding of equal positions (-0 == +0, mesh_repair's weld); refuses NaN and inf.
@@ -111,11 +105,11 @@ Geometry read_geometry_bytes(const std::vector<uint8_t>& bytes, const std::strin
 }  // namespace detail
 
 TriMesh read_mesh(const std::filesystem::path& path) {
-  return detail::read_mesh_bytes(detail::read_file(path), lower_ext(path), path.string());
+  return detail::read_mesh_bytes(detail::read_file(path), detail::lower_extension(path), path.string());
 }
 
 Geometry read_geometry(const std::filesystem::path& path) {
-  return detail::read_geometry_bytes(detail::read_file(path), lower_ext(path), path.string());
+  return detail::read_geometry_bytes(detail::read_file(path), detail::lower_extension(path), path.string());
 }
 
 namespace {
@@ -213,7 +207,7 @@ void write_with_assimp(const TriMesh& m, const std::filesystem::path& tmp, const
 }  // namespace
 
 void write_mesh(const TriMesh& mesh, const std::filesystem::path& path) {
-  const std::string ext = lower_ext(path);
+  const std::string ext = detail::lower_extension(path);
   using Writer = void (*)(const TriMesh&, std::FILE*);
   static const std::map<std::string, Writer> plain = {
       {".obj", write_obj}, {".off", write_off}, {".stl", write_stl}, {".ply", write_ply}};

@@ -47,8 +47,7 @@ void write_dxf(const Outline& o, std::ofstream& out) {
 }  // namespace
 
 void write_outline(const Outline& outline, const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = detail::lower_extension(path);
   if (ext != ".svg" && ext != ".dxf") throw InvalidInput(path.string() + ": a 2D outline is written as .svg or .dxf");
   detail::write_atomically(path, [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pic/primitives.h"
+#include "io/file_util.h"
 #include "scad/dxf.h"
 #include "scad/lower.h"
 #include "scad/region.h"
@@ -142,7 +143,12 @@ class Lowering {
       return s;
     }
     if (k == "minkowski") {  // of the operands where they are, then moved (a sum is not moved twice)
-      Solid s = scad::minkowski(children3(n, kIdentity), opt_);
+      Solid s;
+      try {
+        s = scad::minkowski(children3(n, kIdentity), opt_);
+      } catch (const InvalidInput& e) {
+        fail(n, e.what());
+      }
       transform(s, m);
       return s;
     }
@@ -160,12 +166,7 @@ class Lowering {
     }
     if (k == "cube") return leaf(cube(n), m);
     if (k == "surface") {
-      const Value* f = arg(n, "file");
-      if (!f) f = arg(n, "0");
-      if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
-      std::filesystem::path p = f->text;
-      if (p.is_relative()) p = opt_.base_dir / p;
-      return leaf(surface_mesh(p, flag(n, "center", false), flag(n, "invert", false)), m);
+      return leaf(surface_mesh(file_arg(n), flag(n, "center", false), flag(n, "invert", false)), m);
     }
     if (k == "sphere") {
       const double r = radius(n, "r", "d", 1);
@@ -311,14 +312,19 @@ class Lowering {
     return m;
   }
 
-  TriMesh import(const Node& n) const {
+  // A node's `file` argument (or its first positional one), relative to the model's folder.
+  std::filesystem::path file_arg(const Node& n) const {
     const Value* f = arg(n, "file");
+    if (!f) f = arg(n, "0");
     if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
     std::filesystem::path p = f->text;
-    std::string ext = p.extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return p.is_relative() ? opt_.base_dir / p : p;
+  }
+
+  TriMesh import(const Node& n) const {
+    const std::filesystem::path p = file_arg(n);
+    const std::string ext = lower_extension(p);
     if (ext == ".dxf" || ext == ".svg") fail(n, "a 2D drawing outside linear_extrude/rotate_extrude (the model must be 3D)");
-    if (p.is_relative()) p = opt_.base_dir / p;
     return read_mesh(p);
   }
 
@@ -463,13 +469,9 @@ class Lowering {
   // import() of a DXF drawing (an SVG is refused), or the legacy `file` argument of an
   // extrusion.
   Region import_2d(const Node& n) const {
-    const Value* f = arg(n, "file");
-    if (!f || f->kind != Value::Kind::String) fail(n, "needs file = \"...\"");
-    std::filesystem::path p = f->text;
-    std::string ext = p.extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::filesystem::path p = file_arg(n);
+    const std::string ext = lower_extension(p);
     if (ext != ".dxf") fail(n, "2D import of " + ext + " files is not supported (DXF is)");
-    if (p.is_relative()) p = opt_.base_dir / p;
     DxfImport how;
     if (const Value* v = arg(n, "layer"); v && v->kind == Value::Kind::String) how.layer = v->text;
     if (const Value* v = arg(n, "origin"); v && v->kind == Value::Kind::Vector) {
@@ -677,8 +679,7 @@ int dimension(const Node& n) {
   if (is_2d_node(k) || k == "projection") return 2;
   if (k == "import") {
     const Value* f = arg(n, "file");
-    std::string ext = f && f->kind == Value::Kind::String ? std::filesystem::path(f->text).extension().string() : "";
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = f && f->kind == Value::Kind::String ? lower_extension(f->text) : "";
     return ext == ".dxf" || ext == ".svg" ? 2 : 3;
   }
   if (n.children.empty())

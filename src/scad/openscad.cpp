@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pic/scad.h"
+#include "io/file_util.h"
 #include "scad/lower.h"
 
 #include <chrono>
@@ -35,8 +36,7 @@ namespace {
 // The model's CSG tree as text: a .csg file as it is, a .scad file through `openscad -o
 // x.csg` (a temporary file). Sets the directory imports are relative to, and OpenSCAD's time.
 std::string csg_text(const std::filesystem::path& path, EvalOptions& o, double& openscad_seconds) {
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = detail::lower_extension(path);
   if (ext != ".scad" && ext != ".csg") throw InvalidInput(path.string() + ": expected a .scad or .csg file");
   if (o.base_dir.empty()) o.base_dir = std::filesystem::absolute(path).parent_path();
   openscad_seconds = 0;

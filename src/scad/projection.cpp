@@ -103,7 +103,7 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
     if (s.kind == Solid::Kind::Empty) continue;
     std::vector<std::vector<Vec3>> parts;
     if (!convex_parts(s, o, parts))
-      throw InvalidInput("minkowski: an operand that is not a union of convex parts is not supported");
+      throw InvalidInput("an operand that is not a union of convex parts is not supported");
     if (first) {
       acc = std::move(parts);
       first = false;
@@ -119,7 +119,7 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
           for (const Vec3& q : b) sums.push_back({p[0] + q[0], p[1] + q[1], p[2] + q[2]});
         next.push_back(convex_hull(sums).positions);
       }
-    if (next.size() > 100000) throw InvalidInput("minkowski: too many convex parts");
+    if (next.size() > 100000) throw InvalidInput("too many convex parts");
     acc = std::move(next);
   }
   Solid out;

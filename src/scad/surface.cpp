@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/file_util.h"
 #include "scad/lower.h"
 
 namespace pic::detail::scad {
@@ -57,8 +58,7 @@ std::vector<std::vector<double>> read_png(const std::filesystem::path& path, boo
 }  // namespace
 
 TriMesh surface_mesh(const std::filesystem::path& path, bool center, bool invert) {
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lower_extension(path);
   const auto h = ext == ".png" ? read_png(path, invert) : read_dat(path);
   const size_t rows = h.size(), cols = rows ? h[0].size() : 0;
   for (const auto& r : h)
