@@ -394,6 +394,33 @@ TEST(ScadImport, MalformedDxfIsAnError) {
   EXPECT_THROW(detail::scad::read_dxf(dir / "missing.dxf", {}), IoError);
 }
 
+// SVG: px at 72 dpi (OpenSCAD 2021's default), y flipped about the document's height, each
+// shape filled by the even-odd rule; mm documents through their viewBox.
+TEST(ScadImport, SvgShapesUnitsAndTransforms) {
+  test::TempDir dir("svg");
+  const std::string px = (dir / "px.svg").string(), mm = (dir / "mm.svg").string();
+  std::ofstream(px) << "<?xml version=\"1.0\"?>\n<!-- test -->\n"
+                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"100\" height=\"50\" viewBox=\"0 0 100 50\">"
+                       "<defs><rect width=\"999\" height=\"999\"/></defs>"
+                       "<rect x=\"10\" y=\"5\" width=\"20\" height=\"10\"/>"
+                       "<path d=\"M 50 10 L 70 10 L 60 30 z\"/></svg>";
+  const double u = 25.4 / 72;
+  const Outline a = outline_of("import(file = \"" + px + "\");");
+  EXPECT_NEAR(area(a), (200 + 200) * u * u, 1e-6);  // to Clipper's grid
+  double lo = 1e300, hi = -1e300;
+  for (const auto& r : a.rings)
+    for (const auto& p : r) lo = std::min(lo, p[1]), hi = std::max(hi, p[1]);
+  EXPECT_NEAR(lo, (50 - 30) * u, 1e-6);  // the triangle's tip, y = 30 from the top
+  EXPECT_NEAR(hi, (50 - 5) * u, 1e-6);   // the rectangle's top edge
+  // A 40 x 20 mm document of 160 x 80 user units: a path with an inner square (a hole by the
+  // even-odd rule, though drawn the same way round), in a translated group.
+  std::ofstream(mm) << "<svg width=\"40mm\" height=\"20mm\" viewBox=\"0 0 160 80\"><g transform=\"translate(10 5)\">"
+                       "<path d=\"M0,0 h40 v40 h-40 z M10,10 h10 v10 h-10 z\"/></g></svg>";
+  EXPECT_NEAR(area(outline_of("import(file = \"" + mm + "\");")), (1600 - 100) / 16.0, 1e-6);
+  std::ofstream(dir / "bad.svg") << "<svg><path d=\"M 0 0 L 1 q\"/></svg>";
+  EXPECT_THROW(outline_of("import(file = \"" + (dir / "bad.svg").string() + "\");"), InvalidInput);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

@@ -10,6 +10,7 @@
 #include "scad/dxf.h"
 #include "scad/lower.h"
 #include "scad/region.h"
+#include "scad/svg.h"
 #include "scad/text.h"
 
 namespace pic::detail::scad {
@@ -466,12 +467,12 @@ class Lowering {
     }
     return apply2(m, region_offset(in, amount, join, tolerance));
   }
-  // import() of a DXF drawing (an SVG is refused), or the legacy `file` argument of an
-  // extrusion.
+  // import() of a DXF or SVG drawing, or the legacy `file` argument of an extrusion.
   Region import_2d(const Node& n) const {
     const std::filesystem::path p = file_arg(n);
     const std::string ext = lower_extension(p);
-    if (ext != ".dxf") fail(n, "2D import of " + ext + " files is not supported (DXF is)");
+    if (ext == ".svg") return read_svg(p, number(n, "dpi", 72));
+    if (ext != ".dxf") fail(n, "2D import of " + ext + " files is not supported (DXF and SVG are)");
     DxfImport how;
     if (const Value* v = arg(n, "layer"); v && v->kind == Value::Kind::String) how.layer = v->text;
     if (const Value* v = arg(n, "origin"); v && v->kind == Value::Kind::Vector) {
