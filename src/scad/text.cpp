@@ -21,23 +21,44 @@ namespace {
 constexpr double kEmPerSize = 100.0 / 72.0;
 constexpr double kAdvanceScale = 1000.0 / 1024.0;
 
+// fontconfig's configuration, loaded once and released at exit (its default global one, from
+// FcInit, is never released).
+class FontConfig {
+ public:
+  FontConfig() : config_(FcInitLoadConfigAndFonts()) {}
+  ~FontConfig() {
+    if (config_) FcConfigDestroy(config_);
+  }
+  FontConfig(const FontConfig&) = delete;
+  FontConfig& operator=(const FontConfig&) = delete;
+
+  // The file of the font that best matches a fontconfig pattern ("Liberation Sans:style=Bold").
+  std::string match(const std::string& pattern) {
+    const std::lock_guard<std::mutex> guard(lock_);  // a configuration is not thread-safe
+    if (!config_) throw InvalidInput("text: fontconfig could not load its configuration");
+    FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(pattern.c_str()));
+    if (!pat) throw InvalidInput("text: bad font name '" + pattern + "'");
+    FcConfigSubstitute(config_, pat, FcMatchPattern);
+    FcDefaultSubstitute(pat);
+    FcResult result;
+    FcPattern* found = FcFontMatch(config_, pat, &result);
+    FcPatternDestroy(pat);
+    std::string file;
+    FcChar8* path = nullptr;
+    if (found && FcPatternGetString(found, FC_FILE, 0, &path) == FcResultMatch) file = reinterpret_cast<const char*>(path);
+    if (found) FcPatternDestroy(found);
+    if (file.empty()) throw InvalidInput("text: no font matches '" + pattern + "' (install fonts-liberation2)");
+    return file;
+  }
+
+ private:
+  FcConfig* config_;
+  std::mutex lock_;
+};
+
 std::string font_file(const std::string& pattern) {
-  static std::mutex lock;  // fontconfig's configuration is not thread-safe
-  const std::lock_guard<std::mutex> guard(lock);
-  if (!FcInit()) throw InvalidInput("text: fontconfig could not start");
-  FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(pattern.empty() ? "Liberation Sans" : pattern.c_str()));
-  if (!pat) throw InvalidInput("text: bad font name '" + pattern + "'");
-  FcConfigSubstitute(nullptr, pat, FcMatchPattern);
-  FcDefaultSubstitute(pat);
-  FcResult result;
-  FcPattern* match = FcFontMatch(nullptr, pat, &result);
-  FcPatternDestroy(pat);
-  std::string file;
-  FcChar8* path = nullptr;
-  if (match && FcPatternGetString(match, FC_FILE, 0, &path) == FcResultMatch) file = reinterpret_cast<const char*>(path);
-  if (match) FcPatternDestroy(match);
-  if (file.empty()) throw InvalidInput("text: no font matches '" + pattern + "' (install fonts-liberation2)");
-  return file;
+  static FontConfig fonts;
+  return fonts.match(pattern.empty() ? "Liberation Sans" : pattern);
 }
 
 // Collects a glyph's outline as rings, each curve cut into `segments` straight pieces.
