@@ -421,6 +421,29 @@ TEST(ScadImport, SvgShapesUnitsAndTransforms) {
   EXPECT_THROW(outline_of("import(file = \"" + (dir / "bad.svg").string() + "\");"), InvalidInput);
 }
 
+// The 2D rounded rectangle: a 10 x 4 rectangle plus a 16-gon of radius 1 (vertices at 0, 22.5,
+// ... degrees: 2 wide and 2 high) is the rectangle, a 1-wide strip along each side and the
+// 16-gon's area at the corners; moved once by the translation.
+TEST(ScadMinkowski, TwoDimensionalRoundedRectangle) {
+  const double gon = 8 * std::sin(2 * std::numbers::pi / 16);  // (16 / 2) r^2 sin(2 pi / 16)
+  const Outline o = outline_of(
+      "multmatrix([[1, 0, 0, 50], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) { minkowski() { "
+      "square(size = [10, 4]); circle(r = 1, $fn = 16); } }");
+  EXPECT_NEAR(area(o), 40 + 2 * 10 + 2 * 4 + gon, 1e-6);
+  double lo = 1e300;
+  for (const auto& r : o.rings)
+    for (const auto& p : r) lo = std::min(lo, p[0]);
+  EXPECT_NEAR(lo, 49, 1e-6);
+  // An L made of two bars (a union of convex parts, not convex) grown by a 1-square centred
+  // on the origin: bars of 7 x 3 and 3 x 7 overlapping in a 3 x 3 square.
+  EXPECT_NEAR(area(outline_of("minkowski() { union() { square(size = [5, 1]); square(size = [1, 5]); } "
+                              "square(size = [2, 2], center = true); }")),
+              21 + 21 - 9, 1e-6);
+  EXPECT_THROW(outline_of("minkowski() { difference() { square(size = [4, 4]); square(size = [2, 2]); } "
+                          "circle(r = 1); }"),
+               InvalidInput);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

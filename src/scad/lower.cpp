@@ -388,7 +388,7 @@ class Lowering {
     if (k == "cube" || k == "sphere" || k == "cylinder" || k == "polyhedron" || k == "linear_extrude" ||
         k == "rotate_extrude")
       fail(n, "a 3D object inside a 2D subtree");
-    if (k == "minkowski") fail(n, "2D minkowski is not supported");
+    if (k == "minkowski") return minkowski_2d(n, m);
     throw InvalidInput("line " + std::to_string(n.line) + ": unsupported node '" + k + "'");
   }
   // resize(newsize, auto): per axis newsize / size where newsize > 0; an axis left at 0 keeps
@@ -418,6 +418,52 @@ class Lowering {
     for (int a = 0; a < dims; ++a)
       if (!(want[a] > 0) && automatic[a] && largest > 0) f[a] = largest;
     return f;
+  }
+
+  // 2D minkowski() of operands that are unions of convex parts: the union of the hulls of the
+  // parts' vertex sums, as in 3D.
+  Region minkowski_2d(const Node& n, const Affine2& m) {
+    std::vector<Ring> acc;
+    bool first = true;
+    for (const Node& c : n.children) {
+      std::vector<Ring> parts;
+      convex_parts_2d(n, c, kIdentity2, parts);
+      if (parts.empty()) continue;
+      if (first) {
+        acc = std::move(parts);
+        first = false;
+        continue;
+      }
+      std::vector<Ring> next;
+      for (const Ring& p : acc)
+        for (const Ring& q : parts) {
+          std::vector<P2> sums;
+          for (const P2& x : p)
+            for (const P2& y : q) sums.push_back({x[0] + y[0], x[1] + y[1]});
+          next.push_back(convex_hull_2d(std::move(sums)));
+        }
+      acc = std::move(next);
+    }
+    return apply2(m, region_union({acc}));
+  }
+  // The convex parts of a 2D operand: the children of its unions kept apart, each evaluated
+  // region's rings convex (no holes). \throws naming the minkowski node otherwise.
+  void convex_parts_2d(const Node& mink, const Node& n, const Affine2& m, std::vector<Ring>& out) {
+    if (is_group(n.name)) {
+      for (const Node& c : n.children) convex_parts_2d(mink, c, m, out);
+      return;
+    }
+    if (n.name == "multmatrix") {
+      const Affine a = matrix(n);
+      for (const Node& c : n.children) convex_parts_2d(mink, c, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]}), out);
+      return;
+    }
+    for (const Ring& ring : shape(n, m)) {
+      const double area = signed_area(ring), hull = signed_area(convex_hull_2d(ring));
+      if (!(area > 0) || std::abs(hull - area) > 1e-9 * hull)
+        fail(mink, "an operand that is not a union of convex parts is not supported");
+      out.push_back(ring);
+    }
   }
 
   std::vector<Region> children2(const Node& n, const Affine2& m) {
