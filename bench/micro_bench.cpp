@@ -7,14 +7,24 @@
 //   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
 //                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
 //   BM_WindingQuery/near         inside/outside by the winding number of the open bunny (69k
-//                                triangles in a dipole tree) at random points: 0 = anywhere in
-//                                its box, 1 = within 1 % of its size from its surface (queries/s)
+//                                triangles) at 4096 random grid points, as the sampler decides
+//                                (integer winding of bunny + caps by a ray, caps' share near
+//                                them), on all threads: 0 = anywhere in its box, 1 = within 1 %
+//                                of its size from its surface (queries/s)
+//   BM_DipoleTreeQuery/near      the same decisions by a dipole tree of all the triangles, one
+//                                query at a time
 //   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
-//                                punched (winding), 2 = the Stanford bunny (open base, winding)
+//                                punched (winding), 2 = the Stanford bunny (open base, winding),
+//                                3 = the bunny with its holes closed by fans (parity): the per-PIC
+//                                cost of 2 against 3 is the winding path's overhead
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <array>
+#include <functional>
 #include <map>
 #include <cmath>
 #include <random>
@@ -26,6 +36,8 @@
 #include "geometry/qef.h"
 #include "octree/cell.h"
 #include "geometry/winding.h"
+#include "mesh/clean.h"
+#include "sample/sources.h"
 #include "../apps/common/allocator_settings.h"
 
 namespace {
@@ -187,7 +199,57 @@ pic::TriMesh spot_with_holes() {
   return m;
 }
 
+/// 4096 grid points in the bunny's bounding cube: anywhere in it, or within 1 % of the cube's
+/// size from a vertex of the bunny.
+std::vector<pic::detail::I3> query_points(bool near) {
+  const pic::TriMesh& m = mesh_of("stanford-bunny.obj");
+  const pic::Cube c = pic::bounding_cube(m);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1), off(-0.01, 0.01);
+  std::vector<pic::detail::I3> pts(4096);
+  for (auto& g : pts) {
+    pic::Vec3 p{u(rng), u(rng), u(rng)};
+    if (near) {
+      p = pic::detail::world_to_unit(c, m.positions[rng() % m.positions.size()]);
+      for (double& x : p) x = std::clamp(x + off(rng), 1e-6, 1 - 1e-6);
+    }
+    g = pic::detail::to_grid(p);
+  }
+  return pts;
+}
+
+// Inside/outside of the open bunny by its generalized winding number, as the sampler decides
+// it: the integer winding number of bunny + caps by a ray, minus the caps' share near them.
 void BM_WindingQuery(benchmark::State& state) {
+  static const auto input = [] {
+    const pic::detail::CleanMesh c = pic::detail::clean_mesh(mesh_of("stanford-bunny.obj"));
+    const pic::Cube cube = pic::bounding_cube(c.mesh);
+    std::vector<pic::detail::I3> grid;
+    for (const auto& p : c.mesh.positions) grid.push_back(pic::detail::to_grid(pic::detail::world_to_unit(cube, p)));
+    return pic::detail::winding_input(c.mesh, grid, 1.0 / 4096, nullptr);
+  }();
+  const std::vector<pic::detail::I3> pts = query_points(state.range(0) != 0);
+  size_t inside = 0;
+  for (auto _ : state) {
+    inside = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, pts.size()), size_t{0},
+        [&](const tbb::blocked_range<size_t>& r, size_t n) {
+          for (size_t i = r.begin(); i < r.end(); ++i) n += input.source->inside(pts[i]);
+          return n;
+        },
+        std::plus<>());
+  }
+  benchmark::DoNotOptimize(inside);
+  state.SetLabel(state.range(0) ? "bunny, near the surface" : "bunny, anywhere in its box");
+  state.counters["queries/s"] =
+      benchmark::Counter(static_cast<double>(pts.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["inside"] = static_cast<double>(inside) / static_cast<double>(pts.size());
+}
+BENCHMARK(BM_WindingQuery)->ArgName("near")->Arg(0)->Arg(1)->UseRealTime();
+
+// The same decisions by a dipole tree over all of the bunny's triangles (the general fast
+// winding number, one query at a time): the yardstick the construction above is measured by.
+void BM_DipoleTreeQuery(benchmark::State& state) {
   const pic::TriMesh& m = mesh_of("stanford-bunny.obj");
   const pic::Cube c = pic::bounding_cube(m);
   static pic::detail::DipoleTree tree;
@@ -200,42 +262,45 @@ void BM_WindingQuery(benchmark::State& state) {
     }
     tree.build_triangles(std::move(tris));
   }
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(0, 1), off(-0.01, 0.01);
-  std::vector<pic::Vec3> pts(4096);
-  for (auto& p : pts) {
-    if (state.range(0) == 0) {
-      p = {u(rng), u(rng), u(rng)};
-    } else {
-      p = pic::detail::world_to_unit(c, m.positions[rng() % m.positions.size()]);
-      for (double& x : p) x += off(rng);
-    }
-  }
+  const std::vector<pic::detail::I3> pts = query_points(state.range(0) != 0);
   size_t inside = 0, i = 0;
   for (auto _ : state) {
-    const pic::detail::I3 g = pic::detail::to_grid(pts[i++ % pts.size()]);
+    const pic::detail::I3& g = pts[i++ % pts.size()];
     inside += tree.inside(pic::detail::to_unit(g), &g, 0, 0.05);
   }
   benchmark::DoNotOptimize(inside);
   state.SetLabel(state.range(0) ? "bunny, near the surface" : "bunny, anywhere in its box");
   state.counters["queries/s"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_WindingQuery)->ArgName("near")->Arg(0)->Arg(1);
+BENCHMARK(BM_DipoleTreeQuery)->ArgName("near")->Arg(0)->Arg(1);
+
+/// The bunny with each boundary loop closed by fans on its own vertices: the same surface away
+/// from the holes, and closed, so it takes the parity path.
+pic::TriMesh bunny_closed() {
+  pic::detail::CleanMesh c = pic::detail::clean_mesh(mesh_of("stanford-bunny.obj"));
+  for (const auto& t : pic::detail::cap_loops(pic::detail::boundary_chain(c.mesh))) c.mesh.triangles.push_back(t);
+  return c.mesh;
+}
 
 void BM_SampleAnyInput(benchmark::State& state) {
-  static const pic::TriMesh holes = spot_with_holes();
+  static const pic::TriMesh holes = spot_with_holes(), closed = bunny_closed();
   const int k = static_cast<int>(state.range(0));
-  const pic::TriMesh& m = k == 0 ? mesh_of("spot.obj") : k == 1 ? holes : mesh_of("stanford-bunny.obj");
+  const pic::TriMesh& m = k == 0   ? mesh_of("spot.obj")
+                          : k == 1 ? holes
+                          : k == 2 ? mesh_of("stanford-bunny.obj")
+                                   : closed;
   pic::SampleStats st;
   for (auto _ : state) {
     auto t = pic::sample(m, pic::SampleOptions{}, &st);
     benchmark::DoNotOptimize(t);
   }
-  state.SetLabel(k == 0 ? "spot" : k == 1 ? "spot with holes" : "stanford bunny");
+  state.SetLabel(k == 0 ? "spot" : k == 1 ? "spot with holes" : k == 2 ? "stanford bunny" : "bunny, holes fanned");
   state.counters["PICs"] = static_cast<double>(st.pics);
+  state.counters["us_per_PIC"] = benchmark::Counter(static_cast<double>(st.pics) * 1e-6,
+                                                    benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["boundary_edges"] = static_cast<double>(st.defects.boundary_edges);
 }
-BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The allocator settings of the command-line tool, so both measure the same thing.
 int main(int argc, char** argv) {

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "mesh/clean.h"
+#include "sample/sources.h"
 #include "support/shapes.h"
 #include "geometry/winding.h"
 
@@ -117,6 +118,35 @@ TEST(Winding, CapsCloseTheBoundaryChain) {
   for (const auto& t : detail::cap_loops(chain, &loops)) closed.triangles.push_back(t);
   EXPECT_GE(loops, 2u);
   EXPECT_TRUE(detail::boundary_chain(closed).empty());
+}
+
+// The sampler's decision at a lattice point (integer winding of mesh + caps by a ray, minus the
+// caps' share) is the exact sum's wherever that is not within the caps' tolerance (0.05) of 1/2:
+// an open sphere with two holes, one of them large, and a flipped triangle.
+TEST(Winding, RayAndCapsDecideAsTheExactSum) {
+  TriMesh s = make_sphere({0.5, 0.5, 0.5}, 0.3, 40);
+  std::erase_if(s.triangles, [&](const auto& t) { return s.positions[t[0]][2] > 0.7 || s.positions[t[0]][0] < 0.25; });
+  std::swap(s.triangles[10][1], s.triangles[10][2]);
+  const detail::CleanMesh clean = detail::clean_mesh(s);
+  std::vector<I3> grid;
+  for (const Vec3& p : clean.mesh.positions) grid.push_back(detail::to_grid(p));
+  size_t loops = 0;
+  const detail::WindingInput in = detail::winding_input(clean.mesh, grid, 1.0 / 1024, &loops);
+  EXPECT_EQ(loops, 2u);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.05, 0.95);
+  int checked = 0, inside = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const I3 g = detail::to_grid({u(rng), u(rng), u(rng)});
+    const double w = exact_winding(clean.mesh, detail::to_unit(g));
+    if (std::abs(std::abs(w) - 0.5) < 0.05) continue;
+    ++checked;
+    inside += std::abs(w) >= 0.5;
+    const Vec3 q = detail::to_unit(g);
+    ASSERT_EQ(in.source->inside(g), std::abs(w) >= 0.5) << "w " << w << " at " << q[0] << " " << q[1] << " " << q[2];
+  }
+  EXPECT_GT(checked, 3500);
+  EXPECT_GT(inside, 100);
 }
 
 TEST(Winding, BoundaryFieldIsTheLevelSetNormalOfAFlatHole) {

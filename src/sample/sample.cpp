@@ -146,45 +146,11 @@ Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const
   return tree;
 }
 
-/// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
-std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
-                            double margin, double spread) {
-  std::vector<Box> out;
-  for (const auto& loop : loops) {
-    Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
-    for (uint32_t v : loop) {
-      const Vec3 p = to_unit(grid[v]);
-      for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], p[k]), b.hi[k] = std::max(b.hi[k], p[k]);
-    }
-    const double grow = margin + spread * norm3(sub3(b.hi, b.lo));
-    for (int k = 0; k < 3; ++k) b.lo[k] -= grow, b.hi[k] += grow;
-    out.push_back(b);
-  }
-  return out;
-}
-
 Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
                       const Cube& cube, SampleStats& st, size_t& capped) {
-  // Close the input's boundary with caps: input + caps has an exact integer winding number.
-  const auto chain = boundary_chain(clean.mesh);
-  const auto cones = cap_loops(chain, &st.boundary_loops);
-  const std::vector<I3>& g = grid;
-  std::vector<ITri> tris;
-  tris.reserve(clean.mesh.triangles.size() + cones.size());
-  for (const auto& t : clean.mesh.triangles) tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
-  for (const auto& t : cones) {
-    tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
-    tris.back().use = 0;  // a cap: counts in the winding number, is no part of the surface
-  }
-  std::vector<std::array<Vec3, 2>> boundary;
-  boundary.reserve(chain.size());
-  for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
-  // Caps decide signs only in their loops' boxes (two cells of slack): a box holds its loop's
-  // convex hull, outside which the signs are parity's (see WindingSource::inside).
-  const auto loops = boundary_loops(chain);
   const double cell = 1.0 / double(int64_t{1} << options.depth);
-  WindingSource src(std::move(tris), clean.mesh.triangles.size(), std::move(boundary),
-                    loop_boxes(loops, grid, 2 * cell, 0));
+  WindingInput in = winding_input(clean.mesh, grid, cell, &st.boundary_loops);
+  WindingSource& src = *in.source;
   // Interior walls exist only where parts meet or overlap.
   if (clean.defects.shells > 1 || clean.defects.nonmanifold_edges > 0)
     st.interior_triangles = src.drop_interior_triangles();
@@ -197,7 +163,7 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   // Islands and cracks come from the caps' decisions and from uniform cells whose triangles
   // showed no sign change (the sampler's only departures from crossing parity): settle there,
   // with room for the leaves around them.
-  SettleRegion region{false, loop_boxes(loops, grid, 16 * cell, 0.1)};
+  SettleRegion region{false, loop_boxes(in.loops, grid, 16 * cell, 0.1)};
   for (const Cell& c : src.skipped_cells()) {
     const Vec3 lo = c.min_unit();
     const double s = c.size();

@@ -7,9 +7,14 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <map>
 #include <unordered_map>
 
+#include <Eigen/Dense>
+
 #include "geometry/vec3.h"
+#include "mesh/clean.h"
+#include "geometry/union_find.h"
 
 namespace pic::detail {
 namespace {
@@ -138,9 +143,117 @@ void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, 
 
 // ---- triangle soups -----------------------------------------------------------------------
 
+/// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
+std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
+                            double margin, double spread) {
+  std::vector<Box> out;
+  for (const auto& loop : loops) {
+    Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+    for (uint32_t v : loop) {
+      const Vec3 p = to_unit(grid[v]);
+      for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], p[k]), b.hi[k] = std::max(b.hi[k], p[k]);
+    }
+    const double grow = margin + spread * norm3(sub3(b.hi, b.lo));
+    for (int k = 0; k < 3; ++k) b.lo[k] -= grow, b.hi[k] += grow;
+    out.push_back(b);
+  }
+  return out;
+}
+
+/// Each connected cap's oriented box: principal axes of its vertices.
+std::vector<CapExtent> cap_extents(const std::vector<std::array<uint32_t, 3>>& cones, const std::vector<I3>& grid) {
+  std::unordered_map<uint32_t, uint32_t> dense;
+  std::vector<uint32_t> verts;
+  for (const auto& t : cones)
+    for (uint32_t v : t)
+      if (dense.emplace(v, uint32_t(dense.size())).second) verts.push_back(v);
+  UnionFind sets(dense.size());
+  for (const auto& t : cones) sets.join(dense[t[0]], dense[t[1]]), sets.join(dense[t[0]], dense[t[2]]);
+  std::map<size_t, std::vector<Eigen::Vector3d>> parts;  // ordered: deterministic
+  for (size_t i = 0; i < verts.size(); ++i) {
+    const Vec3 p = to_unit(grid[verts[i]]);
+    parts[sets.root(i)].emplace_back(p[0], p[1], p[2]);
+  }
+  std::vector<CapExtent> out;
+  for (const auto& [root, pts] : parts) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) mean += p;
+    mean /= double(pts.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
+    const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (const auto& p : pts) {
+      const Eigen::Vector3d q = axes.transpose() * (p - mean);
+      lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    }
+    const Eigen::Vector3d c = mean + axes * ((lo + hi) / 2), half = (hi - lo) / 2;
+    CapExtent e;
+    e.centre = {c[0], c[1], c[2]};
+    for (int k = 0; k < 3; ++k) e.axes[k] = {axes(0, k), axes(1, k), axes(2, k)}, e.half[k] = half[k];
+    out.push_back(e);
+  }
+  return out;
+}
+
+WindingInput winding_input(const TriMesh& mesh, const std::vector<I3>& grid, double cell, size_t* loop_count) {
+  // Close the input's boundary with caps: input + caps has an exact integer winding number.
+  const auto chain = boundary_chain(mesh);
+  const auto cones = cap_loops(chain, loop_count);
+  const std::vector<I3>& g = grid;
+  std::vector<ITri> tris;
+  tris.reserve(mesh.triangles.size() + cones.size());
+  for (const auto& t : mesh.triangles) tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+  for (const auto& t : cones) {
+    tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
+    tris.back().use = 0;  // a cap: counts in the winding number, is no part of the surface
+  }
+  std::vector<std::array<Vec3, 2>> boundary;
+  boundary.reserve(chain.size());
+  for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
+  WindingInput in;
+  in.loops = boundary_loops(chain);
+  in.source = std::make_unique<WindingSource>(std::move(tris), mesh.triangles.size(), std::move(boundary),
+                                              cap_extents(cones, grid), 2 * cell);
+  return in;
+}
+
+namespace {
+
+std::vector<CapExtent> grown(std::vector<CapExtent> caps, double margin) {
+  for (CapExtent& c : caps)
+    for (double& h : c.half) h += margin;
+  return caps;
+}
+
+/// A cap in the ball (c, r) seen from distance D covers at most that ball's cone: its
+/// |w| <= (1 - sqrt(1 - r^2 / D^2)) / 2 (unless it winds twice round some direction seen from
+/// there). A cap reaches as far as that bound exceeds `far_share`.
+double cone_cover(double r, double d) {
+  if (d <= r) return 0.5;
+  const double s = r / d;
+  return (1 - std::sqrt(1 - s * s)) / 2;
+}
+std::vector<Box> reach_boxes(const std::vector<CapExtent>& caps, double far_share) {
+  const double reach = 1 / std::sqrt(1 - (1 - 2 * far_share) * (1 - 2 * far_share));  // D / r
+  std::vector<Box> boxes;
+  for (const CapExtent& c : caps) {
+    const double d = reach * c.radius();
+    boxes.push_back({{c.centre[0] - d, c.centre[1] - d, c.centre[2] - d}, {c.centre[0] + d, c.centre[1] + d, c.centre[2] + d}});
+  }
+  return boxes;
+}
+
+}  // namespace
+
 WindingSource::WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary,
-                             std::vector<Box> cap_boxes)
-    : all_(std::move(tris)), mesh_count_(mesh_count), cap_boxes_(cap_boxes), boundary_(std::move(boundary)) {
+                             std::vector<CapExtent> caps, double margin)
+    : all_(std::move(tris)),
+      mesh_count_(mesh_count),
+      cap_extents_(grown(std::move(caps), margin)),
+      far_share_(0.25 / double(std::max<size_t>(cap_extents_.size(), 1))),
+      cap_boxes_(reach_boxes(cap_extents_, far_share_)),
+      boundary_(std::move(boundary)) {
   tris_ = &all_;
   if (all_.size() > mesh_count_) caps_.build_triangles({all_.begin() + long(mesh_count_), all_.end()});
 }
@@ -182,19 +295,69 @@ int32_t WindingSource::winding_from(const I3& a, int32_t w, const I3& b) const {
   return winding_along_axes(all_, near, a, w, b);
 }
 
-bool WindingSource::near_caps(const Box& box) const {
-  bool near = false;
-  cap_boxes_.query(box, [&](uint32_t) { near = true; });
-  return near;
+double CapExtent::cover(const Vec3& u) const {
+  const Vec3 d = sub3(u, centre);
+  const Vec3 q{dot3(d, axes[0]), dot3(d, axes[1]), dot3(d, axes[2])};
+  double w = 0;
+  bool outside = false;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(q[i]) <= half[i]) continue;
+    outside = true;  // the face on u's side along axis i is in view
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    Vec3 c[4];
+    for (int m = 0; m < 4; ++m) {
+      c[m][i] = q[i] > 0 ? half[i] : -half[i];
+      c[m][j] = (m == 1 || m == 2) ? half[j] : -half[j];
+      c[m][k] = m >= 2 ? half[k] : -half[k];
+    }
+    w += std::abs(triangle_winding(q, c[0], c[1], c[2])) + std::abs(triangle_winding(q, c[0], c[2], c[3]));
+  }
+  return outside ? w : 0.5;
+}
+
+bool CapExtent::apart(const Box& b) const {
+  // Separated along one of the box's own axes (sufficient, not necessary).
+  const Vec3 c{(b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2, (b.lo[2] + b.hi[2]) / 2};
+  const Vec3 h{(b.hi[0] - b.lo[0]) / 2, (b.hi[1] - b.lo[1]) / 2, (b.hi[2] - b.lo[2]) / 2};
+  const Vec3 d = sub3(c, centre);
+  for (int i = 0; i < 3; ++i) {
+    const Vec3& a = axes[i];
+    const double spread = std::abs(a[0]) * h[0] + std::abs(a[1]) * h[1] + std::abs(a[2]) * h[2];
+    if (std::abs(dot3(d, a)) > half[i] + spread) return true;
+  }
+  return false;
+}
+
+bool WindingSource::caps_below_half(const Box& b) const {
+  // Caps out of reach add at most far_share_ each; those in reach what their ball allows from
+  // the nearest point of b (and, for a point, their box). A cap alone, seen from outside its
+  // box, covers less than a hemisphere.
+  const bool point = b.lo == b.hi;
+  double sum = 0;
+  size_t in_reach = 0;
+  bool alone_apart = false;
+  cap_boxes_.query(b, [&](uint32_t k) {
+    ++in_reach;
+    const CapExtent& c = cap_extents_[k];
+    if (cap_extents_.size() == 1) alone_apart = c.apart(b);
+    if (sum >= 0.5) return;
+    double d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double gap = std::max({b.lo[i] - c.centre[i], c.centre[i] - b.hi[i], 0.0});
+      d2 += gap * gap;
+    }
+    const double ball = cone_cover(c.radius(), std::sqrt(d2));
+    sum += point && ball > 0.05 ? std::min(ball, c.cover(b.lo)) : ball;
+  });
+  return alone_apart || sum + far_share_ * double(cap_extents_.size() - in_reach) < 0.5;
 }
 
 bool WindingSource::inside(const I3& p, int32_t w) const {
   if (caps_.empty()) return w != 0;
-  // Outside a loop's convex hull its cap subtends less than a hemisphere (unless the loop,
-  // seen from p, winds twice round some direction), so |w_C| < 1/2 and |w - w_C| >= 1/2
-  // exactly when w != 0. Most decisions near the input's surface are settled here.
+  // Where the caps' |w_C| < 1/2 is certain, |w - w_C| >= 1/2 exactly when w != 0. Most
+  // decisions near the input's surface are settled here.
   const Vec3 u = to_unit(p);
-  if (!near_caps({u, u})) return w != 0;
+  if (caps_below_half({u, u})) return w != 0;
   if (const auto far = caps_.inside_far(u, w)) return *far;
   if (const int known = cache_.find(p); known >= 0) return known;
   const bool in = caps_.inside(u, &p, w, kCapTolerance);
@@ -230,7 +393,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     // Away from the caps the signs are parity's: every sign change on an edge is a crossing of
     // the input's surface (all of it in the QEF) — unless a triangle dropped as an interior
     // wall was not one everywhere.
-    if (!near_caps({cell.min_unit(), cell.max_unit()})) return;
+    if (caps_below_half({cell.min_unit(), cell.max_unit()})) return;
   }
   const i64 len = lattice_to_grid(cell.span());
   for (int e = 0; e < 12; ++e) {

@@ -19,6 +19,7 @@
 #include "geometry/box_tree.h"
 #include "geometry/bvh.h"
 #include "sample/sampler.h"
+#include "geometry/vec3.h"
 #include "geometry/winding.h"
 
 namespace pic::detail {
@@ -39,13 +40,27 @@ class DecisionCache {
   uint32_t id_;  // tells this source's entries from an earlier source's in the same thread
 };
 
+/// A connected cap's extent: an oriented box around its vertices (so around its convex hull),
+/// axes along their principal directions (a flat cap gets a thin box).
+struct CapExtent {
+  Vec3 centre;
+  std::array<Vec3, 3> axes;  ///< orthonormal
+  Vec3 half;                 ///< half-extents along the axes
+  double radius() const { return norm3(half); }
+  /// An upper bound on |w| of anything inside the box seen from u: the solid angle of the faces
+  /// u sees, over 4 pi (1/2 when u is in the box).
+  double cover(const Vec3& u) const;
+  /// Whether `b` certainly does not meet the box.
+  bool apart(const Box& b) const;
+};
+
 class WindingSource : public SurfaceSource {
  public:
   /// `tris`: the input's triangles followed by the cone triangles (use = 0) closing it;
-  /// `boundary`: the input's boundary edges; `cap_boxes`: a box around each boundary loop
-  /// (unit space), outside which the caps' solid angle is taken to be below 1/2.
+  /// `boundary`: the input's boundary edges; `caps`: each connected cap's extent (unit
+  /// space), grown by `margin`.
   WindingSource(std::vector<ITri> tris, size_t mesh_count, std::vector<std::array<Vec3, 2>> boundary,
-                std::vector<Box> cap_boxes);
+                std::vector<CapExtent> caps, double margin);
   void child_grid_signs(const Cell& cell, const std::vector<uint32_t>& idx, std::array<bool, 27>& grid,
                         Wind27* wind) const override;
   bool tracks_winding() const override { return true; }
@@ -60,6 +75,8 @@ class WindingSource : public SurfaceSource {
   int32_t winding_from(const I3& a, int32_t w, const I3& b) const;
   /// The sign at grid point p whose integer winding number is w.
   bool inside(const I3& p, int32_t w) const;
+  /// The sign at any grid point (its integer winding number by a ray): a query on its own.
+  bool inside(const I3& p) const { return inside(p, ray_winding(p)); }
   /// Integer winding number at grid point p of `cell` (corner windings `wind`), by a path
   /// along the cell's edges directions from its first corner.
   int32_t winding_in_cell(const Cell& cell, const Wind8& wind, const std::vector<uint32_t>& idx, const I3& p) const;
@@ -72,8 +89,9 @@ class WindingSource : public SurfaceSource {
   size_t drop_interior_triangles();
 
  private:
-  /// Whether `box` (unit space) meets a boundary loop's box: only there do the caps decide.
-  bool near_caps(const Box& box) const;
+  /// Whether the caps' winding number is certainly below 1/2 in magnitude all over `box` (unit
+  /// space): there the caps cannot move a decision.
+  bool caps_below_half(const Box& box) const;
 
   std::vector<ITri> all_;
   size_t mesh_count_;
@@ -81,12 +99,27 @@ class WindingSource : public SurfaceSource {
   mutable TriangleBvh bvh_;  // built on the first ray
   mutable std::once_flag bvh_built_;
   DipoleTree caps_;
-  BoxTree cap_boxes_;
+  std::vector<CapExtent> cap_extents_;
+  double far_share_ = 0;  // the most a cap out of reach adds to |w_C|
+  BoxTree cap_boxes_;     // the caps' reach, one box per cap
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
   DecisionCache cache_;
   mutable std::mutex skipped_mutex_;
   mutable std::vector<Cell> skipped_;
 };
+
+/// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
+std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
+                            double margin, double spread);
+
+/// A cleaned mesh (vertices at `grid`) made ready for winding-number decisions: the input
+/// closed by caps over its boundary loops, which decide signs only near their loops.
+struct WindingInput {
+  std::unique_ptr<WindingSource> source;
+  std::vector<std::vector<uint32_t>> loops;  ///< the input's boundary loops (vertex indices)
+};
+/// `cell`: a finest cell (unit space), the caps' slack; `loop_count`: how many loops were capped.
+WindingInput winding_input(const TriMesh& mesh, const std::vector<I3>& grid, double cell, size_t* loop_count);
 
 class PointSource : public SurfaceSource {
  public:
