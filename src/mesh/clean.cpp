@@ -1,8 +1,5 @@
 #include "mesh/clean.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 #include <cstring>
 #include <unordered_map>
@@ -48,17 +45,58 @@ struct EdgeUse {
   int32_t dir;  // +1: the triangle traverses it low -> high, -1: high -> low
   bool operator<(const EdgeUse& o) const { return key != o.key ? key < o.key : tri < o.tri; }
 };
+/// Items bucketed by a vertex (counting sort): `start[v]..start[v + 1]` index `order` for
+/// vertex v, items in their order within a bucket.
+struct Buckets {
+  std::vector<uint32_t> start, order;
+};
+template <class Vertex>
+Buckets bucket_by_vertex(size_t vertices, size_t items, Vertex&& vertex_of) {
+  Buckets b;
+  b.start.assign(vertices + 1, 0);
+  for (size_t i = 0; i < items; ++i) ++b.start[vertex_of(i) + 1];
+  for (size_t v = 0; v < vertices; ++v) b.start[v + 1] += b.start[v];
+  b.order.resize(items);
+  std::vector<uint32_t> fill(b.start.begin(), b.start.end() - 1);
+  for (size_t i = 0; i < items; ++i) b.order[fill[vertex_of(i)]++] = uint32_t(i);
+  return b;
+}
+
 std::vector<EdgeUse> edge_uses(const TriMesh& m) {
-  std::vector<EdgeUse> uses(m.triangles.size() * 3);
-  tbb::parallel_for(size_t{0}, m.triangles.size(), [&](size_t f) {
-    const auto& t = m.triangles[f];
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = t[e], b = t[(e + 1) % 3];
-      uses[3 * f + e] = {edge_key(a, b), uint32_t(f), a < b ? 1 : -1};
-    }
-  });
-  tbb::parallel_sort(uses.begin(), uses.end());
+  // Bucketed by the edge's lower vertex, then each short run sorted: linear and serial (in a
+  // fresh process a parallel sort's thread start-up cost more than the whole sort).
+  const auto use = [&](size_t i) {
+    const auto& t = m.triangles[i / 3];
+    const uint32_t a = t[i % 3], b = t[(i % 3 + 1) % 3];
+    return EdgeUse{edge_key(a, b), uint32_t(i / 3), a < b ? 1 : -1};
+  };
+  const size_t n = m.triangles.size() * 3;
+  const Buckets b = bucket_by_vertex(m.positions.size(), n, [&](size_t i) { return uint32_t(use(i).key >> 32); });
+  std::vector<EdgeUse> uses(n);
+  for (size_t i = 0; i < n; ++i) uses[i] = use(b.order[i]);
+  for (size_t v = 0; v + 1 < b.start.size(); ++v)
+    if (b.start[v + 1] - b.start[v] > 1) std::sort(uses.begin() + b.start[v], uses.begin() + b.start[v + 1]);
   return uses;
+}
+
+/// Whether two non-degenerate triangles have the same three vertices (in any order).
+bool has_repeats(const TriMesh& m) {
+  const auto sorted = [&](size_t f) {
+    auto t = m.triangles[f];
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  const Buckets b = bucket_by_vertex(m.positions.size(), m.triangles.size(), [&](size_t f) { return sorted(f)[0]; });
+  std::vector<std::array<uint32_t, 3>> run;
+  for (size_t v = 0; v + 1 < b.start.size(); ++v) {
+    if (b.start[v + 1] - b.start[v] < 2) continue;
+    run.clear();
+    for (uint32_t i = b.start[v]; i < b.start[v + 1]; ++i)
+      if (!degenerate(m.triangles[b.order[i]])) run.push_back(sorted(b.order[i]));
+    std::sort(run.begin(), run.end());
+    if (std::adjacent_find(run.begin(), run.end()) != run.end()) return true;
+  }
+  return false;
 }
 
 // Calls f(key, first, count, net) for each undirected edge's run of uses.
@@ -119,6 +157,14 @@ void count_defects(const TriMesh& m, const std::vector<EdgeUse>& uses, MeshDefec
 TriMesh drop_repeats(const TriMesh& in, MeshDefects& d) {
   TriMesh out;
   out.positions = in.positions;
+  if (!has_repeats(in)) {  // the common case, without a hash table
+    out.triangles.reserve(in.triangles.size());
+    for (const auto& t : in.triangles) {
+      if (degenerate(t)) ++d.degenerate_faces;
+      else out.triangles.push_back(t);
+    }
+    return out;
+  }
   std::unordered_map<std::array<uint32_t, 3>, uint32_t, TriHash> seen;  // canonical -> slot
   std::vector<bool> keep;
   for (const auto& t : in.triangles) {

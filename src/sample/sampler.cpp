@@ -2,7 +2,9 @@
 
 #include "geometry/vec3.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <atomic>
@@ -15,6 +17,9 @@
 #include <unordered_map>
 
 namespace pic::detail {
+
+// Cells with at least this many triangles share their per-triangle work between threads.
+constexpr size_t kParallelTris = 4096;
 
 size_t memo_slot(const I3& p, uint64_t extra, int bits) {
   const uint64_t h = (uint64_t(p[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(p[1]) * 0xC2B2AE3D27D4EB4Full) ^
@@ -46,18 +51,30 @@ void MeshSource::child_grid_signs(const Cell& cell, const std::vector<uint32_t>&
   // One pass over the triangles (not one per segment): each triangle's box says which grid
   // lines it can cross, and only those get the exact test. Bit `to` = crossing parity of
   // segment `to`.
-  uint32_t parity = 0;
-  for (uint32_t k : idx) {
-    const ITri& t = (*tris_)[k];
-    const LineMask mask = line_mask(t, base, h, 3);
-    for (const GridSegment& s : kGridSegments) {
-      if (!mask.may_cross(s.axis, s.i, s.ci, s.j, s.cj)) continue;
-      I3 start = base;
-      start[s.i] += s.ci * h;
-      start[s.j] += s.cj * h;
-      if (crosses(t, start, s.axis, h)) parity ^= 1u << s.to;
+  auto parity_of = [&](size_t begin, size_t end) {
+    uint32_t parity = 0;
+    for (size_t i = begin; i < end; ++i) {
+      const ITri& t = (*tris_)[idx[i]];
+      const LineMask mask = line_mask(t, base, h, 3);
+      for (const GridSegment& s : kGridSegments) {
+        if (!mask.may_cross(s.axis, s.i, s.ci, s.j, s.cj)) continue;
+        I3 start = base;
+        start[s.i] += s.ci * h;
+        start[s.j] += s.cj * h;
+        if (crosses(t, start, s.axis, h)) parity ^= 1u << s.to;
+      }
     }
-  }
+    return parity;
+  };
+  // The top cells hold most of the triangles: there the work is shared out (parity is an
+  // exclusive or, so the blocks' order does not matter).
+  const uint32_t parity =
+      idx.size() < kParallelTris
+          ? parity_of(0, idx.size())
+          : tbb::parallel_reduce(
+                tbb::blocked_range<size_t>(0, idx.size(), kParallelTris / 4), uint32_t{0},
+                [&](const tbb::blocked_range<size_t>& r, uint32_t p) { return p ^ parity_of(r.begin(), r.end()); },
+                [](uint32_t a, uint32_t b) { return a ^ b; });
   for (const GridSegment& s : kGridSegments) g[s.to] = g[s.from] ^ ((parity >> s.to) & 1);
 }
 
@@ -109,16 +126,19 @@ void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx
     if (overlaps_box(tris[k], b.lo, b.hi)) out.push_back(k);
 }
 
-void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-                std::array<std::vector<uint32_t>, 8>& out) {
+namespace {
+
+/// split_tris over idx[begin, end), appending to `out`.
+void split_range(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, size_t begin, size_t end,
+                 const Cell& cell, std::array<std::vector<uint32_t>, 8>& out) {
   std::array<IBox, 8> boxes;
   for (int c = 0; c < 8; ++c) {
-    out[c].clear();
     boxes[c] = cell.child(c).box();
   }
   const IBox b = cell.box();
   const I3 mid = boxes[7].lo;
-  for (uint32_t k : idx) {
+  for (size_t i = begin; i < end; ++i) {
+    const uint32_t k = idx[i];
     const ITri& t = tris[k];
     // Per axis, which halves (closed) the box reaches: bit 0 low, bit 1 high.
     std::array<unsigned, 3> halves{};
@@ -140,6 +160,25 @@ void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx,
       out[c].push_back(k);
     }
   }
+}
+
+}  // namespace
+
+void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                std::array<std::vector<uint32_t>, 8>& out) {
+  for (auto& o : out) o.clear();
+  if (idx.size() < kParallelTris) {
+    split_range(tris, idx, 0, idx.size(), cell, out);
+    return;
+  }
+  // Blocks in parallel, joined in order: the same lists as one pass.
+  const size_t block = kParallelTris / 4, blocks = (idx.size() + block - 1) / block;
+  std::vector<std::array<std::vector<uint32_t>, 8>> parts(blocks);
+  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
+    split_range(tris, idx, b * block, std::min(idx.size(), (b + 1) * block), cell, parts[b]);
+  });
+  for (const auto& part : parts)
+    for (int c = 0; c < 8; ++c) out[c].insert(out[c].end(), part[c].begin(), part[c].end());
 }
 
 namespace {
