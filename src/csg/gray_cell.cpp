@@ -107,6 +107,12 @@ EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axi
 
 }  // namespace
 
+/// Crossings of the two operands this close (unit cube) are one: coplanar faces of the two
+/// operands (a cutter flush with a face) come through their stored float vertices up to a few
+/// float steps of the unit cube apart, and would otherwise count as two crossings and refine
+/// the whole shared face's rim to the depth cap. A sliver this thin is far below a finest cell.
+constexpr double kCoincident = 0x1p-22;
+
 /// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
 /// Table 1): two result crossings on one edge force a subdivision, as do two crossings of one
 /// operand on an edge of a virtual cell.
@@ -129,7 +135,7 @@ EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Opera
     auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
     auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
     int n_r = 0;
-    if (ea.change && eb.change && ea.t == eb.t) {
+    if (ea.change && eb.change && std::abs(ea.t - eb.t) * cell.size() <= kCoincident) {
       n_r = apply(op, a0, b0) != apply(op, !a0, !b0);
       v.vis_a = v.vis_b = v.vis_a || n_r;
     } else {
@@ -162,19 +168,29 @@ bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Si
 
 bool surfaces_coincide(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell) {
   if (a.idx.empty() || b.idx.empty()) return false;
-  const ITri& ref = xa.tris[a.idx.front()];
-  // Within a millionth of the cell: the operands' float vertices on one exact plane.
-  const double tol = 1e-6 * cell.size();
-  const auto on_ref = [&](const ITri& t) {
-    const double c = dot3(ref.unit_normal, t.unit_normal);
+  // Within a millionth of the cell, or a few float steps of the unit cube (the operands' float
+  // vertices on one exact plane).
+  const double tol = std::max(1e-6 * cell.size(), kCoincident);
+  const auto same_plane = [&](const ITri& s, const ITri& t) {
+    const double c = dot3(s.unit_normal, t.unit_normal);
     if (std::abs(std::abs(c) - 1) > 1e-9) return false;
-    return std::abs((c > 0 ? t.plane : -t.plane) - ref.plane) <= tol;
+    return std::abs((c > 0 ? t.plane : -t.plane) - s.plane) <= tol;
   };
-  for (uint32_t i : a.idx)
-    if (!on_ref(xa.tris[i])) return false;
-  for (uint32_t j : b.idx)
-    if (!on_ref(xb.tris[j])) return false;
-  return true;
+  // Every plane of one operand here is a plane of the other (a cutter flush with a face, or
+  // with an edge or corner: two or three planes each).
+  const auto covered = [&](const Operand& x, const Side& s, const Operand& y, const Side& t) {
+    for (uint32_t i : s.idx) {
+      bool found = false;
+      for (uint32_t j : t.idx)
+        if (same_plane(y.tris[j], x.tris[i])) {
+          found = true;
+          break;
+        }
+      if (!found) return false;
+    }
+    return true;
+  };
+  return covered(xa, a, xb, b) && covered(xb, b, xa, a);
 }
 
 /// The new feature (where the two surfaces meet) must also fit one point or line over the

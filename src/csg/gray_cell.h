@@ -27,9 +27,9 @@ struct EdgeVerdict {
 EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b,
                          const Cell& cell);
 
-/// Whether both operands' partial contours in the cell lie on one plane (coinciding faces,
-/// such as a box minus a box that shares its faces): the result there is one operand's surface
-/// or none, with no new feature to refine toward.
+/// Whether the operands' partial contours in the cell lie on the same planes (coinciding
+/// faces, edges or corners, such as a box minus a box that shares its faces): the result there
+/// is one operand's surface or none, with no new feature to refine toward.
 bool surfaces_coincide(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
 /// Whether the two operands' partial contours meet inside the cell.
 bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
