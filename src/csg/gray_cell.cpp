@@ -107,10 +107,11 @@ EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axi
 
 }  // namespace
 
-/// Crossings of the two operands this close (unit cube) are one: coplanar faces of the two
-/// operands (a cutter flush with a face) come through their stored float vertices up to a few
-/// float steps of the unit cube apart, and would otherwise count as two crossings and refine
-/// the whole shared face's rim to the depth cap. A sliver this thin is far below a finest cell.
+/// Crossings of the two operands this close (unit cube) bound no sliver of the result where
+/// the result does not change across the pair: coplanar faces of the two operands (a cutter
+/// flush with a face) come through their stored float vertices up to a few float steps of the
+/// unit cube apart, and would otherwise count as two crossings and refine the whole shared
+/// face's rim to the depth cap. A sliver this thin is far below a finest cell.
 constexpr double kCoincident = 0x1p-22;
 
 /// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
@@ -135,9 +136,14 @@ EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Opera
     auto in_a = [&](double t) { return ea.change ? (t < ea.t ? a0 : !a0) : a0; };
     auto in_b = [&](double t) { return eb.change ? (t < eb.t ? b0 : !b0) : b0; };
     int n_r = 0;
-    if (ea.change && eb.change && std::abs(ea.t - eb.t) * cell.size() <= kCoincident) {
+    if (ea.change && eb.change && ea.t == eb.t) {
       n_r = apply(op, a0, b0) != apply(op, !a0, !b0);
       v.vis_a = v.vis_b = v.vis_a || n_r;
+    } else if (ea.change && eb.change && std::abs(ea.t - eb.t) * cell.size() <= kCoincident &&
+               apply(op, a0, b0) == apply(op, !a0, !b0)) {
+      // Nearly one crossing, and the result does not change across it: the sliver between
+      // the two is no crossing at all. (When it does change, the order of the two decides
+      // which operand's surface the result shows, as below.)
     } else {
       if (ea.change) {
         const bool vis = apply(op, a0, in_b(ea.t)) != apply(op, !a0, in_b(ea.t));
