@@ -330,26 +330,32 @@ bool CapExtent::apart(const Box& b) const {
 
 bool WindingSource::caps_below_half(const Box& b) const {
   // Caps out of reach add at most far_share_ each; those in reach what their ball allows from
-  // the nearest point of b (and, for a point, their box). A cap alone, seen from outside its
-  // box, covers less than a hemisphere.
-  const bool point = b.lo == b.hi;
+  // the nearest point of b, or for a point, if that is not enough, their box. A cap alone,
+  // seen from outside its box, covers less than a hemisphere.
+  thread_local std::vector<std::pair<uint32_t, double>> near;  // cap, ball bound
+  near.clear();
   double sum = 0;
-  size_t in_reach = 0;
-  bool alone_apart = false;
   cap_boxes_.query(b, [&](uint32_t k) {
-    ++in_reach;
     const CapExtent& c = cap_extents_[k];
-    if (cap_extents_.size() == 1) alone_apart = c.apart(b);
-    if (sum >= 0.5) return;
     double d2 = 0;
     for (int i = 0; i < 3; ++i) {
       const double gap = std::max({b.lo[i] - c.centre[i], c.centre[i] - b.hi[i], 0.0});
       d2 += gap * gap;
     }
-    const double ball = cone_cover(c.radius(), std::sqrt(d2));
-    sum += point && ball > 0.05 ? std::min(ball, c.cover(b.lo)) : ball;
+    near.push_back({k, cone_cover(c.radius(), std::sqrt(d2))});
+    sum += near.back().second;
   });
-  return alone_apart || sum + far_share_ * double(cap_extents_.size() - in_reach) < 0.5;
+  if (near.empty()) return true;
+  if (cap_extents_.size() == 1 && cap_extents_[0].apart(b)) return true;
+  const double far = far_share_ * double(cap_extents_.size() - near.size());
+  if (sum + far < 0.5) return true;
+  if (b.lo != b.hi) return false;
+  sum = 0;
+  for (const auto& [k, ball] : near) {
+    sum += ball > 0.05 ? std::min(ball, cap_extents_[k].cover(b.lo)) : ball;
+    if (sum + far >= 0.5) return false;
+  }
+  return true;
 }
 
 bool WindingSource::inside(const I3& p, int32_t w) const {
