@@ -125,21 +125,23 @@ void count_defects(const TriMesh& m, const std::vector<EdgeUse>& uses, MeshDefec
     if (n == 2 && net != 0) ++d.inconsistent_edges;
     for (size_t i = 1; i < n; ++i) shells.join(u[i].tri, u[0].tri);
   });
-  // Bounding boxes per shell; a sweep along x finds the first overlapping pair.
-  std::unordered_map<size_t, std::array<Vec3, 2>> boxes;
+  // Bounding boxes per shell (indexed by the shell's root triangle); a sweep along x finds
+  // the first overlapping pair.
+  std::vector<std::array<Vec3, 2>> boxes(m.triangles.size(), {Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}});
+  std::vector<uint32_t> roots;
   for (uint32_t f = 0; f < m.triangles.size(); ++f) {
-    auto [it, fresh] = boxes.try_emplace(shells.root(f));
-    auto& box = it->second;
-    if (fresh) box = {Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}};
+    const size_t r = shells.root(f);
+    if (r == f) roots.push_back(f);
+    auto& box = boxes[r];
     for (uint32_t v : m.triangles[f])
       for (int k = 0; k < 3; ++k) {
         box[0][k] = std::min(box[0][k], m.positions[v][k]);
         box[1][k] = std::max(box[1][k], m.positions[v][k]);
       }
   }
-  d.shells = boxes.size();
+  d.shells = roots.size();
   std::vector<std::array<Vec3, 2>> list;
-  for (const auto& [r, b] : boxes) list.push_back(b);
+  for (uint32_t r : roots) list.push_back(boxes[r]);
   std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a[0][0] < b[0][0]; });
   for (size_t i = 0; i < list.size() && !d.overlapping_shells; ++i)
     for (size_t j = i + 1; j < list.size() && list[j][0][0] <= list[i][1][0]; ++j) {
