@@ -336,6 +336,12 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
                         "sphere(r = 1); }",
                         o),
                InvalidInput);
+  // Extruded text is not convex either: refused at once (its convexity used to be tested by
+  // a hull of its mostly coplanar points, which did not finish).
+  EXPECT_THROW(eval_csg("minkowski() { linear_extrude(height = 2) { text(text = \"PIC\", size = 10); } "
+                        "sphere(r = 0.6, $fn = 12); }",
+                        o),
+               InvalidInput);
 }
 
 // surface(): heights from a text matrix, and from a PNG's luminance (OpenSCAD 2021.01's export

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 
 #include "scad/lower.h"
 #include "scad/region.h"
+#include "geometry/union_find.h"
+#include "geometry/vec3.h"
 
 namespace pic::detail::scad {
 
@@ -65,10 +68,40 @@ Region project(const TriMesh& m, bool cut) {
 
 namespace {
 
+/// Whether a closed surface bounds a convex solid: connected, positive volume, and convex at
+/// every edge (each neighbour's far vertex on or below a triangle's plane). A closed connected
+/// surface that is locally convex everywhere is the boundary of a convex body. (Not a hull
+/// and a volume comparison: the incremental hull does not finish on large, mostly coplanar
+/// point sets such as extruded text.)
 bool convex(const TriMesh& m) {
-  const TriMesh h = convex_hull(m.positions);
-  const double v = volume(m), hv = volume(h);
-  return hv > 0 && std::abs(hv - v) <= 1e-9 * hv;
+  if (m.triangles.empty() || !(volume(m) > 0)) return false;
+  Vec3 lo = m.positions[m.triangles[0][0]], hi = lo;
+  for (const auto& t : m.triangles)
+    for (uint32_t v : t)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.positions[v][k]), hi[k] = std::max(hi[k], m.positions[v][k]);
+  const double eps = 1e-9 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
+  by_edge.reserve(3 * m.triangles.size());
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int e = 0; e < 3; ++e)
+      if (!by_edge.emplace(uint64_t(m.triangles[f][e]) << 32 | m.triangles[f][(e + 1) % 3], f).second) return false;
+  UnionFind parts(m.triangles.size());
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+    const double len = std::sqrt(dot3(n, n));
+    for (int e = 0; e < 3; ++e) {
+      const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
+      if (it == by_edge.end()) return false;  // not closed
+      parts.join(f, it->second);
+      for (uint32_t v : m.triangles[it->second])
+        if (len > 0 && dot3(n, sub3(m.positions[v], a)) > eps * len) return false;
+    }
+  }
+  for (uint32_t f = 1; f < m.triangles.size(); ++f)
+    if (parts.root(f) != parts.root(0)) return false;
+  return true;
 }
 
 // The solid as a union of convex point sets (hull vertices), or false when a part is not
