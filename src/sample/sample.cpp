@@ -3,7 +3,6 @@
 // cloud over the points' winding number (sources.h); both then settle their signs (signs/).
 #include "sample/sampler.h"
 
-#include <tbb/parallel_for.h>
 #include "sample/sources.h"
 #include "mesh/clean.h"
 #include "signs/invariants.h"
@@ -215,11 +214,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
   if (mode == InsideMode::Parity) {
     // Every edge on exactly two triangles is closed already (parity chosen by Auto).
     if (clean.defects.boundary_edges > 0 || clean.defects.nonmanifold_edges > 0) check_closed(clean.mesh);
-    std::vector<ITri> tris(clean.mesh.triangles.size());
-    tbb::parallel_for(size_t{0}, tris.size(), [&](size_t i) {
-      const auto& t = clean.mesh.triangles[i];
-      tris[i] = make_itri(grid[t[0]], grid[t[1]], grid[t[2]]);
-    });
+    const std::vector<ITri> tris = grid_triangles(clean.mesh.triangles, grid);
     // Root corners are outside: the mesh lies strictly inside the cube.
     tree = sample_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
     // Leaves at the depth cap may hold two components; make each hold one (see topology.h).

@@ -6,15 +6,15 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
-#include <optional>
 #include <map>
+#include <optional>
 #include <unordered_map>
 
 #include <Eigen/Dense>
 
+#include "geometry/union_find.h"
 #include "geometry/vec3.h"
 #include "mesh/clean.h"
-#include "geometry/union_find.h"
 
 namespace pic::detail {
 namespace {
@@ -143,6 +143,17 @@ void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, 
 
 // ---- triangle soups -----------------------------------------------------------------------
 
+std::vector<ITri> grid_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const std::vector<I3>& grid,
+                                size_t room) {
+  std::vector<ITri> out(tris.size());
+  out.reserve(tris.size() + room);
+  tbb::parallel_for(size_t{0}, tris.size(), [&](size_t i) {
+    const auto& t = tris[i];
+    out[i] = make_itri(grid[t[0]], grid[t[1]], grid[t[2]]);
+  });
+  return out;
+}
+
 /// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
 std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
                             double margin, double spread) {
@@ -200,17 +211,14 @@ WindingInput winding_input(const TriMesh& mesh, const std::vector<I3>& grid, dou
   // Close the input's boundary with caps: input + caps has an exact integer winding number.
   const auto chain = boundary_chain(mesh);
   const auto cones = cap_loops(chain, loop_count);
-  const std::vector<I3>& g = grid;
-  std::vector<ITri> tris;
-  tris.reserve(mesh.triangles.size() + cones.size());
-  for (const auto& t : mesh.triangles) tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
-  for (const auto& t : cones) {
-    tris.push_back(make_itri(g[t[0]], g[t[1]], g[t[2]]));
-    tris.back().use = 0;  // a cap: counts in the winding number, is no part of the surface
+  std::vector<ITri> tris = grid_triangles(mesh.triangles, grid, cones.size());
+  for (ITri& t : grid_triangles(cones, grid)) {
+    t.use = 0;  // a cap: counts in the winding number, is no part of the surface
+    tris.push_back(t);
   }
   std::vector<std::array<Vec3, 2>> boundary;
   boundary.reserve(chain.size());
-  for (const auto& [a, b] : chain) boundary.push_back({to_unit(g[a]), to_unit(g[b])});
+  for (const auto& [a, b] : chain) boundary.push_back({to_unit(grid[a]), to_unit(grid[b])});
   WindingInput in;
   in.loops = boundary_loops(chain);
   in.source = std::make_unique<WindingSource>(std::move(tris), mesh.triangles.size(), std::move(boundary),

@@ -108,6 +108,11 @@ class WindingSource : public SurfaceSource {
   mutable std::vector<Cell> skipped_;
 };
 
+/// The triangles (vertex indices into `grid`) as exact lattice triangles, made in parallel;
+/// `room` more reserved.
+std::vector<ITri> grid_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const std::vector<I3>& grid,
+                                size_t room = 0);
+
 /// Each boundary loop's box (unit space), grown by `margin` plus `spread` times its diagonal.
 std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, const std::vector<I3>& grid,
                             double margin, double spread);
