@@ -236,6 +236,79 @@ Vec3 point_on_edge(const Vec3& e0, const Vec3& e1, double t, double margin) {
   return x;
 }
 
+// The plain split of every polygon, with each vertex's polygons (CSR): the surface the added
+// points are placed on.
+struct PlainSurface {
+  const std::vector<Vec3>& x;
+  const std::vector<MeshPolygon>& polys;
+  const std::vector<Split>& splits;
+  std::vector<uint32_t> first, around;
+
+  std::pair<const uint32_t*, size_t> near(uint32_t v) const {
+    return {around.data() + first[v], size_t(first[v + 1] - first[v])};
+  }
+};
+
+// Where the surface crosses polygon i's edge, as an edge parameter: where the edge pierces the
+// polygon's own plain split, else that of the polygons around its vertices, else one ring
+// further out (a fold can put the plain crossing a polygon away); else the ring's mean plane.
+double edge_parameter(const PlainSurface& s, size_t i) {
+  const MeshPolygon& p = s.polys[i];
+  std::array<Vec3, 4> q;
+  for (int k = 0; k < p.count; ++k) q[k] = s.x[p.v[k]];
+  const double prefer = ring_height(q, p.count, p.e0, p.e1);
+  const auto better = [&](double a, double b) {
+    const double oa = std::max({0.0, -a, a - 1}), ob = std::max({0.0, -b, b - 1});
+    return oa < ob || (oa == ob && std::abs(a - prefer) < std::abs(b - prefer));
+  };
+  const auto look = [&](const uint32_t* list, size_t count, double& t) {
+    const double h = pierce_near(s.x, s.polys, s.splits, list, count, p.e0, p.e1, prefer);
+    if (h == h && (t != t || better(h, t))) t = h;
+  };
+  const uint32_t self = uint32_t(i);
+  double t = std::numeric_limits<double>::quiet_NaN();
+  look(&self, 1, t);
+  if (!(t >= 0 && t <= 1))
+    for (int k = 0; k < p.count; ++k) {
+      const auto [list, count] = s.near(p.v[k]);
+      look(list, count, t);
+    }
+  for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
+    for (uint32_t j = s.first[p.v[k]]; j < s.first[p.v[k] + 1]; ++j)
+      for (int m = 0; m < s.polys[s.around[j]].count; ++m) {
+        const auto [list, count] = s.near(s.polys[s.around[j]].v[m]);
+        look(list, count, t);
+      }
+  if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
+  return t;
+}
+
+// Where the plain split misses a side's face, the surface still crosses the face: it enters
+// through the two sign-changing edges on the face's border that the side's two polygons are
+// dual to. F is then the point nearest q of the chord between those edges' crossings (the
+// surface's trace on the face, to first order). False when the side has not two polygons.
+bool chord_across_face(const PlainSurface& s, uint32_t a, uint32_t b, const Face& face, const Vec3& q, double inset,
+                       Vec3& f) {
+  std::array<Vec3, 2> end;
+  int found = 0;
+  const auto [list, count] = s.near(a);
+  for (size_t k = 0; k < count; ++k) {
+    const MeshPolygon& p = s.polys[list[k]];
+    if (std::find(p.v.begin(), p.v.begin() + p.count, b) == p.v.begin() + p.count) continue;
+    if (found == 2) return false;
+    end[found++] = point_on_edge(p.e0, p.e1, edge_parameter(s, list[k]), inset);
+  }
+  if (found != 2) return false;
+  const Vec3 d = sub3(end[1], end[0]);
+  const double len = dot3(d, d);
+  const double t = len > 0 ? std::clamp(dot3(sub3(q, end[0]), d) / len, 0.0, 1.0) : 0.5;
+  for (int k = 0; k < 3; ++k) f[k] = end[0][k] + t * d[k];
+  f[face.axis] = face.plane;
+  for (int k = 0; k < 3; ++k)
+    if (k != face.axis) f[k] = std::clamp(f[k], face.lo[k] + inset, face.hi[k] - inset);
+  return true;
+}
+
 // True when the triangles `tris` (index triples into ring `r`) lie in the ring of tetrahedra
 // (e0, e1, r_i, r_i+1) around the edge, strictly inside except at the ring's vertices. The
 // ring must wind once around the edge, each step turning the same way by less than half a
@@ -413,7 +486,8 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
         plain[i] = uint8_t(tris + (other ? 4 : 0));
   });
   // Each vertex's polygons (CSR): the plain surface around a polygon.
-  std::vector<uint32_t> first(x.size() + 1, 0), around;
+  PlainSurface surface{x, polys, splits, std::vector<uint32_t>(x.size() + 1, 0), {}};
+  std::vector<uint32_t>&first = surface.first, &around = surface.around;
   for (const MeshPolygon& p : polys)
     for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
   for (size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
@@ -423,7 +497,6 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     for (size_t i = 0; i < n; ++i)
       for (int k = 0; k < polys[i].count; ++k) around[fill[polys[i].v[k]]++] = uint32_t(i);
   }
-  const auto near = [&](uint32_t v) { return std::pair(around.data() + first[v], size_t(first[v + 1] - first[v])); };
   // Face points: one per side off its face, numbered in polygon order where first met.
   TriangulationStats st;
   const auto nv = static_cast<uint32_t>(x.size());
@@ -444,8 +517,10 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     }
   }
   st.face_points = face_owner.size();
-  // Each face point: where the plain surface around its side crosses the face (or comes
-  // nearest it), else where the side meets the face's plane, moved into the face.
+  // Each face point: where the plain surface around its side crosses the face; where it misses
+  // the face (it may pass through a third cell beside a crease), on the chord between the face's
+  // two edge crossings; else the face's point nearest the plain surface, or nearest where the
+  // side meets the face's plane.
   std::vector<Vec3> face_x(face_owner.size());
   tbb::parallel_for(size_t{0}, face_owner.size(), [&](size_t j) {
     const auto [i, k] = face_owner[j];
@@ -456,10 +531,11 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     Vec3 f = q;
     double off = std::numeric_limits<double>::infinity(), dq = off;
     for (const uint32_t v : {a, b}) {  // polygons around a, then those around b only
-      const auto [list, count] = near(v);
+      const auto [list, count] = surface.near(v);
       plain_surface_in_face(x, polys, splits, list, count, v == b ? a : kNone, face, inset, q, f, off, dq);
     }
-    if (!(off < std::numeric_limits<double>::infinity())) {
+    const bool missed = off > 0;  // no plain triangle around the side crosses the face itself
+    if (missed && !chord_across_face(surface, a, b, face, q, inset, f) && std::isinf(off)) {
       f = q;
       for (int d = 0; d < 3; ++d)
         if (d != face.axis) f[d] = std::clamp(q[d], face.lo[d] + inset, face.hi[d] - inset);
@@ -520,30 +596,7 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
   // Each fan's edge point: where its edge crosses the plain surface of the polygons around it.
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     if (edge_id[i] == kNone) return;
-    const MeshPolygon& p = polys[i];
-    const std::array<Vec3, 4> q = ring_of(i);
-    const double prefer = ring_height(q, p.count, p.e0, p.e1);
-    const auto better = [&](double a, double b) {
-      const double oa = std::max({0.0, -a, a - 1}), ob = std::max({0.0, -b, b - 1});
-      return oa < ob || (oa == ob && std::abs(a - prefer) < std::abs(b - prefer));
-    };
-    double t = std::numeric_limits<double>::quiet_NaN();
-    const auto look = [&](uint32_t v) {
-      const auto [list, count] = near(v);
-      const double h = pierce_near(x, polys, splits, list, count, p.e0, p.e1, prefer);
-      if (h == h && (t != t || better(h, t))) t = h;
-    };
-    // The polygon's own split first: where it pierces the edge, nothing else is needed.
-    const uint32_t self = uint32_t(i);
-    t = pierce_near(x, polys, splits, &self, 1, p.e0, p.e1, prefer);
-    if (!(t >= 0 && t <= 1))
-      for (int k = 0; k < p.count; ++k) look(p.v[k]);
-    // Else one ring further out (a fold can put the plain crossing a polygon away).
-    for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
-      for (uint32_t j = first[p.v[k]]; j < first[p.v[k] + 1]; ++j)
-        for (int m = 0; m < polys[around[j]].count; ++m) look(polys[around[j]].v[m]);
-    if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
-    x[nv + edge_id[i]] = point_on_edge(p.e0, p.e1, t, inset);
+    x[nv + edge_id[i]] = point_on_edge(polys[i].e0, polys[i].e1, edge_parameter(surface, i), inset);
   });
   // The triangles.
   std::vector<Tri> out(tri_at[n]);
