@@ -273,12 +273,18 @@ double edge_parameter(const PlainSurface& s, size_t i) {
       const auto [list, count] = s.near(p.v[k]);
       look(list, count, t);
     }
-  for (int k = 0; k < p.count && !(t >= 0 && t <= 1); ++k)
-    for (uint32_t j = s.first[p.v[k]]; j < s.first[p.v[k] + 1]; ++j)
-      for (int m = 0; m < s.polys[s.around[j]].count; ++m) {
-        const auto [list, count] = s.near(s.polys[s.around[j]].v[m]);
-        look(list, count, t);
-      }
+  if (!(t >= 0 && t <= 1)) {  // each polygon of the next ring once
+    std::vector<uint32_t> further;
+    for (int k = 0; k < p.count; ++k)
+      for (uint32_t j = s.first[p.v[k]]; j < s.first[p.v[k] + 1]; ++j)
+        for (int m = 0; m < s.polys[s.around[j]].count; ++m) {
+          const auto [list, count] = s.near(s.polys[s.around[j]].v[m]);
+          further.insert(further.end(), list, list + count);
+        }
+    std::sort(further.begin(), further.end());
+    further.erase(std::unique(further.begin(), further.end()), further.end());
+    look(further.data(), further.size(), t);
+  }
   if (t != t) t = mean_plane_height(q, p.count, p.e0, p.e1);
   return t;
 }

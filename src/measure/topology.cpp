@@ -41,27 +41,35 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
   // The common case, tested without sorting: every edge at v is used by exactly two of v's
   // triangles, once each way. Then "next of i is previous of j" is a permutation of the
   // triangles and its cycles are v's fans. Returns their count, or 0 if the case does not hold.
-  constexpr uint32_t kFastFan = 32;
+  // The previous vertices go into a small hash table (distinct, or the case does not hold);
+  // each next must find one that no other next found.
+  constexpr uint32_t kFastFan = 32, kSlots = 64, kEmpty = ~uint32_t{0};
   const auto closed_fan_cycles = [&](size_t v, uint32_t n) {
-    std::array<uint32_t, kFastFan> next, prev, succ;
+    std::array<uint32_t, kFastFan> next, succ;
+    std::array<uint32_t, kSlots> key;
+    std::array<uint8_t, kSlots> owner;
+    key.fill(kEmpty);
+    const auto hash = [](uint32_t x) { return (x * 0x9E3779B1u) >> 26; };
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t h = corner[first[v] + i];
       const auto& t = mesh.triangles[h / 3];
       next[i] = t[(h % 3 + 1) % 3];
-      prev[i] = t[(h % 3 + 2) % 3];
+      const uint32_t prev = t[(h % 3 + 2) % 3];
+      uint32_t s = hash(prev);
+      for (; key[s] != kEmpty; s = (s + 1) % kSlots)
+        if (key[s] == prev) return 0;
+      key[s] = prev;
+      owner[s] = uint8_t(i);
     }
+    std::array<bool, kFastFan> taken{};
     for (uint32_t i = 0; i < n; ++i) {
-      uint32_t matches = 0, twins = 0;
-      for (uint32_t j = 0; j < n; ++j) {
-        if (prev[j] == next[i]) {
-          succ[i] = j;
-          ++matches;
-        }
-        twins += next[j] == next[i];
-      }
-      if (matches != 1 || twins != 1) return 0;
+      uint32_t s = hash(next[i]);
+      while (key[s] != kEmpty && key[s] != next[i]) s = (s + 1) % kSlots;
+      if (key[s] == kEmpty || taken[owner[s]]) return 0;
+      taken[owner[s]] = true;
+      succ[i] = owner[s];
     }
-    // next values distinct and each matched once, so succ is a permutation.
+    // Every next matched a distinct previous, so succ is a permutation.
     int cycles = 0;
     std::array<bool, kFastFan> seen{};
     for (uint32_t i = 0; i < n; ++i) {
