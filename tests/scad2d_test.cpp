@@ -344,6 +344,17 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
                InvalidInput);
 }
 
+// hull() of extruded text: thousands of points on two planes. The hull tested "sees" with a
+// tolerance; points almost on several faces' planes saw sets of faces that were not disks, and
+// the face list grew until memory ran out. Exact orientation tests keep it a convex polytope.
+TEST(ScadHull, ExtrudedTextIsHulled) {
+  EvalOptions o;
+  o.depth = 8;
+  const TriMesh m = contour(eval_csg("hull() { linear_extrude(height = 2) { text(text = \"PIC 0.1 hello\", size = 10); } }", o));
+  EXPECT_TRUE(analyze_topology(m).manifold());
+  EXPECT_NEAR(volume(m), 1490.4007, 1490.4007 * 5e-3);  // OpenSCAD 2021's render
+}
+
 // surface(): heights from a text matrix, and from a PNG's luminance (OpenSCAD 2021.01's export
 // of the same 3 x 2 image has these heights: white 100, green 71.52, red 21.26, ...).
 TEST(ScadSurface, HeightMapsFromTextAndImages) {
