@@ -9,6 +9,11 @@
 // convert_ms (OBJ arrays -> Manifold, incl. merge and validity checks) and export_ms
 // (Manifold -> mesh arrays) complete the end-to-end time end_to_end_ms = convert + chain + export.
 // The result is written as OBJ with every float32 coordinate printed exactly.
+//
+// With --sculpt CENTRES.txt (lines `x y z r`, as pic_sculpt --centres writes them), the chain's
+// result is then sculpted: one sphere (--segments, default 32) subtracted per line, in order,
+// each forced to evaluate; sculpt.stroke_ms summarises those subtractions (the sphere's own
+// construction is sculpt.tool_ms), and the sculpted solid is what OUT.obj gets.
 import Module from 'manifold-3d';
 import { readFileSync, openSync, writeSync, closeSync } from 'node:fs';
 
@@ -16,13 +21,17 @@ const USAGE = 'usage: node manifold_peer.mjs --out OUT.obj [--repeat N] A.obj (u
 const args = process.argv.slice(2);
 let out = null;
 let repeat = 20;
+let sculptFile = null;
+let segments = 32;
 const chain = [];
 for (let i = 0; i < args.length; i++) {
   if (args[i] === '--out') out = args[++i];
   else if (args[i] === '--repeat') repeat = Math.max(1, parseInt(args[++i], 10) || 1);
+  else if (args[i] === '--sculpt') sculptFile = args[++i];
+  else if (args[i] === '--segments') segments = Math.max(3, parseInt(args[++i], 10) || 32);
   else chain.push(args[i]);
 }
-if (!out || chain.length < 3 || chain.length % 2 === 0) { console.error(USAGE); process.exit(1); }
+if (!out || chain.length < (sculptFile ? 1 : 3) || chain.length % 2 === 0) { console.error(USAGE); process.exit(1); }
 for (let k = 1; k < chain.length; k += 2)
   if (!['union', 'difference', 'intersection'].includes(chain[k])) { console.error(`unknown op ${chain[k]}\n${USAGE}`); process.exit(1); }
 
@@ -105,6 +114,33 @@ try {
     else result = acc;
   }
 
+  if (result === null) result = solids[0];  // no Booleans before the sculpting
+  let sculpt = null;
+  if (sculptFile) {
+    const strokes = [], tools = [];
+    for (const line of readFileSync(sculptFile, 'utf8').split('\n')) {
+      const v = line.trim().split(/\s+/).map(Number);
+      if (v.length !== 4 || v.some((x) => !Number.isFinite(x))) continue;
+      const ta = now();
+      const tool = wasm.Manifold.sphere(v[3], segments).translate([v[0], v[1], v[2]]);
+      tool.numTri();
+      const tb = now();
+      const next = result.subtract(tool);
+      next.numTri();
+      strokes.push(now() - tb);
+      tools.push(tb - ta);
+      tool.delete();
+      result.delete();
+      result = next;
+    }
+    const summary = (xs) => {
+      const s = [...xs].sort((a, b) => a - b);
+      const at = (q) => s.length ? s[Math.min(s.length - 1, Math.floor(q * (s.length - 1) + 0.5))] : 0;
+      return { median: at(0.5), p95: at(0.95), mean: s.reduce((a, b) => a + b, 0) / Math.max(1, s.length), max: at(1) };
+    };
+    sculpt = { strokes: strokes.length, segments, stroke_ms: summary(strokes), tool_ms: summary(tools) };
+  }
+
   const te = now();
   const mesh = result.getMesh();
   const exportMs = now() - te;
@@ -129,6 +165,7 @@ try {
     volume: result.volume(),
     genus: result.genus(),
     peak_rss_bytes: process.resourceUsage().maxRSS * 1024,
+    sculpt,
     out,
   }));
 } catch (e) {

@@ -28,6 +28,11 @@ SCULPT = os.path.join(BUILD, "bench", "pic_sculpt")
 MICRO = os.path.join(BUILD, "bench", "pic_bench")
 VDB = os.path.join(BUILD, "bench", "pic_vdb_peer")
 MANIFOLD = os.path.join("bench", "manifold_peer.mjs")
+# Native Manifold's `mfbench` (built from a Manifold source snapshot by the shared tools'
+# manifold-native/build.sh), and the Thingi10K difference pair (A - B, already in one frame).
+MFBENCH = os.environ.get("PIC_MFBENCH") or os.path.expanduser("~/.cache/pic-peers/manifold/mfbench")
+THINGI_DIR = os.environ.get("THINGI_DIR") or os.path.join(os.path.dirname(ROOT), "shared", "data")
+THINGI_PAIR = ("thingi10k-1706459.obj", "thingi10k-1514499.obj")
 
 REPS = int(os.environ.get("PIC_BENCH_REPS", "5"))
 STROKES = int(os.environ.get("PIC_BENCH_STROKES", "1000"))
@@ -322,6 +327,104 @@ def manifold_peer():
             % (d["hausdorff"], 1 / 4096))
 
 
+def native_manifold_peer():
+    """The CAD tool's chain on native Manifold (mfbench), warm best of 20."""
+    if not os.path.exists(MFBENCH):
+        return skip("manifold_native", "%s not found (build it with the shared tools' manifold-native/build.sh, or set "
+                                       "PIC_MFBENCH)" % MFBENCH)
+    j, rss, _ = run([MFBENCH, os.path.join(OUT, "cad_tool_mfbench.obj")] + cad_inputs() + ["--repeat", "20"], "mfbench_cad")
+    j["peak_rss_bytes_wait4"] = rss
+    results["manifold_native_cad"] = j
+    log("native Manifold: convert %.2f ms + 3 booleans %.2f ms (best of 20) + export %.2f ms"
+        % (sum(j["to_manifold_ms"]), j["boolean_ms"], j["from_manifold_ms"]))
+
+
+def thingi_pair():
+    """A - B of the Thingi10K pair: PIC (both sampled in one cube, the Boolean, the contour) beside
+    native Manifold (conversion, difference, export)."""
+    a, b = (os.path.join(THINGI_DIR, f) for f in THINGI_PAIR)
+    if not (os.path.exists(a) and os.path.exists(b)):
+        return skip("thingi_pair", "%s and %s not found (set THINGI_DIR)" % (a, b))
+    res = os.path.join(OUT, "thingi_pair.pic")
+    runs, contours = [], []
+    for _ in range(REPS):
+        j, _, _ = run([PIC, "csg", a, "subtract", b, "-o", res, "--json"], "csg_thingi")
+        runs.append(j)
+    for _ in range(REPS):
+        c, _, _ = run([PIC, "mesh", res, "-o", os.path.join(OUT, "thingi_pair_pic.obj"), "--json", "--no-check"],
+                      "contour_thingi")
+        contours.append(c["seconds"])
+    pic = {"csg_step_seconds": med([r["ops"][0]["seconds"] for r in runs]),
+           "sample_and_csg_seconds": med([r["seconds"] for r in runs]), "contour_seconds": med(contours),
+           "pics": runs[-1]["pics"], "triangles": c["triangles"]}
+    pic["end_to_end_seconds"] = pic["sample_and_csg_seconds"] + pic["contour_seconds"]
+    results["thingi_pair"] = {"pic": pic}
+    log("PIC: sample both + A - B %.3f s (the Boolean %.3f s) + contour %.3f s = %.3f s; %d triangles"
+        % (pic["sample_and_csg_seconds"], pic["csg_step_seconds"], pic["contour_seconds"], pic["end_to_end_seconds"],
+           pic["triangles"]))
+    if not os.path.exists(MFBENCH):
+        return skip("thingi_pair_manifold", "%s not found" % MFBENCH)
+    m, _, _ = run([MFBENCH, os.path.join(OUT, "thingi_pair_mfbench.obj"), a, "difference", b, "--repeat", str(REPS)],
+                  "mfbench_thingi")
+    results["thingi_pair"]["manifold_native"] = m
+    log("native Manifold: convert %.1f ms + difference %.1f ms (best of %d) + export %.1f ms"
+        % (sum(m["to_manifold_ms"]), m["boolean_ms"], REPS, m["from_manifold_ms"]))
+
+
+def sculpt_peer():
+    """The same strokes (pic_sculpt's centres) subtracted from the exact carved slab by Manifold (WASM)."""
+    if not os.path.exists(SCULPT_CENTRES):
+        return skip("sculpt_manifold", "no stroke centres (the sculpting section did not run)")
+    if not shutil_which("node") or not os.path.isdir("bench/node_modules/manifold-3d"):
+        return skip("sculpt_manifold", "node or the npm package manifold-3d missing (cd bench && npm ci)")
+    chain = [os.path.join(IN, "slab.obj")]
+    for cut in ("dimple", "groove", "notch"):
+        chain += ["difference", os.path.join(IN, cut + ".obj")]
+    j, _, _ = run(["node", MANIFOLD, "--out", os.path.join(OUT, "sculpted_manifold.obj"), "--repeat", "1",
+                   "--sculpt", SCULPT_CENTRES, "--segments", "32"] + chain, "sculpt_manifold", timeout=max(TIMEOUT, 900))
+    results["sculpt_manifold"] = j["sculpt"]
+    log("Manifold (WASM), the same %d strokes: median %.3f ms, p95 %.3f ms per subtraction"
+        % (j["sculpt"]["strokes"], j["sculpt"]["stroke_ms"]["median"], j["sculpt"]["stroke_ms"]["p95"]))
+    if not os.path.exists(MFBENCH):
+        return skip("sculpt_manifold_native", "%s not found" % MFBENCH)
+    # Native: every stroke's sphere as an OBJ (a UV sphere, 32 segments around, 16 rings).
+    tools = []
+    with open(SCULPT_CENTRES) as f:
+        for k, line in enumerate(f):
+            x, y, z, rad = map(float, line.split())
+            path = os.path.join(RES, "stroke%04d.obj" % k)
+            write_uv_sphere(path, (x, y, z), rad, 32, 16)
+            tools += ["difference", path]
+    m, _, _ = run([MFBENCH, os.path.join(OUT, "sculpted_mfbench.obj")] + chain + tools, "sculpt_mfbench",
+                  timeout=max(TIMEOUT, 900))
+    strokes = [o["ms"] for o in m["ops"][3:]]
+    results["sculpt_manifold_native"] = {"strokes": len(strokes), "stroke_ms": {"median": med(strokes), "p95": p95(strokes)}}
+    log("Manifold (native), the same %d strokes: median %.3f ms, p95 %.3f ms per subtraction"
+        % (len(strokes), med(strokes), p95(strokes)))
+
+
+def write_uv_sphere(path, c, r, around, rings):
+    import math
+    v = [(c[0], c[1], c[2] - r)]
+    for i in range(1, rings):
+        t = math.pi * i / rings
+        for j in range(around):
+            p = 2 * math.pi * j / around
+            v.append((c[0] + r * math.sin(t) * math.cos(p), c[1] + r * math.sin(t) * math.sin(p), c[2] - r * math.cos(t)))
+    v.append((c[0], c[1], c[2] + r))
+    top = len(v)
+    ring = lambda i, j: 2 + (i - 1) * around + j % around  # 1-based OBJ index of ring i (1..rings-1)
+    f = [(1, ring(1, j + 1), ring(1, j)) for j in range(around)]
+    for i in range(1, rings - 1):
+        for j in range(around):
+            f.append((ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)))
+            f.append((ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)))
+    f += [(top, ring(rings - 1, j), ring(rings - 1, j + 1)) for j in range(around)]
+    with open(path, "w") as out:
+        out.write("".join("v %.17g %.17g %.17g\n" % p for p in v))
+        out.write("".join("f %d %d %d\n" % t for t in f))
+
+
 def vdb_peer():
     if not os.path.exists(VDB):
         return skip("openvdb", "%s not built (apt-get install libopenvdb-dev, reconfigure)" % VDB)
@@ -350,9 +453,13 @@ def shutil_which(x):
 
 
 # ---------------------------------------------------------------------------------------------
+SCULPT_CENTRES = os.path.join(OUT, "sculpt_centres.txt")
+
+
 def sculpt():
     j, rss, _ = run([SCULPT, os.path.join(IN, "slab_carved.pic"), "--strokes", str(STROKES), "--radius", "0.02",
-                     "--seed", "1", "--out", os.path.join(OUT, "sculpted.pic")], "sculpt", timeout=max(TIMEOUT, 900))
+                     "--seed", "1", "--out", os.path.join(OUT, "sculpted.pic"), "--centres", SCULPT_CENTRES], "sculpt",
+                    timeout=max(TIMEOUT, 900))
     j["peak_rss_bytes_wait4"] = rss
     results["sculpt"] = j
     # Topology after every stroke (contoured, untimed) over the first CHECK_STROKES strokes.
@@ -400,6 +507,33 @@ def mb(x):
 
 def ms(x):
     return "%.2f" % (x * 1e3) if x is not None else "—"
+
+
+def side_by_side(r):
+    """(workload, PIC ms, peer, peer ms) for every pair measured in this run."""
+    rows = []
+    c, mn = r.get("cad_pic"), r.get("manifold_native_cad")
+    if c and mn:
+        rows.append(("CAD tool: the 3 Booleans", c["csg_seconds_total"] * 1e3, "Manifold (native)", mn["boolean_ms"]))
+        rows.append(("CAD tool: end to end (sample/convert, Booleans, contour/export)", c["end_to_end_seconds"] * 1e3,
+                     "Manifold (native)", sum(mn["to_manifold_ms"]) + mn["boolean_ms"] + mn["from_manifold_ms"]))
+    mf = r.get("manifold")
+    if c and mf:
+        rows.append(("CAD tool: the 3 Booleans", c["csg_seconds_total"] * 1e3, "Manifold (WASM)", mf["chain_ms"]))
+    t = r.get("thingi_pair") or {}
+    if t.get("pic") and t.get("manifold_native"):
+        p, m = t["pic"], t["manifold_native"]
+        rows.append(("Thingi10K pair A − B: the Boolean", p["csg_step_seconds"] * 1e3, "Manifold (native)", m["boolean_ms"]))
+        rows.append(("Thingi10K pair A − B: end to end", p["end_to_end_seconds"] * 1e3, "Manifold (native)",
+                     sum(m["to_manifold_ms"]) + m["boolean_ms"] + m["from_manifold_ms"]))
+    s, sm, sn = r.get("sculpt"), r.get("sculpt_manifold"), r.get("sculpt_manifold_native")
+    if s and sn:
+        rows.append(("sculpting: stroke median", s["stroke_ms"]["median"], "Manifold (native)", sn["stroke_ms"]["median"]))
+        rows.append(("sculpting: stroke p95", s["stroke_ms"]["p95"], "Manifold (native)", sn["stroke_ms"]["p95"]))
+    if s and sm:
+        rows.append(("sculpting: stroke median", s["stroke_ms"]["median"], "Manifold (WASM)", sm["stroke_ms"]["median"]))
+        rows.append(("sculpting: stroke p95", s["stroke_ms"]["p95"], "Manifold (WASM)", sm["stroke_ms"]["p95"]))
+    return rows
 
 
 def report():
@@ -501,6 +635,21 @@ def report():
             cs = ", ".join("%s %.4g" % kv for kv in b["counters"].items())
             md.append("| %s %s | %.4g %s | %s |" % (b["name"], b["label"], b["real_time"], b["unit"], cs))
         md.append("")
+    side = side_by_side(r)
+    if side:
+        md.append("### Side by side: each PIC figure beside its peer, measured in this run")
+        md.append("")
+        md.append("| workload | PIC | peer | peer figure | PIC / peer |")
+        md.append("|---|---:|---|---:|---:|")
+        for w, p, peer, q in side:
+            md.append("| %s | %.2f ms | %s | %.2f ms | %.2f |" % (w, p, peer, q, p / q if q else float("nan")))
+        md.append("")
+        md.append("PIC: medians of fresh `pic` processes (library time, file I/O excluded; the Thingi pair "
+                  "samples both meshes in one cube); sculpting: `pic_sculpt` strokes (`csg_inplace`, tool sampling "
+                  "excluded). Native Manifold: `mfbench`, warm best of N, conversion and export timed apart; "
+                  "sculpting peer: Manifold's WASM build (about 2x slower than native) subtracting spheres of the "
+                  "same centres and radius (32 segments) from the exact carved slab.")
+        md.append("")
     # targets
     tg = []
     t2 = {x["model"]: x for x in r.get("table2", [])}
@@ -522,6 +671,20 @@ def report():
     if c and mf:
         tg.append(("CSG step faster than Manifold", "PIC %s ms vs Manifold %.2f ms (warm)" % (ms(c["csg_seconds_total"]), mf["chain_ms"]),
                    c["csg_seconds_total"] * 1e3 < mf["chain_ms"]))
+    mn, tp = r.get("manifold_native_cad"), (r.get("thingi_pair") or {})
+    if c and mn:
+        tg.append(("CAD tool: PIC's 3 Booleans faster than native Manifold's", "PIC %s ms vs %.2f ms"
+                   % (ms(c["csg_seconds_total"]), mn["boolean_ms"]), c["csg_seconds_total"] * 1e3 < mn["boolean_ms"]))
+    if tp.get("pic") and tp.get("manifold_native"):
+        p_, m_n = tp["pic"], tp["manifold_native"]
+        peer_e2e = sum(m_n["to_manifold_ms"]) + m_n["boolean_ms"] + m_n["from_manifold_ms"]
+        tg.append(("Thingi10K pair: the Boolean faster than native Manifold's", "PIC %s ms vs %.1f ms"
+                   % (ms(p_["csg_step_seconds"]), m_n["boolean_ms"]), p_["csg_step_seconds"] * 1e3 < m_n["boolean_ms"]))
+        tg.append(("Thingi10K pair: end to end within 2x of native Manifold", "PIC %s ms vs %.1f ms"
+                   % (ms(p_["end_to_end_seconds"]), peer_e2e), p_["end_to_end_seconds"] * 1e3 <= 2 * peer_e2e))
+    if s:
+        tg.append(("sculpt stroke median ≤ 2 ms, p95 ≤ 5 ms", "%.3f / %.3f ms" % (s["stroke_ms"]["median"], s["stroke_ms"]["p95"]),
+                   s["stroke_ms"]["median"] <= 2.0 and s["stroke_ms"]["p95"] <= 5.0))
     r["targets"] = [{"target": a, "measured": b, "met": bool(m_)} for a, b, m_ in tg]
     if tg:
         md.append("### Targets")
@@ -552,13 +715,23 @@ def main():
         return
     t0 = time.monotonic()
     section("machine", meta)
-    section("inputs", make_inputs)
-    section("sampling and contouring (paper Table 2 setting)", table2)
-    section("CAD tool with PIC (paper Table 3 setting)", cad_pic)
-    section("peer: Manifold", manifold_peer)
-    section("peer: OpenVDB", vdb_peer)
-    section("sculpting", sculpt)
-    section("micro-benchmarks", micro)
+    # PIC_BENCH_ONLY=key,key,... runs only those sections (keys as below; "inputs" is needed by
+    # every section but table2).
+    only = set(filter(None, os.environ.get("PIC_BENCH_ONLY", "").split(",")))
+    for key, name, fn in [
+        ("inputs", "inputs", make_inputs),
+        ("table2", "sampling and contouring (paper Table 2 setting)", table2),
+        ("cad", "CAD tool with PIC (paper Table 3 setting)", cad_pic),
+        ("manifold", "peer: Manifold", manifold_peer),
+        ("openvdb", "peer: OpenVDB", vdb_peer),
+        ("sculpt", "sculpting", sculpt),
+        ("manifold_native", "peer: native Manifold (CAD tool)", native_manifold_peer),
+        ("thingi", "Thingi10K pair: PIC and native Manifold", thingi_pair),
+        ("sculpt_peer", "peer: sculpting with Manifold", sculpt_peer),
+        ("micro", "micro-benchmarks", micro),
+    ]:
+        if not only or key in only:
+            section(name, fn)
     results["meta"]["loadavg_end"] = loadavg()
     results["meta"]["total_seconds"] = time.monotonic() - t0
     with open(os.path.join(OUT, "results.json"), "w") as f:  # first: kept even if the report fails

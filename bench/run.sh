@@ -11,7 +11,8 @@
 # Knobs (environment): PIC_BENCH_REPS (5) runs per timing, median reported;
 # PIC_BENCH_STROKES (1000); PIC_BENCH_VDB_VOXELS ("1/1024 1/2048"); PIC_BENCH_SUBDIV (4:
 # spot 4-split 4 times = 1.5 M triangles); PIC_BENCH_MICRO (1: run pic_bench);
-# PIC_BENCH_TIMEOUT (600 s per command).
+# PIC_BENCH_TIMEOUT (600 s per command); PIC_BENCH_ONLY (sections, e.g. "inputs,cad,thingi"; see
+# bench/run.py); PIC_MFBENCH (native Manifold's mfbench), THINGI_DIR (the Thingi10K pair).
 set -uo pipefail
 BUILD=${1:-build}
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

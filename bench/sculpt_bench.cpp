@@ -3,14 +3,16 @@
 // touches, not the size of the object).
 //
 //   pic_sculpt INPUT.pic [--strokes 1000] [--radius 0.02] [--segments 32] [--seed 1]
-//              [--repick 50] [--out OUT.pic] [--mesh OUT.obj] [--check]
+//              [--repick 50] [--out OUT.pic] [--mesh OUT.obj] [--check] [--centres OUT.txt]
 //
 // --radius is relative to the root cube. Stroke centres are vertices of the current contour,
 // re-extracted every --repick strokes (the contour time is not part of a stroke). Each stroke
 // samples its tool sphere into the object's cube at the object's depth (reported separately as
 // tool_sample) and then subtracts it (reported as stroke). --check contours the object after
 // every stroke (untimed) and reports which strokes left it open or non-manifold, and after
-// how many the contour stays non-manifold even after pic::split_nonmanifold.
+// how many the contour stays non-manifold even after pic::split_nonmanifold. --centres writes
+// each stroke's centre and radius in the input's units (`x y z r` a line), so a peer can make
+// the same strokes (bench/manifold_peer.mjs --sculpt).
 // Prints one JSON object.
 #include <sys/resource.h>
 
@@ -18,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <random>
 #include <string>
@@ -63,14 +66,14 @@ size_t peak_rss_bytes() {
 }
 
 int usage() {
-  std::cerr << "usage: pic_sculpt INPUT.pic [--strokes N] [--radius R] [--segments S] [--seed K] [--repick M] [--check] "
+  std::cerr << "usage: pic_sculpt INPUT.pic [--strokes N] [--radius R] [--segments S] [--seed K] [--repick M] [--check] [--centres OUT.txt] "
                "[--out OUT.pic] [--mesh OUT.obj]\n";
   return 1;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string input, out, mesh_out;
+  std::string input, out, mesh_out, centres_out;
   int strokes = 1000, segments = 32, repick = 50;
   bool check = false;
   double radius = 0.02;
@@ -90,6 +93,7 @@ int main(int argc, char** argv) {
       else if (a == "--out") out = next();
       else if (a == "--mesh") mesh_out = next();
       else if (a == "--check") check = true;
+      else if (a == "--centres") centres_out = next();
       else if (input.empty() && a[0] != '-') input = a;
       else return usage();
     } catch (const std::exception&) {
@@ -111,7 +115,7 @@ int main(int argc, char** argv) {
 
     std::vector<double> stroke_s, tool_s, visited, stamped, tool_pics, contour_s, combine_s, cleanup_s;
     stroke_s.reserve(strokes);
-    std::vector<pic::Vec3> candidates;
+    std::vector<pic::Vec3> candidates, centres;
     double pick_s = 0;
     int first_open = -1, first_nonmanifold = -1, open_count = 0, nonmanifold_count = 0, unsplittable_count = 0;
     size_t skipped = 0;
@@ -134,6 +138,7 @@ int main(int argc, char** argv) {
         if (skipped > 100000) throw std::runtime_error("no stroke centre fits in the cube");
         continue;
       }
+      centres.push_back(c);
       const auto t0 = Clock::now();
       pic::SampleStats sst;
       const pic::Octree tool = pic::sample(pic::make_sphere(c, r, segments), so, &sst);
@@ -187,6 +192,12 @@ int main(int argc, char** argv) {
       if (!mesh_out.empty()) pic::write_mesh(m, mesh_out);
     }
     if (!out.empty()) pic::save(tree, out);
+    if (!centres_out.empty()) {
+      std::ofstream f(centres_out);
+      f.precision(17);
+      for (const pic::Vec3& c : centres) f << c[0] << ' ' << c[1] << ' ' << c[2] << ' ' << r << '\n';
+      if (!f) throw std::runtime_error("cannot write " + centres_out);
+    }
     std::cout << "{\"strokes\": " << strokes << ", \"radius\": " << num(radius) << ", \"depth\": " << tree.max_depth
               << ", \"segments\": " << segments << ", \"seed\": " << seed << ", \"repick\": " << repick
               << ", \"stroke_ms\": " << summary(stroke_s, 1e3) << ", \"tool_sample_ms\": " << summary(tool_s, 1e3)
