@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <set>
 #include <functional>
 #include <vector>
 
@@ -444,6 +445,25 @@ TEST(Csg, SculptingStaysClosedAndManifold) {
     if (!topo.manifold()) ++bad;
   }
   EXPECT_EQ(bad, 0) << "strokes leaving non-manifold results";
+}
+
+// A union of parts placed apart is the parts themselves: each is copied into the result whole
+// (large copies are cleaned only where they meet the rest), so the result's contour has exactly
+// the vertices of the two parts' own contours.
+TEST(Csg, UnionOfDisjointPartsIsThePartsThemselves) {
+  const int depth = 10;
+  const Octree a = sample_in_unit(make_sphere({0.27, 0.5, 0.5}, 0.2, 96), depth);
+  const Octree b = sample_in_unit(make_torus({0.73, 0.5, 0.5}, 0.14, 0.06, 2, 96), depth);
+  ASSERT_GT(b.nodes.size(), size_t{1} << 15) << "large enough to be copied as a part";
+  Octree u = a;
+  csg_inplace(u, b, CsgOp::Union);
+  const TriMesh m = unsplit_contour(u);
+  EXPECT_TRUE(IsClosedManifold(m));
+  std::multiset<Vec3> parts, whole(m.positions.begin(), m.positions.end());
+  for (const Octree* t : {&a, &b})
+    for (const Vec3& p : unsplit_contour(*t).positions) parts.insert(p);
+  EXPECT_TRUE(parts == whole);
+  EXPECT_NEAR(volume(m), volume(unsplit_contour(a)) + volume(unsplit_contour(b)), 1e-9);
 }
 
 TEST(Csg, CostFollowsTheOverlapNotTheObject) {

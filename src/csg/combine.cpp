@@ -18,6 +18,7 @@ constexpr int kParallelLevels = 4;
 struct Fragment {
   static constexpr uint32_t kLocal = 1u << 31;
   std::vector<Node> nodes;
+  std::vector<uint8_t> inside_copy;  // per node: inside a copied subtree, off its root's faces
   std::vector<std::array<float, 3>> vertices;
   std::vector<std::pair<uint32_t, Node>> pending;  // A's slot -> node
   std::vector<SignHint> hints;                      // see sign_hint()
@@ -34,6 +35,7 @@ struct Fragment {
   Node absorb(const Fragment& f, Node root) {
     const uint32_t nb = kLocal | uint32_t(nodes.size()), vb = kLocal | uint32_t(vertices.size());
     for (const Node& n : f.nodes) nodes.push_back(relocate(n, nb, vb));
+    inside_copy.insert(inside_copy.end(), f.inside_copy.begin(), f.inside_copy.end());
     vertices.insert(vertices.end(), f.vertices.begin(), f.vertices.end());
     for (const auto& [slot, n] : f.pending) pending.push_back({slot, relocate(n, nb, vb)});
     hints.insert(hints.end(), f.hints.begin(), f.hints.end());
@@ -65,6 +67,7 @@ class FragmentWriter {
   uint32_t alloc8() {
     const auto first = static_cast<uint32_t>(out_.nodes.size());
     out_.nodes.resize(first + 8);
+    out_.inside_copy.resize(first + 8, 0);
     return Fragment::kLocal | first;
   }
   Node gray(const Cell& cell, uint8_t signs, const Vec3& x, uint8_t flags) {
@@ -74,8 +77,28 @@ class FragmentWriter {
   }
   static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
 
-  /// Copies a subtree of `src` into the output, complemented if `invert`.
+  /// Copies a subtree of `src` into the output, complemented if `invert`. In a copy of more
+  /// than kQuietCopy nodes, the nodes whose cells lie on none of the copy's root cell faces are
+  /// marked inside_copy: every neighbour they have is the source's own, as it was there.
   Node copy_subtree(const Octree& src, uint32_t node, bool invert) {
+    const size_t from = out_.nodes.size();
+    const Node root = copy_nodes(src, node, invert, 0x3f);
+    if (out_.nodes.size() - from <= kQuietCopy)
+      std::fill(out_.inside_copy.begin() + std::ptrdiff_t(from), out_.inside_copy.end(), uint8_t{0});
+    return root;
+  }
+
+ private:
+  /// A sampled operand can carry a sign island of its own (a small sphere's pole piercing a
+  /// lattice plane beside a coarse leaf), which the clean-up removes from what it copies:
+  /// sculpting tools are cleaned whole. Large copies (whole parts of a model placed apart, as
+  /// in a union of disjoint parts) keep their interior as sampled, as their own contour has it:
+  /// cleaning them cost about a second per 100,000 PICs.
+  static constexpr size_t kQuietCopy = 1u << 15;
+
+  /// copy_subtree's recursion. `faces`: which faces of the copy's root cell this cell lies on
+  /// (bit 2a: the low side of axis a, 2a + 1: the high side).
+  Node copy_nodes(const Octree& src, uint32_t node, bool invert, uint8_t faces) {
     const Node n = src.nodes[node];
     switch (n.kind) {
       case CellKind::White:
@@ -86,17 +109,24 @@ class FragmentWriter {
                     invert ? uint8_t(~n.signs) : n.signs, n.flags, 0};
       case CellKind::Internal: {
         const uint32_t first = alloc8();
-        for (int c = 0; c < 8; ++c) set(first + c, copy_subtree(src, n.index + c, invert));
+        for (int c = 0; c < 8; ++c) {
+          uint8_t child_faces = 0;
+          for (int a = 0; a < 3; ++a) child_faces |= uint8_t(faces & (1u << (2 * a + ((c >> a) & 1))));
+          if (child_faces == 0) out_.inside_copy[(first & ~Fragment::kLocal) + c] = 1;
+          set(first + c, copy_nodes(src, n.index + c, invert, child_faces));
+        }
         return Node{first, CellKind::Internal, 0, 0, 0};
       }
     }
     return n;
   }
 
+ public:
   /// Appends a freshly sampled subtree; returns its root.
   Node append(const Builder& sub) {
     const size_t from = out_.nodes.size();
     Node root = append_subtree(out_.nodes, out_.vertices, sub);
+    out_.inside_copy.resize(out_.nodes.size(), 0);
     auto mark = [](Node& n) {
       if (n.kind == CellKind::Internal || n.kind == CellKind::Gray) n.index |= Fragment::kLocal;
     };
@@ -317,7 +347,13 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
   for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
   a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
+  // The new nodes are this operation's, stamped for the clean-up; but inside a copied subtree,
+  // off its root cell's faces, every neighbour is the source's own, as it was there: nothing
+  // for the clean-up to find that the source did not have (a union of disjoint parts no longer
+  // cleans each part whole).
   sa.resize(a.nodes.size(), stamp);
+  for (size_t k = 0; k < f.inside_copy.size(); ++k)
+    if (f.inside_copy[k]) sa[node_base + k] = 0;
   // A slot written here is part of the result this operation made, even where the tag step
   // left it unstamped (A uniform there, B's subtree copied in): the clean-up must see it, or
   // B's own defects there pass into the result unchecked (an island a sampled tool carries —
