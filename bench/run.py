@@ -7,6 +7,7 @@ PIC_BENCH_REPS runs unless stated otherwise.
 """
 import datetime
 import json
+import math
 import os
 import platform
 import shlex
@@ -404,7 +405,6 @@ def sculpt_peer():
 
 
 def write_uv_sphere(path, c, r, around, rings):
-    import math
     v = [(c[0], c[1], c[2] - r)]
     for i in range(1, rings):
         t = math.pi * i / rings

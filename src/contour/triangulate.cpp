@@ -178,6 +178,12 @@ double pierce(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e0, const
   return (h - e0[ax]) / (e1[ax] - e0[ax]);
 }
 
+// How well edge parameter t places an edge point: first how far it falls outside the edge,
+// then how far from `prefer`; smaller is better.
+std::pair<double, double> edge_key(double t, double prefer) {
+  return {std::max({0.0, -t, t - 1}), std::abs(t - prefer)};
+}
+
 // The edge parameter where the line of edge (e0, e1) pierces the plain split of the polygons
 // `near` (their triangles): inside the edge if it can, then nearest to `prefer`; NaN when the
 // line pierces none. The plain dual contouring surface crosses a sign-changing edge within its
@@ -186,13 +192,12 @@ double pierce(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e0, const
 double pierce_near(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& polys, const std::vector<Split>& splits,
                    const uint32_t* near, size_t count, const Vec3& e0, const Vec3& e1, double prefer) {
   double best = std::numeric_limits<double>::quiet_NaN();
-  const auto key = [&](double t) { return std::pair(std::max({0.0, -t, t - 1}), std::abs(t - prefer)); };
   for (size_t k = 0; k < count; ++k) {
     const MeshPolygon& p = polys[near[k]];
     const Split& sp = splits[near[k]];
     for (int i = 0; i < (p.count == 4 ? 2 : 1); ++i) {
       const double t = pierce(x[p.v[sp[i][0]]], x[p.v[sp[i][1]]], x[p.v[sp[i][2]]], e0, e1);
-      if (t == t && (best != best || key(t) < key(best))) best = t;
+      if (t == t && (best != best || edge_key(t, prefer) < edge_key(best, prefer))) best = t;
     }
   }
   return best;
@@ -257,13 +262,9 @@ double edge_parameter(const PlainSurface& s, size_t i) {
   std::array<Vec3, 4> q;
   for (int k = 0; k < p.count; ++k) q[k] = s.x[p.v[k]];
   const double prefer = ring_height(q, p.count, p.e0, p.e1);
-  const auto better = [&](double a, double b) {
-    const double oa = std::max({0.0, -a, a - 1}), ob = std::max({0.0, -b, b - 1});
-    return oa < ob || (oa == ob && std::abs(a - prefer) < std::abs(b - prefer));
-  };
   const auto look = [&](const uint32_t* list, size_t count, double& t) {
     const double h = pierce_near(s.x, s.polys, s.splits, list, count, p.e0, p.e1, prefer);
-    if (h == h && (t != t || better(h, t))) t = h;
+    if (h == h && (t != t || edge_key(h, prefer) < edge_key(t, prefer))) t = h;
   };
   const uint32_t self = uint32_t(i);
   double t = std::numeric_limits<double>::quiet_NaN();
