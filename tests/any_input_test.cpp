@@ -187,6 +187,72 @@ TEST(AnyInput, OverlappingShellsGiveTheirUnion) {
   EXPECT_LT(volume(contour_split(par)) / exact, 0.92);
 }
 
+// A box as the intersection of three slabs (centre, unit axes, half sizes): the signed
+// distance of p to its surface, < 0 inside.
+struct OrientedBox {
+  Vec3 centre;
+  std::array<Vec3, 3> axes;
+  Vec3 half;
+  double signed_distance(const Vec3& p) const {
+    double out = 0, in = -1e300;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::abs(dot3(sub3(p, centre), axes[k])) - half[k];
+      out += d > 0 ? d * d : 0;
+      in = std::max(in, d);
+    }
+    return out > 0 ? std::sqrt(out) : in;
+  }
+  TriMesh mesh() const {
+    TriMesh m = make_box({-half[0], -half[1], -half[2]}, half);
+    for (Vec3& p : m.positions) {
+      Vec3 q = centre;
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j) q[j] += p[k] * axes[k][j];
+      p = q;
+    }
+    return m;
+  }
+};
+
+TEST(AnyInput, OverlappingBoxesKeepEveryVertexOnTheUnionsSurface) {
+  // Four boxes in one mesh, one of them turned: a small box covers part of a big one's top and
+  // part of the turned box's wall. A wall triangle whose test points are all covered is
+  // dropped as interior, though a corner of it bounds the union; the vertices there must
+  // still follow it (they sat 30 finest cells inside the small box).
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  const std::array<Vec3, 3> axes{Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
+  const std::array<Vec3, 3> turned{Vec3{c, s, 0}, Vec3{-s, c, 0}, Vec3{0, 0, 1}};
+  const std::vector<OrientedBox> boxes{{{0.5, 0.5, 0.5}, axes, {0.5, 0.5, 0.5}},
+                                       {{1.5, 0.5, 0.5}, axes, {0.5, 0.5, 0.5}},
+                                       {{1.0, 1.0, 1.0}, turned, {0.5, 0.5, 0.5}},
+                                       {{0.5, 0.5, 1.15}, axes, {0.3, 0.3, 0.25}}};
+  TriMesh soup;
+  for (const OrientedBox& b : boxes) {
+    const TriMesh m = b.mesh();
+    const auto base = static_cast<uint32_t>(soup.positions.size());
+    soup.positions.insert(soup.positions.end(), m.positions.begin(), m.positions.end());
+    for (auto t : m.triangles) soup.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  SampleStats st;
+  const Octree t = sample_depth(soup, 9, &st);
+  ASSERT_EQ(st.classifier, "winding");
+  EXPECT_GT(st.interior_triangles, 0u);
+  const TriMesh m = contour_split(t);
+  EXPECT_TRUE(IsClosedManifold(m));
+  const double cell = t.cube.size / 512;
+  double worst = 0;
+  for (const Vec3& p : m.positions) {
+    double on = 1e300, deepest = 0;
+    for (const OrientedBox& b : boxes) {
+      const double d = b.signed_distance(p);
+      on = std::min(on, std::abs(d));
+      deepest = std::min(deepest, d);
+    }
+    worst = std::max({worst, on, -deepest});
+  }
+  EXPECT_LT(worst, 0.05 * cell) << "a vertex off the union's surface";
+}
+
 TEST(AnyInput, AFlatSheetEnclosesNoSolid) {
   TriMesh sheet;
   sheet.positions = {{0.2, 0.2, 0.5}, {0.8, 0.2, 0.5}, {0.8, 0.8, 0.5}, {0.2, 0.8, 0.5}};

@@ -402,7 +402,11 @@ void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_
 
 void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind,
                                     const std::vector<uint32_t>& idx, Qef& q) const {
-  if (!wind || boundary_.empty()) return;
+  if (!wind) return;
+  if (boundary_.empty()) {
+    if (dropped_any_) add_dropped_wall_planes(cell, signs, *wind, idx, q);
+    return;
+  }
   if (!dropped_any_) {
     // Away from the caps the signs are parity's: every sign change on an edge is a crossing of
     // the input's surface (all of it in the QEF) — unless a triangle dropped as an interior
@@ -445,6 +449,41 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     memo = {a, len, axis, cache_.id(), x, n};
     if (n == Vec3{0, 0, 0}) continue;
     q.add_plane(n, dot3(n, x), 0.5);
+  }
+}
+
+void WindingSource::add_dropped_wall_planes(const Cell& cell, uint8_t signs, const Wind8& wind,
+                                            const std::vector<uint32_t>& idx, Qef& q) const {
+  // Overlapping closed shells: a triangle dropped as an interior wall may still bound the
+  // solid somewhere (its sample points were covered, a corner of it is not). Where a sign
+  // change on an edge is not explained by the triangles left in the QEF, the crossing that
+  // takes w to or from 0 gives the plane, so the vertex cannot ignore that piece of surface.
+  const i64 len = lattice_to_grid(cell.span());
+  thread_local std::vector<std::pair<double, uint32_t>> hits;
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    if ((((signs >> c0) ^ (signs >> c1)) & 1) == 0) continue;
+    const I3 a = lattice_to_grid(cell.corner(c0));
+    const Vec3 ua = to_unit(a);
+    hits.clear();
+    int surface = 0;
+    for (uint32_t k : idx) {
+      const ITri& t = all_[k];
+      if (!crosses(t, a, axis, len)) continue;
+      surface += (t.use & kUseQef) != 0;
+      hits.push_back({(t.plane - dot3(t.unit_normal, ua)) / t.unit_normal[axis], k});
+    }
+    if (surface & 1) continue;  // a kept triangle changes the sign here
+    std::sort(hits.begin(), hits.end());
+    int32_t w = wind[c0];
+    for (const auto& [s, k] : hits) {
+      const bool was = w != 0;
+      w -= sgn(all_[k].n[axis]);
+      if (was == (w != 0)) continue;
+      const ITri& t = all_[k];
+      q.add_plane(t.unit_normal, t.plane, 0.5);
+      break;
+    }
   }
 }
 

@@ -92,6 +92,10 @@ class WindingSource : public SurfaceSource {
   /// Whether the caps' winding number is certainly below 1/2 in magnitude all over `box` (unit
   /// space): there the caps cannot move a decision.
   bool caps_below_half(const Box& box) const;
+  /// Closed input with dropped walls: the planes of dropped triangles where they change a
+  /// cell edge's sign (add_fill_planes).
+  void add_dropped_wall_planes(const Cell& cell, uint8_t signs, const Wind8& wind, const std::vector<uint32_t>& idx,
+                               Qef& q) const;
 
   std::vector<ITri> all_;
   size_t mesh_count_;
