@@ -16,6 +16,7 @@
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "scad/text.h"
+#include "support/mesh_checks.h"
 #include "support/temp_dir.h"
 
 namespace pic {
@@ -331,17 +332,51 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
       "cube(size = [10, 2, 2]); cube(size = [2, 10, 2]); } cube(size = [2, 2, 2], center = true); } }",
       o)));
   EXPECT_NEAR(ell, 12 * 4 * 4 + 4 * 12 * 4 - 4 * 4 * 4, 320 * 1e-6);
-  // A part that is not convex is refused, not approximated.
+}
+
+// A non-convex operand plus a convex one: the operand moved, and the hull of each planar piece
+// of its surface plus the convex one.
+TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
+  EvalOptions o;
+  o.depth = 8;
+  // A 4-cube with a 2 x 2 notch along one vertical edge (a difference: its contour's faces are
+  // grouped by plane; the top is an L cut into convex pieces), grown by a centred 2-cube: the
+  // L's outline grows by 1 on every side and the notch shrinks to 2 x 2, so 6 x 6 - 2 x 2 in
+  // plan, 6 high.
+  const TriMesh notch = contour(eval_csg(
+      "minkowski() { difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } "
+      "cube(size = [2, 2, 2], center = true); }",
+      o));
+  EXPECT_TRUE(test::IsClosedManifold(notch));
+  EXPECT_NEAR(volume(notch), (36 - 4) * 6, 192 * 1e-5);
+  // A tube (its top and bottom are squares with square holes) grown by the same cube: the
+  // hole shrinks from 4 x 4 to 2 x 2 and stays open.
+  const TriMesh tube = contour(eval_csg(
+      "minkowski() { difference() { cube(size = [10, 10, 10], center = true); "
+      "cube(size = [4, 4, 20], center = true); } cube(size = [2, 2, 2], center = true); }",
+      o));
+  EXPECT_TRUE(test::IsClosedManifold(tube));
+  EXPECT_NEAR(volume(tube), 12 * 12 * 12 - 2 * 2 * 12, 1680 * 1e-5);
+  // Two non-convex operands are refused, not approximated.
   EXPECT_THROW(eval_csg("minkowski() { difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } "
-                        "sphere(r = 1); }",
+                        "difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } }",
                         o),
                InvalidInput);
-  // Extruded text is not convex either: refused at once (its convexity used to be tested by
-  // a hull of its mostly coplanar points, which did not finish).
-  EXPECT_THROW(eval_csg("minkowski() { linear_extrude(height = 2) { text(text = \"PIC\", size = 10); } "
-                        "sphere(r = 0.6, $fn = 12); }",
-                        o),
-               InvalidInput);
+}
+
+// Rounded text, the idiom that used to be refused: an extruded glyph with a hole plus a ball.
+// Closed, one part, and the volume of OpenSCAD 2021's CGAL render of the same model
+// (`openscad -o ref.stl`, Liberation Sans).
+constexpr double kRoundedPVolume = 140.1232047;
+TEST(ScadMinkowski, RoundedText) {
+  EvalOptions o;
+  o.depth = 8;
+  const TriMesh m = contour(eval_csg("minkowski() { linear_extrude(height = 2) { text(text = \"P\", size = 10); } "
+                                     "sphere(r = 0.5, $fn = 8); }",
+                                     o));
+  EXPECT_TRUE(test::IsClosedManifold(m));
+  EXPECT_EQ(test::component_count(m), 1u);
+  EXPECT_NEAR(volume(m) / kRoundedPVolume, 1, 0.005);
 }
 
 // hull() of extruded text: thousands of points on two planes. The hull tested "sees" with a

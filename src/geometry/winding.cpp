@@ -15,8 +15,6 @@ namespace {
 constexpr double kInv4Pi = 1.0 / (4 * std::numbers::pi);
 constexpr double kNearBeta = 1.5;  // inside(): nearer nodes are never summarized
 
-Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Vec3 scale3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
 
 // Winding number of a dipole of vector area `area` at `x`, seen from p; `radius` clamps the
 // distance so a point sample behaves like a disc of that radius next to it.

@@ -14,8 +14,8 @@
 namespace pic {
 namespace {
 
-Vec3 add3(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Vec3 mul3(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+using detail::add3;
+using detail::scale3;
 using detail::cross3;
 using detail::dot3;
 using detail::norm3;
@@ -172,7 +172,7 @@ std::vector<Vec3> surface_points(const TriMesh& m, size_t samples, uint64_t seed
       v = 1 - v;
     }
     const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-    pts.push_back(add3(a, add3(mul3(sub3(b, a), u), mul3(sub3(c, a), v))));
+    pts.push_back(add3(a, add3(scale3(sub3(b, a), u), scale3(sub3(c, a), v))));
   }
   return pts;
 }

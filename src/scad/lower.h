@@ -33,8 +33,10 @@ TriMesh solid_surface(const Solid& s, const EvalOptions& options);
 /// projection(): the shadow of a closed surface on z = 0 (union of its triangles' shadows), or,
 /// with `cut`, its section by that plane (projection.cpp).
 std::vector<Ring> project(const TriMesh& surface, bool cut);
-/// minkowski() of operands that are unions of convex parts: the union of the hulls of their
-/// parts' vertex sums. \throws InvalidInput for an operand with a non-convex part.
+/// minkowski() of operands that are unions of convex parts (the union of the hulls of their
+/// parts' vertex sums), at most one of them with non-convex parts (each such part plus a convex
+/// one: the part moved, and the hull of each surface triangle plus the convex part).
+/// \throws InvalidInput for two operands with non-convex parts.
 Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options);
 
 /// surface(): the solid under a height map, a .dat text matrix or a PNG (surface.cpp).

@@ -1,0 +1,336 @@
+// minkowski(): the sum of operands that are unions of convex parts, or of one operand with
+// non-convex parts and others without, as a union of convex hulls (and moved copies) that the
+// evaluator samples and unites on the octrees.
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "scad/lower.h"
+#include "scad/region.h"
+#include "geometry/union_find.h"
+#include "geometry/vec3.h"
+
+namespace pic::detail::scad {
+namespace {
+
+/// Whether a closed surface bounds a convex solid: connected, positive volume, and convex at
+/// every edge (each neighbour's far vertex on or below a triangle's plane). A closed connected
+/// surface that is locally convex everywhere is the boundary of a convex body. (Not a hull
+/// and a volume comparison: the incremental hull does not finish on large, mostly coplanar
+/// point sets such as extruded text.)
+bool convex(const TriMesh& m) {
+  if (m.triangles.empty() || !(volume(m) > 0)) return false;
+  Vec3 lo = m.positions[m.triangles[0][0]], hi = lo;
+  for (const auto& t : m.triangles)
+    for (uint32_t v : t)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.positions[v][k]), hi[k] = std::max(hi[k], m.positions[v][k]);
+  const double eps = 1e-9 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
+  by_edge.reserve(3 * m.triangles.size());
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int e = 0; e < 3; ++e)
+      if (!by_edge.emplace(uint64_t(m.triangles[f][e]) << 32 | m.triangles[f][(e + 1) % 3], f).second) return false;
+  UnionFind parts(m.triangles.size());
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+    const double len = std::sqrt(dot3(n, n));
+    for (int e = 0; e < 3; ++e) {
+      const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
+      if (it == by_edge.end()) return false;  // not closed
+      parts.join(f, it->second);
+      for (uint32_t v : m.triangles[it->second])
+        if (len > 0 && dot3(n, sub3(m.positions[v], a)) > eps * len) return false;
+    }
+  }
+  for (uint32_t f = 1; f < m.triangles.size(); ++f)
+    if (parts.root(f) != parts.root(0)) return false;
+  return true;
+}
+
+/// Whether a counter-clockwise ring turns left (or goes straight) at every vertex.
+bool convex_ring(const Ring& r) {
+  const size_t n = r.size();
+  double extent = 0;
+  for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  const double eps = 1e-12 * extent * extent;
+  for (size_t i = 0; i < n; ++i) {
+    const P2 &a = r[i], &b = r[(i + 1) % n], &c = r[(i + 2) % n];
+    if ((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) < -eps) return false;
+  }
+  return true;
+}
+
+/// The rings without vertices within `tol` of the line through their neighbours (a contour
+/// puts many along one straight edge; each would start a trapezoid strip).
+Region without_straight_vertices(Region region, double tol) {
+  for (Ring& r : region) {
+    Ring kept;
+    for (size_t i = 0; i < r.size(); ++i) {
+      const P2& a = kept.empty() ? r.back() : kept.back();
+      const P2 &b = r[i], &c = r[(i + 1) % r.size()];
+      const double dx = c[0] - a[0], dy = c[1] - a[1], len = std::hypot(dx, dy);
+      const double off = std::abs((b[0] - a[0]) * dy - (b[1] - a[1]) * dx);
+      const bool between = (b[0] - a[0]) * dx + (b[1] - a[1]) * dy > 0 && (c[0] - b[0]) * dx + (c[1] - b[1]) * dy > 0;
+      if (!(len > 0) || off > tol * len || !between) kept.push_back(b);
+    }
+    r = std::move(kept);
+  }
+  std::erase_if(region, [](const Ring& r) { return r.size() < 3; });
+  return region;
+}
+
+/// The region cut into convex pieces: trapezoids between consecutive heights of its vertices
+/// (in each strip the rings' edges across it, left to right, bound the filled, non-zero
+/// winding intervals), each stacked on the one below while their union stays convex.
+std::vector<Ring> convex_pieces(const Region& region) {
+  std::vector<double> ys;
+  for (const Ring& r : region)
+    for (const P2& p : r) ys.push_back(p[1]);
+  std::sort(ys.begin(), ys.end());
+  ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
+  struct Cross {
+    double mid, lo, hi;  // x at the strip's middle, bottom and top
+    int dir;
+  };
+  struct Piece {
+    std::vector<P2> left, right;  // bottom to top
+    Ring ring() const {
+      Ring out(right.begin(), right.end());
+      out.insert(out.end(), left.rbegin(), left.rend());
+      return out;
+    }
+  };
+  std::vector<Ring> out;
+  std::vector<Piece> open, next;
+  std::vector<Cross> cross;
+  for (size_t i = 0; i + 1 < ys.size(); ++i) {
+    const double y0 = ys[i], y1 = ys[i + 1];
+    cross.clear();
+    for (const Ring& r : region)
+      for (size_t k = 0; k < r.size(); ++k) {
+        const P2 &a = r[k], &b = r[(k + 1) % r.size()];
+        if (std::min(a[1], b[1]) > y0 || std::max(a[1], b[1]) < y1 || a[1] == b[1]) continue;
+        const auto x = [&](double y) { return a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]); };
+        cross.push_back({x((y0 + y1) / 2), x(y0), x(y1), b[1] > a[1] ? 1 : -1});
+      }
+    std::sort(cross.begin(), cross.end(), [](const Cross& a, const Cross& b) { return a.mid < b.mid; });
+    next.clear();
+    int w = 0;
+    for (size_t k = 0; k + 1 < cross.size(); ++k) {
+      w += cross[k].dir;
+      if (w == 0) continue;
+      const P2 bl{cross[k].lo, y0}, br{cross[k + 1].lo, y0}, tl{cross[k].hi, y1}, tr{cross[k + 1].hi, y1};
+      bool stacked = false;
+      for (Piece& p : open) {
+        if (p.left.empty() || p.left.back() != bl || p.right.back() != br) continue;
+        Piece q = p;
+        q.left.push_back(tl);
+        q.right.push_back(tr);
+        if (convex_ring(q.ring())) {
+          next.push_back(std::move(q));
+          p.left.clear();  // continued
+          stacked = true;
+        }
+        break;
+      }
+      if (!stacked) next.push_back({{bl, tl}, {br, tr}});
+    }
+    for (const Piece& p : open)
+      if (!p.left.empty()) out.push_back(p.ring());
+    std::swap(open, next);
+  }
+  for (const Piece& p : open)
+    if (!p.left.empty()) out.push_back(p.ring());
+  return out;
+}
+
+/// Convex planar polygons covering a surface, each inside it: edge-neighbours on one plane
+/// (within `tol`, world units) are grouped, their union taken (Clipper), and an outline that
+/// is not one convex ring cut into trapezoids. A sum then needs one hull
+/// per face of a polyhedral solid, not one per triangle of its contour.
+std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
+  const size_t nt = m.triangles.size();
+  std::vector<Vec3> normal(nt);
+  for (size_t f = 0; f < nt; ++f) {
+    const auto& t = m.triangles[f];
+    normal[f] = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+  }
+  std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
+  by_edge.reserve(3 * nt);
+  for (uint32_t f = 0; f < nt; ++f)
+    for (int e = 0; e < 3; ++e) by_edge.emplace(uint64_t(m.triangles[f][e]) << 32 | m.triangles[f][(e + 1) % 3], f);
+  UnionFind groups(nt);
+  for (uint32_t f = 0; f < nt; ++f) {
+    const auto& t = m.triangles[f];
+    const double len = norm3(normal[f]);
+    if (!(len > 0)) continue;
+    for (int e = 0; e < 3; ++e) {
+      const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
+      // Parallel normals too: a sliver along a crease has its vertices on both faces' planes.
+      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) <= (1 - 1e-8) * len * norm3(normal[it->second]))
+        continue;
+      bool flat = true;
+      for (uint32_t v : m.triangles[it->second])
+        flat = flat && std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[t[0]]))) <= tol * len;
+      if (flat) groups.join(f, it->second);
+    }
+  }
+  std::unordered_map<size_t, std::vector<uint32_t>> members;
+  for (uint32_t f = 0; f < nt; ++f) members[groups.root(f)].push_back(f);
+  std::vector<std::vector<Vec3>> out;
+  for (uint32_t f = 0; f < nt; ++f) {
+    if (groups.root(f) != f) continue;
+    const std::vector<uint32_t>& tris = members[f];
+    if (tris.size() == 1) {
+      const auto& t = m.triangles[f];
+      out.push_back({m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]});
+      continue;
+    }
+    // The group's plane frame: origin at a vertex, u and v across the summed normal.
+    Vec3 n{0, 0, 0};
+    for (uint32_t g : tris) n = add3(n, normal[g]);
+    n = scale3(n, 1 / norm3(n));
+    const Vec3 o = m.positions[m.triangles[f][0]];
+    const Vec3 seed = std::abs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    Vec3 u = cross3(n, seed);
+    u = scale3(u, 1 / norm3(u));
+    const Vec3 v = cross3(n, u);
+    Region shadow;
+    for (uint32_t g : tris) {
+      Ring ring;
+      for (uint32_t k : m.triangles[g]) {
+        const Vec3 d = sub3(m.positions[k], o);
+        ring.push_back({dot3(d, u), dot3(d, v)});
+      }
+      if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
+      shadow.push_back(std::move(ring));
+    }
+    const Region outline = without_straight_vertices(region_union({shadow}), tol);
+    const auto lift = [&](const Ring& ring) {
+      std::vector<Vec3> pts;
+      for (const P2& p : ring) pts.push_back(add3(o, add3(scale3(u, p[0]), scale3(v, p[1]))));
+      return pts;
+    };
+    if (outline.size() == 1 && convex_ring(outline[0])) {
+      // The group's own vertices: their hull is the outline, without Clipper's rounding.
+      std::vector<Vec3> pts;
+      for (uint32_t g : tris)
+        for (uint32_t k : m.triangles[g]) pts.push_back(m.positions[k]);
+      out.push_back(std::move(pts));
+      continue;
+    }
+    for (const Ring& r : convex_pieces(outline)) out.push_back(lift(r));
+  }
+  return out;
+}
+
+// One part of a minkowski operand: a convex point set (its hull), or a closed non-convex
+// surface.
+struct Part {
+  std::vector<Vec3> points;  // convex: the hull's vertices
+  TriMesh surface;           // non-convex (empty when convex)
+  bool convex() const { return surface.triangles.empty(); }
+};
+
+Part surface_part(const TriMesh& m) {
+  if (convex(m)) return {convex_hull(m.positions).positions, {}};
+  return {{}, m};
+}
+
+// The solid as a union of parts; its surface when a part is not a primitive, a polyhedron or
+// a union of them (a hull, difference or intersection: evaluated and contoured).
+void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
+  switch (s.kind) {
+    case Solid::Kind::Empty: return;
+    case Solid::Kind::Union:
+      for (const Solid& c : s.children) parts_of(c, o, out);
+      return;
+    case Solid::Kind::Mesh: out.push_back(surface_part(s.mesh)); return;
+    default: {
+      const TriMesh m = solid_surface(s, o);
+      if (!m.triangles.empty()) out.push_back(surface_part(m));
+    }
+  }
+}
+
+std::vector<Vec3> sums(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  std::vector<Vec3> out;
+  out.reserve(a.size() * b.size());
+  for (const Vec3& p : a)
+    for (const Vec3& q : b) out.push_back(add3(p, q));
+  return out;
+}
+
+// A non-convex solid N plus a convex C: every x = n + c of the sum either has x - c0 in N or,
+// walking c from c0 to c inside C, x - c crosses N's surface. So N + C is N moved by any c0 of
+// C together with each planar piece of N's surface plus C (a convex hull).
+void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& out) {
+  // c0: the centroid of C's vertices, inside C, so that N + c0 shares no face with a hull
+  // (flush faces of opposite sides are where a sampled union is least certain).
+  Vec3 c0{0, 0, 0};
+  for (const Vec3& p : c) c0 = add3(c0, scale3(p, 1.0 / double(c.size())));
+  Part moved{{}, n};
+  for (Vec3& p : moved.surface.positions) p = add3(p, c0);
+  out.push_back(std::move(moved));
+  Vec3 lo = n.positions[0], hi = lo;
+  for (const Vec3& p : n.positions)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  // Float contour vertices sit within ~1e-7 of a cell of their planes: 1e-6 of the extent.
+  const double tol = 1e-6 * norm3(sub3(hi, lo));
+  for (const auto& piece : planar_pieces(n, tol)) out.push_back({convex_hull(sums(piece, c)).positions, {}});
+}
+
+// The parts as a solid: their hulls or surfaces, unioned on the octrees.
+Solid part_solid(const std::vector<Part>& parts) {
+  Solid out;
+  out.kind = Solid::Kind::Union;
+  for (const Part& p : parts) {
+    Solid leaf;
+    leaf.kind = Solid::Kind::Mesh;
+    leaf.mesh = p.convex() ? convex_hull(p.points) : p.surface;
+    if (!leaf.mesh.triangles.empty()) out.children.push_back(std::move(leaf));
+  }
+  if (out.children.empty()) return {};
+  if (out.children.size() == 1) return std::move(out.children[0]);
+  return out;
+}
+
+}  // namespace
+
+Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
+  // Above this many parts the sum is refused rather than left running for hours.
+  constexpr size_t kMaxParts = 100000;
+  std::vector<Part> acc;
+  bool first = true, single = true;
+  const Solid* only = nullptr;
+  for (const Solid& s : operands) {
+    if (s.kind == Solid::Kind::Empty) continue;
+    std::vector<Part> parts;
+    parts_of(s, o, parts);
+    only = &s;
+    if (first) {
+      acc = std::move(parts);
+      first = false;
+      continue;
+    }
+    single = false;
+    // (A1 u A2) + (B1 u B2) = union of Ai + Bj; a convex sum is the hull of vertex sums.
+    std::vector<Part> next;
+    for (const Part& a : acc)
+      for (const Part& b : parts) {
+        if (a.convex() && b.convex()) next.push_back({convex_hull(sums(a.points, b.points)).positions, {}});
+        else if (a.convex()) add_sum(b.surface, a.points, next);
+        else if (b.convex()) add_sum(a.surface, b.points, next);
+        else throw InvalidInput("the sum of two operands that are not unions of convex parts is not supported");
+        if (next.size() > kMaxParts) throw InvalidInput("too many convex parts");
+      }
+    acc = std::move(next);
+  }
+  // One operand is itself (its convex parts as hulls, as before).
+  if (single && only && std::any_of(acc.begin(), acc.end(), [](const Part& p) { return !p.convex(); })) return *only;
+  return part_solid(acc);
+}
+
+}  // namespace pic::detail::scad
