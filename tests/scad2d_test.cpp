@@ -491,9 +491,17 @@ TEST(ScadMinkowski, TwoDimensionalRoundedRectangle) {
   EXPECT_NEAR(area(outline_of("minkowski() { union() { square(size = [5, 1]); square(size = [1, 5]); } "
                               "square(size = [2, 2], center = true); }")),
               21 + 21 - 9, 1e-6);
-  EXPECT_THROW(outline_of("minkowski() { difference() { square(size = [4, 4]); square(size = [2, 2]); } "
-                          "circle(r = 1); }"),
-               InvalidInput);
+  // Non-convex operands are cut into convex pieces. A 4-square with a 2 x 2 notch (an L) grown
+  // by a centred 2-square: 6 x 6 less a 2 x 2 notch.
+  const std::string ell = "difference() { square(size = [4, 4]); square(size = [2, 2]); }";
+  EXPECT_NEAR(area(outline_of("minkowski() { " + ell + " square(size = [2, 2], center = true); }")), 36 - 4, 1e-6);
+  // A frame (a ring with a hole) grown the same way: 12 x 12 with a 2 x 2 hole left.
+  EXPECT_NEAR(area(outline_of("minkowski() { difference() { square(size = [10, 10], center = true); "
+                              "square(size = [4, 4], center = true); } square(size = [2, 2], center = true); }")),
+              144 - 4, 1e-6);
+  // Two L's: [0,4]x[2,4] u [2,4]x[0,2] summed with itself is [0,8]x[4,8] u [2,8]x[2,6] u
+  // [4,8]x[0,4], 32 + 12 + 8.
+  EXPECT_NEAR(area(outline_of("minkowski() { " + ell + " " + ell + " }")), 52, 1e-6);
 }
 
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {

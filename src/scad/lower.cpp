@@ -420,20 +420,21 @@ class Lowering {
     return f;
   }
 
-  // 2D minkowski() of operands that are unions of convex parts: the union of the hulls of the
-  // parts' vertex sums, as in 3D.
+  // 2D minkowski(): each operand cut into convex parts that cover it, the sum the union of the
+  // hulls of the parts' vertex sums.
   Region minkowski_2d(const Node& n, const Affine2& m) {
     std::vector<Ring> acc;
     bool first = true;
     for (const Node& c : n.children) {
       std::vector<Ring> parts;
-      convex_parts_2d(n, c, kIdentity2, parts);
+      convex_parts_2d(c, kIdentity2, parts);
       if (parts.empty()) continue;
       if (first) {
         acc = std::move(parts);
         first = false;
         continue;
       }
+      if (acc.size() * parts.size() > 100000) fail(n, "too many convex parts");
       std::vector<Ring> next;
       for (const Ring& p : acc)
         for (const Ring& q : parts) {
@@ -447,23 +448,27 @@ class Lowering {
     return apply2(m, region_union({acc}));
   }
   // The convex parts of a 2D operand: the children of its unions kept apart, each evaluated
-  // region's rings convex (no holes). \throws naming the minkowski node otherwise.
-  void convex_parts_2d(const Node& mink, const Node& n, const Affine2& m, std::vector<Ring>& out) {
+  // region's rings as they are when convex (no holes), else the region cut into convex pieces.
+  void convex_parts_2d(const Node& n, const Affine2& m, std::vector<Ring>& out) {
     if (is_group(n.name)) {
-      for (const Node& c : n.children) convex_parts_2d(mink, c, m, out);
+      for (const Node& c : n.children) convex_parts_2d(c, m, out);
       return;
     }
     if (n.name == "multmatrix") {
       const Affine a = matrix(n);
-      for (const Node& c : n.children) convex_parts_2d(mink, c, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]}), out);
+      for (const Node& c : n.children) convex_parts_2d(c, compose2(m, {a[0], a[1], a[3], a[4], a[5], a[7]}), out);
       return;
     }
-    for (const Ring& ring : shape(n, m)) {
+    const Region region = shape(n, m);
+    const bool convex = std::all_of(region.begin(), region.end(), [](const Ring& ring) {
       const double area = signed_area(ring), hull = signed_area(convex_hull_2d(ring));
-      if (!(area > 0) || std::abs(hull - area) > 1e-9 * hull)
-        fail(mink, "an operand that is not a union of convex parts is not supported");
-      out.push_back(ring);
+      return area > 0 && std::abs(hull - area) <= 1e-9 * hull;
+    });
+    if (convex) {
+      out.insert(out.end(), region.begin(), region.end());
+      return;
     }
+    for (Ring& piece : convex_pieces(region)) out.push_back(std::move(piece));
   }
 
   std::vector<Region> children2(const Node& n, const Affine2& m) {

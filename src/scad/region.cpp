@@ -149,4 +149,101 @@ double region_area(const Region& region) {
   return a;
 }
 
+/// Whether a counter-clockwise ring turns left (or goes straight) at every vertex.
+bool convex_ring(const Ring& r) {
+  const size_t n = r.size();
+  double extent = 0;
+  for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  const double eps = 1e-12 * extent * extent;
+  for (size_t i = 0; i < n; ++i) {
+    const P2 &a = r[i], &b = r[(i + 1) % n], &c = r[(i + 2) % n];
+    if ((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) < -eps) return false;
+  }
+  return true;
+}
+
+/// The rings without vertices within `tol` of the line through their neighbours (a contour
+/// puts many along one straight edge; each would start a trapezoid strip).
+Region without_straight_vertices(Region region, double tol) {
+  for (Ring& r : region) {
+    Ring kept;
+    for (size_t i = 0; i < r.size(); ++i) {
+      const P2& a = kept.empty() ? r.back() : kept.back();
+      const P2 &b = r[i], &c = r[(i + 1) % r.size()];
+      const double dx = c[0] - a[0], dy = c[1] - a[1], len = std::hypot(dx, dy);
+      const double off = std::abs((b[0] - a[0]) * dy - (b[1] - a[1]) * dx);
+      const bool between = (b[0] - a[0]) * dx + (b[1] - a[1]) * dy > 0 && (c[0] - b[0]) * dx + (c[1] - b[1]) * dy > 0;
+      if (!(len > 0) || off > tol * len || !between) kept.push_back(b);
+    }
+    r = std::move(kept);
+  }
+  std::erase_if(region, [](const Ring& r) { return r.size() < 3; });
+  return region;
+}
+
+/// The region cut into convex pieces: trapezoids between consecutive heights of its vertices
+/// (in each strip the rings' edges across it, left to right, bound the filled, non-zero
+/// winding intervals), each stacked on the one below while their union stays convex.
+std::vector<Ring> convex_pieces(const Region& region) {
+  std::vector<double> ys;
+  for (const Ring& r : region)
+    for (const P2& p : r) ys.push_back(p[1]);
+  std::sort(ys.begin(), ys.end());
+  ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
+  struct Cross {
+    double mid, lo, hi;  // x at the strip's middle, bottom and top
+    int dir;
+  };
+  struct Piece {
+    std::vector<P2> left, right;  // bottom to top
+    Ring ring() const {
+      Ring out(right.begin(), right.end());
+      out.insert(out.end(), left.rbegin(), left.rend());
+      return out;
+    }
+  };
+  std::vector<Ring> out;
+  std::vector<Piece> open, next;
+  std::vector<Cross> cross;
+  for (size_t i = 0; i + 1 < ys.size(); ++i) {
+    const double y0 = ys[i], y1 = ys[i + 1];
+    cross.clear();
+    for (const Ring& r : region)
+      for (size_t k = 0; k < r.size(); ++k) {
+        const P2 &a = r[k], &b = r[(k + 1) % r.size()];
+        if (std::min(a[1], b[1]) > y0 || std::max(a[1], b[1]) < y1 || a[1] == b[1]) continue;
+        const auto x = [&](double y) { return a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]); };
+        cross.push_back({x((y0 + y1) / 2), x(y0), x(y1), b[1] > a[1] ? 1 : -1});
+      }
+    std::sort(cross.begin(), cross.end(), [](const Cross& a, const Cross& b) { return a.mid < b.mid; });
+    next.clear();
+    int w = 0;
+    for (size_t k = 0; k + 1 < cross.size(); ++k) {
+      w += cross[k].dir;
+      if (w == 0) continue;
+      const P2 bl{cross[k].lo, y0}, br{cross[k + 1].lo, y0}, tl{cross[k].hi, y1}, tr{cross[k + 1].hi, y1};
+      bool stacked = false;
+      for (Piece& p : open) {
+        if (p.left.empty() || p.left.back() != bl || p.right.back() != br) continue;
+        Piece q = p;
+        q.left.push_back(tl);
+        q.right.push_back(tr);
+        if (convex_ring(q.ring())) {
+          next.push_back(std::move(q));
+          p.left.clear();  // continued
+          stacked = true;
+        }
+        break;
+      }
+      if (!stacked) next.push_back({{bl, tl}, {br, tr}});
+    }
+    for (const Piece& p : open)
+      if (!p.left.empty()) out.push_back(p.ring());
+    std::swap(open, next);
+  }
+  for (const Piece& p : open)
+    if (!p.left.empty()) out.push_back(p.ring());
+  return out;
+}
+
 }  // namespace pic::detail::scad

@@ -32,4 +32,12 @@ std::vector<Ring> rings_from_segments(const std::vector<Segment>& segs, double t
 /// Area (holes subtracted).
 double region_area(const Region& region);
 
+/// Whether a counter-clockwise ring turns left (or goes straight) at every vertex.
+bool convex_ring(const Ring& ring);
+/// The rings without vertices within `tol` of the line through their neighbours.
+Region without_straight_vertices(Region region, double tol);
+/// The region cut into convex pieces (counter-clockwise rings) that cover it exactly:
+/// trapezoids between consecutive heights of its vertices, stacked while convex.
+std::vector<Ring> convex_pieces(const Region& region);
+
 }  // namespace pic::detail::scad
