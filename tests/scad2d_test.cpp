@@ -357,11 +357,32 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
       o));
   EXPECT_TRUE(test::IsClosedManifold(tube));
   EXPECT_NEAR(volume(tube), 12 * 12 * 12 - 2 * 2 * 12, 1680 * 1e-5);
-  // Two non-convex operands are refused, not approximated.
-  EXPECT_THROW(eval_csg("minkowski() { difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } "
-                        "difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } }",
-                        o),
-               InvalidInput);
+  // A ball with a corner cut away is the union of the ball beyond each face of the cube: three
+  // convex pieces, so the sum is three hulls (volume of OpenSCAD 2021's CGAL render).
+  const TriMesh ball = contour(eval_csg(
+      "minkowski() { difference() { sphere(r = 10); multmatrix([[1, 0, 0, 5], [0, 1, 0, 5], [0, 0, 1, 5], "
+      "[0, 0, 0, 1]]) { cube(size = [10, 10, 10], center = true); } } sphere(r = 1, $fn = 8); }",
+      o));
+  EXPECT_TRUE(test::IsClosedManifold(ball));
+  EXPECT_NEAR(volume(ball) / 4965.831324, 1, 0.005);
+  // A ball minus a ball has no few convex pieces and no flat faces to group: it would need
+  // tens of thousands of hulls, so it is refused at once with the count.
+  try {
+    eval_csg("minkowski() { difference() { sphere(r = 10, $fn = 48); sphere(r = 5, $fn = 48); } "
+             "sphere(r = 1, $fn = 8); }",
+             o);
+    FAIL() << "a curved operand was summed";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("planar pieces"), std::string::npos) << e.what();
+  }
+  // Two notched cubes: each decomposes into convex pieces, so their sum is exact: the L
+  // [0,4]x[2,4] u [2,4]x[0,2] plus itself (area 52, as in 2D) times a height of 8.
+  const std::string notched = "difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); }";
+  EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + notched + " " + notched + " }", o))), 52 * 8, 416 * 1e-5);
+  // Two non-convex operands without convex pieces (extruded L polygons) are refused.
+  const std::string ell =
+      "linear_extrude(height = 2) { polygon(points = [[0, 0], [4, 0], [4, 4], [2, 4], [2, 2], [0, 2]]); }";
+  EXPECT_THROW(eval_csg("minkowski() { " + ell + " " + ell + " }", o), InvalidInput);
 }
 
 // Rounded text, the idiom that used to be refused: an extruded glyph with a hole plus a ball.

@@ -49,16 +49,19 @@ bool convex(const TriMesh& m) {
   return true;
 }
 
-/// Convex planar polygons covering a surface, each inside it: edge-neighbours on one plane
-/// (within `tol`, world units) are grouped, their union taken (Clipper), and an outline that
-/// is not one convex ring cut into trapezoids. A sum then needs one hull
-/// per face of a polyhedral solid, not one per triangle of its contour.
+/// Convex planar polygons covering a surface, each within `tol` of it: edge-neighbours on one
+/// plane (within `tol`, world units, with parallel normals) are grouped; a group that is flat within
+/// `tol` as a whole has its union taken (Clipper), and an outline that is not one convex ring
+/// is cut into trapezoids; any other group stays one piece per triangle. A sum then needs one
+/// hull per face of a polyhedral solid, not one per triangle of its contour.
 std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
   const size_t nt = m.triangles.size();
-  std::vector<Vec3> normal(nt);
+  std::vector<Vec3> normal(nt);  // unit, or zero for a degenerate triangle
   for (size_t f = 0; f < nt; ++f) {
     const auto& t = m.triangles[f];
-    normal[f] = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+    const Vec3 n = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+    const double len = norm3(n);
+    normal[f] = len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0};
   }
   std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
   by_edge.reserve(3 * nt);
@@ -67,35 +70,45 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
   UnionFind groups(nt);
   for (uint32_t f = 0; f < nt; ++f) {
     const auto& t = m.triangles[f];
-    const double len = norm3(normal[f]);
-    if (!(len > 0)) continue;
     for (int e = 0; e < 3; ++e) {
       const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
-      // Parallel normals too: a sliver along a crease has its vertices on both faces' planes.
-      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) <= (1 - 1e-8) * len * norm3(normal[it->second]))
-        continue;
+      // Near-parallel normals too: a sliver along a crease has its vertices on both planes.
+      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) < 1 - 1e-8) continue;
       bool flat = true;
       for (uint32_t v : m.triangles[it->second])
-        flat = flat && std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[t[0]]))) <= tol * len;
+        flat = flat && std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[t[0]]))) <= tol;
       if (flat) groups.join(f, it->second);
     }
   }
   std::unordered_map<size_t, std::vector<uint32_t>> members;
   for (uint32_t f = 0; f < nt; ++f) members[groups.root(f)].push_back(f);
   std::vector<std::vector<Vec3>> out;
+  const auto each_triangle = [&](const std::vector<uint32_t>& tris) {
+    for (uint32_t g : tris) {
+      const auto& t = m.triangles[g];
+      out.push_back({m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]});
+    }
+  };
   for (uint32_t f = 0; f < nt; ++f) {
     if (groups.root(f) != f) continue;
     const std::vector<uint32_t>& tris = members[f];
-    if (tris.size() == 1) {
-      const auto& t = m.triangles[f];
-      out.push_back({m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]});
+    // The group's plane: area-weighted normal through its vertices' mean. Neighbours within
+    // `tol` of each other can drift round a finely faceted curve: then each triangle is a piece.
+    Vec3 n{0, 0, 0}, o{0, 0, 0};
+    for (uint32_t g : tris) {
+      const auto& t = m.triangles[g];
+      n = add3(n, cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]])));
+      for (uint32_t k : t) o = add3(o, scale3(m.positions[k], 1.0 / double(3 * tris.size())));
+    }
+    const double len = norm3(n);
+    bool flat = tris.size() > 1 && len > 0;
+    if (flat) n = scale3(n, 1 / len);
+    for (size_t i = 0; i < tris.size() && flat; ++i)
+      for (uint32_t k : m.triangles[tris[i]]) flat = flat && std::abs(dot3(n, sub3(m.positions[k], o))) <= tol;
+    if (!flat) {
+      each_triangle(tris);
       continue;
     }
-    // The group's plane frame: origin at a vertex, u and v across the summed normal.
-    Vec3 n{0, 0, 0};
-    for (uint32_t g : tris) n = add3(n, normal[g]);
-    n = scale3(n, 1 / norm3(n));
-    const Vec3 o = m.positions[m.triangles[f][0]];
     const Vec3 seed = std::abs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
     Vec3 u = cross3(n, seed);
     u = scale3(u, 1 / norm3(u));
@@ -131,6 +144,12 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
 
 // One part of a minkowski operand: a convex point set (its hull), or a closed non-convex
 // surface.
+void extent(const Solid& s, Vec3& lo, Vec3& hi) {
+  for (const Vec3& p : s.mesh.positions)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  for (const Solid& c : s.children) extent(c, lo, hi);
+}
+
 struct Part {
   std::vector<Vec3> points;  // convex: the hull's vertices
   TriMesh surface;           // non-convex (empty when convex)
@@ -142,20 +161,172 @@ Part surface_part(const TriMesh& m) {
   return {{}, m};
 }
 
-// The solid as a union of parts; its surface when a part is not a primitive, a polyhedron or
-// a union of them (a hull, difference or intersection: evaluated and contoured).
-void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
-  switch (s.kind) {
-    case Solid::Kind::Empty: return;
-    case Solid::Kind::Union:
-      for (const Solid& c : s.children) parts_of(c, o, out);
-      return;
-    case Solid::Kind::Mesh: out.push_back(surface_part(s.mesh)); return;
-    default: {
-      const TriMesh m = solid_surface(s, o);
-      if (!m.triangles.empty()) out.push_back(surface_part(m));
-    }
+// ---- convex decomposition of differences and intersections of convex parts ----------------
+
+struct Plane {
+  Vec3 n;  // unit, outward
+  double d;
+};
+using Convex = std::vector<Vec3>;  // a convex polytope: its hull's vertices
+
+std::vector<Plane> face_planes(const TriMesh& hull) {
+  std::vector<Plane> out;
+  for (const auto& t : hull.triangles) {
+    const Vec3 &a = hull.positions[t[0]], &b = hull.positions[t[1]], &c = hull.positions[t[2]];
+    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+    const double len = norm3(n);
+    if (!(len > 0)) continue;
+    const Plane p{scale3(n, 1 / len), dot3(n, a) / len};
+    // The two triangles of a quad give one plane: one clipped piece, not two.
+    const bool seen = std::any_of(out.begin(), out.end(), [&](const Plane& q) {
+      return dot3(p.n, q.n) > 1 - 1e-12 && std::abs(p.d - q.d) <= 1e-12 * (1 + std::abs(p.d));
+    });
+    if (!seen) out.push_back(p);
   }
+  return out;
+}
+
+// The part of a convex polytope on the side n.x >= d (`outside` of the plane) or n.x <= d:
+// its vertices there and its edges' crossings. Empty when it does not reach past the plane
+// by more than eps.
+Convex clip(const TriMesh& hull, const Plane& p, bool outside, double eps) {
+  const double sign = outside ? 1 : -1;
+  std::vector<double> side(hull.positions.size());
+  bool reaches = false;
+  for (size_t i = 0; i < side.size(); ++i) {
+    side[i] = sign * (dot3(p.n, hull.positions[i]) - p.d);
+    reaches = reaches || side[i] > eps;
+  }
+  if (!reaches) return {};
+  Convex out;
+  for (size_t i = 0; i < side.size(); ++i)
+    if (side[i] >= 0) out.push_back(hull.positions[i]);
+  for (const auto& t : hull.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[e], b = t[(e + 1) % 3];
+      if (a < b && ((side[a] > 0 && side[b] < 0) || (side[a] < 0 && side[b] > 0))) {
+        const double l = side[a] / (side[a] - side[b]);
+        out.push_back(add3(hull.positions[a], scale3(sub3(hull.positions[b], hull.positions[a]), l)));
+      }
+    }
+  return out;
+}
+
+bool boxes_apart(const Convex& a, const Convex& b) {
+  for (int k = 0; k < 3; ++k) {
+    double alo = 1e300, ahi = -1e300, blo = 1e300, bhi = -1e300;
+    for (const Vec3& p : a) alo = std::min(alo, p[k]), ahi = std::max(ahi, p[k]);
+    for (const Vec3& p : b) blo = std::min(blo, p[k]), bhi = std::max(bhi, p[k]);
+    if (ahi < blo || bhi < alo) return true;
+  }
+  return false;
+}
+
+// Each part of a sum is sampled and united on its own (tens of milliseconds): an operand with
+// more pieces than this is refused at once rather than left running for minutes (a difference
+// that decomposes into more falls back to its contour's flat faces first).
+constexpr size_t kMaxPieces = 4000;
+// A decomposition's pieces overlap and are large (a sphere minus a ball would give one piece
+// per face of the ball): past this many, the contour's flat faces serve better.
+constexpr size_t kMaxConvexPieces = 256;
+
+/// The solid as convex polytopes whose union it is, or false (a non-convex leaf, a hull of a
+/// difference, too many pieces). P - Q for convex Q is the union over Q's faces of P beyond
+/// that face's plane (a point outside Q is beyond one of them); P n Q is P clipped by every
+/// face of Q. Pieces may overlap.
+bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) {
+  switch (s.kind) {
+    case Solid::Kind::Empty: return true;
+    case Solid::Kind::Mesh:
+      if (!convex(s.mesh)) return false;
+      out.push_back(convex_hull(s.mesh.positions).positions);
+      return true;
+    case Solid::Kind::Union:
+      for (const Solid& c : s.children)
+        if (!convex_decomposition(c, eps, out)) return false;
+      return out.size() <= kMaxConvexPieces;
+    case Solid::Kind::Difference:
+    case Solid::Kind::Intersect: {
+      const bool difference = s.kind == Solid::Kind::Difference;
+      std::vector<Convex> parts;
+      if (s.children.empty() || !convex_decomposition(s.children[0], eps, parts)) return false;
+      for (size_t i = 1; i < s.children.size(); ++i) {
+        std::vector<Convex> cutters;
+        if (!convex_decomposition(s.children[i], eps, cutters)) return false;
+        if (!difference && cutters.size() != 1) return false;  // (A n (B u C): not needed yet)
+        for (const Convex& q : cutters) {
+          const TriMesh qh = convex_hull(q);
+          const std::vector<Plane> planes = face_planes(qh);
+          std::vector<Convex> next;
+          for (const Convex& part : parts) {
+            if (difference && boxes_apart(part, q)) {
+              next.push_back(part);
+              continue;
+            }
+            const TriMesh ph = convex_hull(part);
+            if (!difference) {
+              TriMesh cut = ph;
+              for (const Plane& pl : planes) {
+                const Convex c = clip(cut, pl, false, eps);
+                cut = c.empty() ? TriMesh{} : convex_hull(c);
+                if (cut.triangles.empty()) break;
+              }
+              if (!cut.triangles.empty()) next.push_back(cut.positions);
+              continue;
+            }
+            // Outside q's box the part is kept in up to six slabs; only the part inside the box
+            // is split by q's faces (so a plate with holes in a row is not split by every hole
+            // once per piece left by the others).
+            TriMesh rest = ph;
+            Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+            for (const Vec3& v : q)
+              for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+            for (int k = 0; k < 3 && !rest.triangles.empty(); ++k) {
+              Vec3 axis{0, 0, 0};
+              axis[k] = 1;
+              for (const Plane& side : {Plane{scale3(axis, -1), -lo[k]}, Plane{axis, hi[k]}}) {
+                if (Convex c = clip(rest, side, true, eps); !c.empty()) next.push_back(std::move(c));
+                const Convex inner = clip(rest, side, false, eps);
+                rest = inner.empty() ? TriMesh{} : convex_hull(inner);
+                if (rest.triangles.empty()) break;
+              }
+            }
+            if (rest.triangles.empty()) continue;
+            for (const Plane& pl : planes)
+              if (Convex c = clip(rest, pl, true, eps); !c.empty()) next.push_back(std::move(c));
+          }
+          if (next.size() > kMaxConvexPieces) return false;
+          parts = std::move(next);
+        }
+      }
+      out.insert(out.end(), parts.begin(), parts.end());
+      return out.size() <= kMaxConvexPieces;
+    }
+    default: return false;
+  }
+}
+
+// The solid as a union of parts: convex polytopes where it decomposes into few, else its
+// surface (a leaf's mesh, or the subtree evaluated on octrees and contoured).
+void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
+  if (s.kind == Solid::Kind::Empty) return;
+  if (s.kind == Solid::Kind::Union) {
+    for (const Solid& c : s.children) parts_of(c, o, out);
+    return;
+  }
+  if (s.kind == Solid::Kind::Mesh) {
+    out.push_back(surface_part(s.mesh));
+    return;
+  }
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  extent(s, lo, hi);
+  std::vector<Convex> convex_parts;
+  if (convex_decomposition(s, 1e-9 * norm3(sub3(hi, lo)), convex_parts)) {
+    for (Convex& c : convex_parts) out.push_back({std::move(c), {}});
+    return;
+  }
+  const TriMesh m = solid_surface(s, o);
+  if (!m.triangles.empty()) out.push_back(surface_part(m));
 }
 
 std::vector<Vec3> sums(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
@@ -180,9 +351,15 @@ void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& ou
   Vec3 lo = n.positions[0], hi = lo;
   for (const Vec3& p : n.positions)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  // Float contour vertices sit within ~1e-7 of a cell of their planes: 1e-6 of the extent.
+  // Float contour vertices on a flat face sit within ~1e-7 of a cell of its plane: 1e-6 of the
+  // extent. (Faces of a tessellated curve are not recovered at any useful tolerance: the
+  // contour's vertices between them are the sampler's, not the facets'.)
   const double tol = 1e-6 * norm3(sub3(hi, lo));
-  for (const auto& piece : planar_pieces(n, tol)) out.push_back({convex_hull(sums(piece, c)).positions, {}});
+  const auto pieces = planar_pieces(n, tol);
+  if (pieces.size() > kMaxPieces)
+    throw InvalidInput("a non-convex operand with " + std::to_string(pieces.size()) +
+                       " planar pieces (curved faces) is not supported: at most " + std::to_string(kMaxPieces));
+  for (const auto& piece : pieces) out.push_back({convex_hull(sums(piece, c)).positions, {}});
 }
 
 // The parts as a solid: their hulls or surfaces, unioned on the octrees.
