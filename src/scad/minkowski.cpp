@@ -230,6 +230,82 @@ constexpr size_t kMaxPieces = 4000;
 // per face of the ball): past this many, the contour's flat faces serve better.
 constexpr size_t kMaxConvexPieces = 256;
 
+/// A right prism (every vertex on one of two parallel planes, the two caps the same outline:
+/// a linear extrusion without twist or scale, however it was moved) as convex prisms over the
+/// convex pieces of its cap. False for any other mesh.
+bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
+  if (m.triangles.empty()) return false;
+  // The axis: a triangle's normal along which every vertex is on one of two planes (the caps';
+  // a wall's normal fails unless the prism is a box). The largest triangles are tried first.
+  std::vector<std::pair<double, Vec3>> normals;
+  for (const auto& t : m.triangles) {
+    const Vec3 n = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+    if (const double a = norm3(n); a > 0) normals.push_back({a, scale3(n, 1 / a)});
+  }
+  std::sort(normals.begin(), normals.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  const auto two_planes = [&](const Vec3& axis) {
+    double z0 = 1e300, z1 = -1e300;
+    for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
+    for (const Vec3& p : m.positions)
+      if (const double z = dot3(axis, p); std::abs(z - z0) > eps && std::abs(z - z1) > eps) return false;
+    return z1 - z0 > eps;
+  };
+  Vec3 axis{0, 0, 0};
+  for (size_t i = 0; i < normals.size() && i < 16 && axis == Vec3{0, 0, 0}; ++i)
+    if (two_planes(normals[i].second)) axis = normals[i].second;
+  if (axis == Vec3{0, 0, 0}) return false;
+  double z0 = 1e300, z1 = -1e300;
+  for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
+  const Vec3 seed = std::abs(axis[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  Vec3 u = cross3(axis, seed);
+  u = scale3(u, 1 / norm3(u));
+  const Vec3 v = cross3(axis, u);
+  std::vector<P2> bottom, top;
+  for (const Vec3& p : m.positions) {
+    const double z = dot3(axis, p);
+    const P2 q{dot3(u, p), dot3(v, p)};
+    if (std::abs(z - z0) <= eps) bottom.push_back(q);
+    else if (std::abs(z - z1) <= eps) top.push_back(q);
+    else return false;  // a vertex between the caps: twisted, scaled in slices, or no prism
+  }
+  const auto same = [&](std::vector<P2> a, std::vector<P2> b) {
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    b.erase(std::unique(b.begin(), b.end()), b.end());
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+      if (std::abs(a[i][0] - b[i][0]) > eps || std::abs(a[i][1] - b[i][1]) > eps) return false;
+    return true;
+  };
+  if (!same(bottom, top)) return false;
+  // The cap: the union of the triangles on the bottom plane, seen from outside the solid.
+  Region cap;
+  for (const auto& t : m.triangles) {
+    bool on = true;
+    for (uint32_t k : t) on = on && std::abs(dot3(axis, m.positions[k]) - z0) <= eps;
+    if (!on) continue;
+    Ring ring;
+    for (uint32_t k : t) ring.push_back({dot3(u, m.positions[k]), dot3(v, m.positions[k])});
+    if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
+    cap.push_back(std::move(ring));
+  }
+  const Region outline = region_union({cap});
+  // The prism's volume must be the cap's area times its height (else the walls are not the
+  // cap's outline moved straight up: a mesh with the same vertices but other faces).
+  if (std::abs(region_area(outline) * (z1 - z0) - volume(m)) > 1e-6 * std::abs(volume(m))) return false;
+  for (const Ring& r : convex_pieces(outline)) {
+    Convex c;
+    for (const P2& q : r) {
+      const Vec3 base = add3(scale3(u, q[0]), scale3(v, q[1]));
+      c.push_back(add3(base, scale3(axis, z0)));
+      c.push_back(add3(base, scale3(axis, z1)));
+    }
+    out.push_back(std::move(c));
+  }
+  return true;
+}
+
 /// The solid as convex polytopes whose union it is, or false (a non-convex leaf, a hull of a
 /// difference, too many pieces). P - Q for convex Q is the union over Q's faces of P beyond
 /// that face's plane (a point outside Q is beyond one of them); P n Q is P clipped by every
@@ -238,9 +314,11 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
   switch (s.kind) {
     case Solid::Kind::Empty: return true;
     case Solid::Kind::Mesh:
-      if (!convex(s.mesh)) return false;
-      out.push_back(convex_hull(s.mesh.positions).positions);
-      return true;
+      if (convex(s.mesh)) {
+        out.push_back(convex_hull(s.mesh.positions).positions);
+        return true;
+      }
+      return prism_pieces(s.mesh, eps, out) && out.size() <= kMaxConvexPieces;
     case Solid::Kind::Union:
       for (const Solid& c : s.children)
         if (!convex_decomposition(c, eps, out)) return false;
@@ -314,7 +392,7 @@ void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
     for (const Solid& c : s.children) parts_of(c, o, out);
     return;
   }
-  if (s.kind == Solid::Kind::Mesh) {
+  if (s.kind == Solid::Kind::Mesh && convex(s.mesh)) {
     out.push_back(surface_part(s.mesh));
     return;
   }
@@ -325,7 +403,7 @@ void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
     for (Convex& c : convex_parts) out.push_back({std::move(c), {}});
     return;
   }
-  const TriMesh m = solid_surface(s, o);
+  const TriMesh m = s.kind == Solid::Kind::Mesh ? s.mesh : solid_surface(s, o);
   if (!m.triangles.empty()) out.push_back(surface_part(m));
 }
 
