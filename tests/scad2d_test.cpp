@@ -379,10 +379,13 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   // [0,4]x[2,4] u [2,4]x[0,2] plus itself (area 52, as in 2D) times a height of 8.
   const std::string notched = "difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); }";
   EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + notched + " " + notched + " }", o))), 52 * 8, 416 * 1e-5);
-  // Two non-convex operands without convex pieces (extruded L polygons) are refused.
+  // Extruded L polygons are prisms over convex pieces: the same L area 52, 2 + 2 high.
   const std::string ell =
       "linear_extrude(height = 2) { polygon(points = [[0, 0], [4, 0], [4, 4], [2, 4], [2, 2], [0, 2]]); }";
-  EXPECT_THROW(eval_csg("minkowski() { " + ell + " " + ell + " }", o), InvalidInput);
+  EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell + " " + ell + " }", o))), 52 * 4, 208 * 1e-5);
+  // Two non-convex operands without convex pieces (twisted extrusions) are refused.
+  const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 4) { square(size = [2, 2]); }";
+  EXPECT_THROW(eval_csg("minkowski() { " + twisted + " " + twisted + " }", o), InvalidInput);
 }
 
 // Rounded text, the idiom that used to be refused: an extruded glyph with a hole plus a ball.
