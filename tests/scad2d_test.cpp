@@ -334,15 +334,14 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
   EXPECT_NEAR(ell, 12 * 4 * 4 + 4 * 12 * 4 - 4 * 4 * 4, 320 * 1e-6);
 }
 
-// A non-convex operand plus a convex one: the operand moved, and the hull of each planar piece
-// of its surface plus the convex one.
+// A non-convex operand plus a convex one: the operand cut into convex pieces (a difference of
+// convex parts, a prism), or moved, with the hull of each flat piece of its surface.
 TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   EvalOptions o;
   o.depth = 8;
-  // A 4-cube with a 2 x 2 notch along one vertical edge (a difference: its contour's faces are
-  // grouped by plane; the top is an L cut into convex pieces), grown by a centred 2-cube: the
-  // L's outline grows by 1 on every side and the notch shrinks to 2 x 2, so 6 x 6 - 2 x 2 in
-  // plan, 6 high.
+  // A 4-cube with a 2 x 2 notch along one vertical edge (the cube beyond each side face of the
+  // notch: two convex pieces), grown by a centred 2-cube: the L's outline grows by 1 on every
+  // side and the notch shrinks to 2 x 2, so 6 x 6 - 2 x 2 in plan, 6 high.
   const TriMesh notch = contour(eval_csg(
       "minkowski() { difference() { cube(size = [4, 4, 4]); cube(size = [2, 2, 9]); } "
       "cube(size = [2, 2, 2], center = true); }",
@@ -357,6 +356,19 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
       o));
   EXPECT_TRUE(test::IsClosedManifold(tube));
   EXPECT_NEAR(volume(tube), 12 * 12 * 12 - 2 * 2 * 12, 1680 * 1e-5);
+  // A plate with 6 x 6 square holes decomposes into too many pieces: its contour's flat faces
+  // are grouped instead (the top and bottom cut into trapezoids). Grown by the 2-cube, the
+  // 4 x 4 holes shrink to 2 x 2: 42 x 42 x 4 less 36 holes of 2 x 2 x 4.
+  std::string holes;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      holes += "multmatrix([[1, 0, 0, " + std::to_string(3 + 6 * i) + "], [0, 1, 0, " + std::to_string(3 + 6 * j) +
+               "], [0, 0, 1, -1], [0, 0, 0, 1]]) { cube(size = [4, 4, 4]); } ";
+  const TriMesh plate = contour(eval_csg(
+      "minkowski() { difference() { cube(size = [40, 40, 2]); " + holes + "} cube(size = [2, 2, 2], center = true); }",
+      o));
+  EXPECT_TRUE(test::IsClosedManifold(plate));
+  EXPECT_NEAR(volume(plate), 42 * 42 * 4 - 36 * 16, 6480 * 1e-4);
   // A ball with a corner cut away is the union of the ball beyond each face of the cube: three
   // convex pieces, so the sum is three hulls (volume of OpenSCAD 2021's CGAL render).
   const TriMesh ball = contour(eval_csg(
