@@ -39,6 +39,21 @@ std::vector<Ring> project(const TriMesh& surface, bool cut);
 /// \throws InvalidInput for two operands with non-convex parts.
 Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options);
 
+/// Whether a closed surface bounds a convex solid: connected, positive volume, convex at
+/// every edge (hull.cpp).
+bool is_convex(const TriMesh& m);
+/// A plane n.x = d, n unit and outward.
+struct Plane {
+  Vec3 n;
+  double d;
+};
+/// The distinct planes of a convex hull's faces.
+std::vector<Plane> face_planes(const TriMesh& hull);
+/// The part of a convex polytope (its hull) on the side n.x >= d (`outside`) or n.x <= d: its
+/// vertices there and its edges' crossings. Empty when it does not reach past the plane by
+/// more than eps.
+std::vector<Vec3> clip_convex(const TriMesh& hull, const Plane& p, bool outside, double eps);
+
 /// surface(): the solid under a height map, a .dat text matrix or a PNG (surface.cpp).
 /// \throws IoError when unreadable, InvalidInput when malformed.
 TriMesh surface_mesh(const std::filesystem::path& path, bool center, bool invert);

@@ -13,42 +13,6 @@
 namespace pic::detail::scad {
 namespace {
 
-/// Whether a closed surface bounds a convex solid: connected, positive volume, and convex at
-/// every edge (each neighbour's far vertex on or below a triangle's plane). A closed connected
-/// surface that is locally convex everywhere is the boundary of a convex body. (Not a hull
-/// and a volume comparison: the incremental hull does not finish on large, mostly coplanar
-/// point sets such as extruded text.)
-bool convex(const TriMesh& m) {
-  if (m.triangles.empty() || !(volume(m) > 0)) return false;
-  Vec3 lo = m.positions[m.triangles[0][0]], hi = lo;
-  for (const auto& t : m.triangles)
-    for (uint32_t v : t)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.positions[v][k]), hi[k] = std::max(hi[k], m.positions[v][k]);
-  const double eps = 1e-9 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
-  by_edge.reserve(3 * m.triangles.size());
-  for (uint32_t f = 0; f < m.triangles.size(); ++f)
-    for (int e = 0; e < 3; ++e)
-      if (!by_edge.emplace(uint64_t(m.triangles[f][e]) << 32 | m.triangles[f][(e + 1) % 3], f).second) return false;
-  UnionFind parts(m.triangles.size());
-  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
-    const auto& t = m.triangles[f];
-    const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
-    const double len = std::sqrt(dot3(n, n));
-    for (int e = 0; e < 3; ++e) {
-      const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
-      if (it == by_edge.end()) return false;  // not closed
-      parts.join(f, it->second);
-      for (uint32_t v : m.triangles[it->second])
-        if (len > 0 && dot3(n, sub3(m.positions[v], a)) > eps * len) return false;
-    }
-  }
-  for (uint32_t f = 1; f < m.triangles.size(); ++f)
-    if (parts.root(f) != parts.root(0)) return false;
-  return true;
-}
-
 /// Convex planar polygons covering a surface, each within `tol` of it: edge-neighbours on one
 /// plane (within `tol`, world units, with parallel normals) are grouped; a group that is flat within
 /// `tol` as a whole has its union taken (Clipper), and an outline that is not one convex ring
@@ -157,60 +121,13 @@ struct Part {
 };
 
 Part surface_part(const TriMesh& m) {
-  if (convex(m)) return {convex_hull(m.positions).positions, {}};
+  if (is_convex(m)) return {convex_hull(m.positions).positions, {}};
   return {{}, m};
 }
 
 // ---- convex decomposition of differences and intersections of convex parts ----------------
 
-struct Plane {
-  Vec3 n;  // unit, outward
-  double d;
-};
 using Convex = std::vector<Vec3>;  // a convex polytope: its hull's vertices
-
-std::vector<Plane> face_planes(const TriMesh& hull) {
-  std::vector<Plane> out;
-  for (const auto& t : hull.triangles) {
-    const Vec3 &a = hull.positions[t[0]], &b = hull.positions[t[1]], &c = hull.positions[t[2]];
-    const Vec3 n = cross3(sub3(b, a), sub3(c, a));
-    const double len = norm3(n);
-    if (!(len > 0)) continue;
-    const Plane p{scale3(n, 1 / len), dot3(n, a) / len};
-    // The two triangles of a quad give one plane: one clipped piece, not two.
-    const bool seen = std::any_of(out.begin(), out.end(), [&](const Plane& q) {
-      return dot3(p.n, q.n) > 1 - 1e-12 && std::abs(p.d - q.d) <= 1e-12 * (1 + std::abs(p.d));
-    });
-    if (!seen) out.push_back(p);
-  }
-  return out;
-}
-
-// The part of a convex polytope on the side n.x >= d (`outside` of the plane) or n.x <= d:
-// its vertices there and its edges' crossings. Empty when it does not reach past the plane
-// by more than eps.
-Convex clip(const TriMesh& hull, const Plane& p, bool outside, double eps) {
-  const double sign = outside ? 1 : -1;
-  std::vector<double> side(hull.positions.size());
-  bool reaches = false;
-  for (size_t i = 0; i < side.size(); ++i) {
-    side[i] = sign * (dot3(p.n, hull.positions[i]) - p.d);
-    reaches = reaches || side[i] > eps;
-  }
-  if (!reaches) return {};
-  Convex out;
-  for (size_t i = 0; i < side.size(); ++i)
-    if (side[i] >= 0) out.push_back(hull.positions[i]);
-  for (const auto& t : hull.triangles)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = t[e], b = t[(e + 1) % 3];
-      if (a < b && ((side[a] > 0 && side[b] < 0) || (side[a] < 0 && side[b] > 0))) {
-        const double l = side[a] / (side[a] - side[b]);
-        out.push_back(add3(hull.positions[a], scale3(sub3(hull.positions[b], hull.positions[a]), l)));
-      }
-    }
-  return out;
-}
 
 bool boxes_apart(const Convex& a, const Convex& b) {
   for (int k = 0; k < 3; ++k) {
@@ -314,7 +231,7 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
   switch (s.kind) {
     case Solid::Kind::Empty: return true;
     case Solid::Kind::Mesh:
-      if (convex(s.mesh)) {
+      if (is_convex(s.mesh)) {
         out.push_back(convex_hull(s.mesh.positions).positions);
         return true;
       }
@@ -345,7 +262,7 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
             if (!difference) {
               TriMesh cut = ph;
               for (const Plane& pl : planes) {
-                const Convex c = clip(cut, pl, false, eps);
+                const Convex c = clip_convex(cut, pl, false, eps);
                 cut = c.empty() ? TriMesh{} : convex_hull(c);
                 if (cut.triangles.empty()) break;
               }
@@ -363,15 +280,15 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
               Vec3 axis{0, 0, 0};
               axis[k] = 1;
               for (const Plane& side : {Plane{scale3(axis, -1), -lo[k]}, Plane{axis, hi[k]}}) {
-                if (Convex c = clip(rest, side, true, eps); !c.empty()) next.push_back(std::move(c));
-                const Convex inner = clip(rest, side, false, eps);
+                if (Convex c = clip_convex(rest, side, true, eps); !c.empty()) next.push_back(std::move(c));
+                const Convex inner = clip_convex(rest, side, false, eps);
                 rest = inner.empty() ? TriMesh{} : convex_hull(inner);
                 if (rest.triangles.empty()) break;
               }
             }
             if (rest.triangles.empty()) continue;
             for (const Plane& pl : planes)
-              if (Convex c = clip(rest, pl, true, eps); !c.empty()) next.push_back(std::move(c));
+              if (Convex c = clip_convex(rest, pl, true, eps); !c.empty()) next.push_back(std::move(c));
           }
           if (next.size() > kMaxConvexPieces) return false;
           parts = std::move(next);
@@ -392,7 +309,7 @@ void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
     for (const Solid& c : s.children) parts_of(c, o, out);
     return;
   }
-  if (s.kind == Solid::Kind::Mesh && convex(s.mesh)) {
+  if (s.kind == Solid::Kind::Mesh && is_convex(s.mesh)) {
     out.push_back(surface_part(s.mesh));
     return;
   }
