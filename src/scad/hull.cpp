@@ -1,5 +1,6 @@
 // Convex hulls for OpenSCAD's hull(): an incremental 3D hull (each point removes the faces it
-// sees and cones the horizon to itself) and Andrew's monotone chain in 2D.
+// sees and cones the horizon to itself) and Andrew's monotone chain in 2D; and the convex
+// polytope tests and clips that minkowski() cuts its operands with.
 //
 // "Sees" is decided by the exact orientation predicate: a point sees a face only when it lies
 // strictly above the face's plane. With a tolerance instead, a point almost on the planes of
