@@ -375,8 +375,6 @@ Solid part_solid(const std::vector<Part>& parts) {
 }  // namespace
 
 Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
-  // Above this many parts the sum is refused rather than left running for hours.
-  constexpr size_t kMaxParts = 100000;
   std::vector<Part> acc;
   bool first = true, single = true;
   const Solid* only = nullptr;
@@ -399,7 +397,8 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
         else if (a.convex()) add_sum(b.surface, a.points, next);
         else if (b.convex()) add_sum(a.surface, b.points, next);
         else throw InvalidInput("the sum of two operands that are not unions of convex parts is not supported");
-        if (next.size() > kMaxParts) throw InvalidInput("too many convex parts");
+        if (next.size() > kMaxPieces)
+          throw InvalidInput("the sum has more than " + std::to_string(kMaxPieces) + " convex parts");
       }
     acc = std::move(next);
   }
