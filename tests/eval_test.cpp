@@ -117,6 +117,24 @@ TEST(Eval, UnsupportedNodeNamesNodeAndLine) {
   }
 }
 
+// OpenSCAD warns about an import() of a file that does not exist and renders the rest; so
+// does pic eval (a file that exists but is broken is still an error).
+TEST(Eval, MissingImportIsLeftOutWithAWarning) {
+  EvalOptions o;
+  o.depth = 7;
+  std::vector<std::string> warnings;
+  o.warning = [&](const std::string& w) { warnings.push_back(w); };
+  const Octree t = eval_csg(
+      "union() {\n cube(size = [2, 3, 4]);\n import(file = \"no_such_part.stl\");\n"
+      " linear_extrude(height = 1) { import(file = \"no_such_drawing.dxf\"); }\n}",
+      o);
+  EXPECT_NEAR(volume(contour(t)), 24, 24 * 1e-6);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("line 3"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("no_such_part.stl"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("no_such_drawing.dxf"), std::string::npos) << warnings[1];
+}
+
 TEST(Eval, SyntaxErrorNamesLine) {
   EXPECT_THROW(eval_csg("cube(size = [1, 1, 1]);\ncube(size = [1, 1 1]);\n"), InvalidInput);
   try {

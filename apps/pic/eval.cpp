@@ -37,6 +37,7 @@ void run(const EvalArgs& a) {
   eo.smooth = a.smooth;
   eo.parallel = !a.serial;
   eo.progress = [](const std::string& m) { std::cerr << "pic: " << m << "\n"; };
+  eo.warning = [](const std::string& m) { std::cerr << "pic: warning: " << m << "\n"; };
   if (is_outline_path(a.out)) return run_outline(a, eo);
   EvalStats st;
   const Octree tree = eval_scad(a.in, eo, &st);

@@ -28,6 +28,9 @@ struct EvalOptions {
   std::filesystem::path base_dir;
   /// Called now and then with a one-line progress message (may be empty: silent).
   std::function<void(const std::string&)> progress;
+  /// Called with each warning where OpenSCAD warns and goes on (an `import()` of a file that
+  /// does not exist is an empty object, as in OpenSCAD); may be empty: silent.
+  std::function<void(const std::string&)> warning;
 };
 
 struct EvalStats {

@@ -322,8 +322,16 @@ class Lowering {
     return p.is_relative() ? opt_.base_dir / p : p;
   }
 
+  // OpenSCAD warns about an import() file that does not exist and goes on with nothing there.
+  bool missing(const Node& n, const std::filesystem::path& p) const {
+    std::error_code ec;
+    if (std::filesystem::exists(p, ec)) return false;
+    if (opt_.warning) opt_.warning("line " + std::to_string(n.line) + ": import: cannot open " + p.string() + " (left out)");
+    return true;
+  }
   TriMesh import(const Node& n) const {
     const std::filesystem::path p = file_arg(n);
+    if (missing(n, p)) return {};
     const std::string ext = lower_extension(p);
     if (ext == ".dxf" || ext == ".svg") fail(n, "a 2D drawing outside linear_extrude/rotate_extrude (the model must be 3D)");
     return read_mesh(p);
@@ -521,6 +529,7 @@ class Lowering {
   // import() of a DXF or SVG drawing, or the legacy `file` argument of an extrusion.
   Region import_2d(const Node& n) const {
     const std::filesystem::path p = file_arg(n);
+    if (missing(n, p)) return {};
     const std::string ext = lower_extension(p);
     if (ext == ".svg") return read_svg(p, number(n, "dpi", 72));
     if (ext != ".dxf") fail(n, "2D import of " + ext + " files is not supported (DXF and SVG are)");
