@@ -3,6 +3,7 @@
 // evaluator samples and unites on the octrees.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 
 #include "scad/lower.h"
@@ -13,12 +14,9 @@
 namespace pic::detail::scad {
 namespace {
 
-/// Convex planar polygons covering a surface, each within `tol` of it: edge-neighbours on one
-/// plane (within `tol`, world units, with parallel normals) are grouped; a group that is flat within
-/// `tol` as a whole has its union taken (Clipper), and an outline that is not one convex ring
-/// is cut into trapezoids; any other group stays one piece per triangle. A sum then needs one
-/// hull per face of a polyhedral solid, not one per triangle of its contour.
-std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
+// Edge-neighbouring triangles on one plane (within `tol`, world units, with parallel normals:
+// a sliver along a crease has its vertices on both faces' planes), in groups.
+std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol) {
   const size_t nt = m.triangles.size();
   std::vector<Vec3> normal(nt);  // unit, or zero for a degenerate triangle
   for (size_t f = 0; f < nt; ++f) {
@@ -36,7 +34,6 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
     const auto& t = m.triangles[f];
     for (int e = 0; e < 3; ++e) {
       const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
-      // Near-parallel normals too: a sliver along a crease has its vertices on both planes.
       if (it == by_edge.end() || dot3(normal[f], normal[it->second]) < 1 - 1e-8) continue;
       bool flat = true;
       for (uint32_t v : m.triangles[it->second])
@@ -44,65 +41,76 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
       if (flat) groups.join(f, it->second);
     }
   }
-  std::unordered_map<size_t, std::vector<uint32_t>> members;
-  for (uint32_t f = 0; f < nt; ++f) members[groups.root(f)].push_back(f);
-  std::vector<std::vector<Vec3>> out;
-  const auto each_triangle = [&](const std::vector<uint32_t>& tris) {
+  std::unordered_map<size_t, size_t> slot;
+  std::vector<std::vector<uint32_t>> out;
+  for (uint32_t f = 0; f < nt; ++f) {
+    const auto [it, fresh] = slot.emplace(groups.root(f), out.size());
+    if (fresh) out.emplace_back();
+    out[it->second].push_back(f);
+  }
+  return out;
+}
+
+// One group's convex pieces: a group flat within `tol` as a whole has its union taken
+// (Clipper), and an outline that is not one convex ring is cut into trapezoids; any other group
+// (neighbours within `tol` of each other can drift round a finely faceted curve) is one piece
+// per triangle.
+void group_pieces(const TriMesh& m, const std::vector<uint32_t>& tris, double tol,
+                  std::vector<std::vector<Vec3>>& out) {
+  // The group's plane: the area-weighted normal through its vertices' mean.
+  Vec3 n{0, 0, 0}, o{0, 0, 0};
+  for (uint32_t g : tris) {
+    const auto& t = m.triangles[g];
+    n = add3(n, cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]])));
+    for (uint32_t k : t) o = add3(o, scale3(m.positions[k], 1.0 / double(3 * tris.size())));
+  }
+  const double len = norm3(n);
+  bool flat = tris.size() > 1 && len > 0;
+  if (flat) n = scale3(n, 1 / len);
+  for (size_t i = 0; i < tris.size() && flat; ++i)
+    for (uint32_t k : m.triangles[tris[i]]) flat = flat && std::abs(dot3(n, sub3(m.positions[k], o))) <= tol;
+  if (!flat) {
     for (uint32_t g : tris) {
       const auto& t = m.triangles[g];
       out.push_back({m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]});
     }
-  };
-  for (uint32_t f = 0; f < nt; ++f) {
-    if (groups.root(f) != f) continue;
-    const std::vector<uint32_t>& tris = members[f];
-    // The group's plane: area-weighted normal through its vertices' mean. Neighbours within
-    // `tol` of each other can drift round a finely faceted curve: then each triangle is a piece.
-    Vec3 n{0, 0, 0}, o{0, 0, 0};
-    for (uint32_t g : tris) {
-      const auto& t = m.triangles[g];
-      n = add3(n, cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]])));
-      for (uint32_t k : t) o = add3(o, scale3(m.positions[k], 1.0 / double(3 * tris.size())));
-    }
-    const double len = norm3(n);
-    bool flat = tris.size() > 1 && len > 0;
-    if (flat) n = scale3(n, 1 / len);
-    for (size_t i = 0; i < tris.size() && flat; ++i)
-      for (uint32_t k : m.triangles[tris[i]]) flat = flat && std::abs(dot3(n, sub3(m.positions[k], o))) <= tol;
-    if (!flat) {
-      each_triangle(tris);
-      continue;
-    }
-    const Vec3 seed = std::abs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    Vec3 u = cross3(n, seed);
-    u = scale3(u, 1 / norm3(u));
-    const Vec3 v = cross3(n, u);
-    Region shadow;
-    for (uint32_t g : tris) {
-      Ring ring;
-      for (uint32_t k : m.triangles[g]) {
-        const Vec3 d = sub3(m.positions[k], o);
-        ring.push_back({dot3(d, u), dot3(d, v)});
-      }
-      if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
-      shadow.push_back(std::move(ring));
-    }
-    const Region outline = without_straight_vertices(region_union({shadow}), tol);
-    const auto lift = [&](const Ring& ring) {
-      std::vector<Vec3> pts;
-      for (const P2& p : ring) pts.push_back(add3(o, add3(scale3(u, p[0]), scale3(v, p[1]))));
-      return pts;
-    };
-    if (outline.size() == 1 && convex_ring(outline[0])) {
-      // The group's own vertices: their hull is the outline, without Clipper's rounding.
-      std::vector<Vec3> pts;
-      for (uint32_t g : tris)
-        for (uint32_t k : m.triangles[g]) pts.push_back(m.positions[k]);
-      out.push_back(std::move(pts));
-      continue;
-    }
-    for (const Ring& r : convex_pieces(outline)) out.push_back(lift(r));
+    return;
   }
+  const Vec3 seed = std::abs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  Vec3 u = cross3(n, seed);
+  u = scale3(u, 1 / norm3(u));
+  const Vec3 v = cross3(n, u);
+  Region shadow;
+  for (uint32_t g : tris) {
+    Ring ring;
+    for (uint32_t k : m.triangles[g]) {
+      const Vec3 d = sub3(m.positions[k], o);
+      ring.push_back({dot3(d, u), dot3(d, v)});
+    }
+    if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
+    shadow.push_back(std::move(ring));
+  }
+  const Region outline = without_straight_vertices(region_union({shadow}), tol);
+  if (outline.size() == 1 && convex_ring(outline[0])) {
+    // The group's own vertices: their hull is the outline, without Clipper's rounding.
+    std::vector<Vec3> pts;
+    for (uint32_t g : tris)
+      for (uint32_t k : m.triangles[g]) pts.push_back(m.positions[k]);
+    out.push_back(std::move(pts));
+    return;
+  }
+  for (const Ring& r : convex_pieces(outline)) {
+    std::vector<Vec3> pts;
+    for (const P2& p : r) pts.push_back(add3(o, add3(scale3(u, p[0]), scale3(v, p[1]))));
+    out.push_back(std::move(pts));
+  }
+}
+
+/// Convex planar polygons covering a surface, each within `tol` of it: one hull per face of a
+/// polyhedral solid in a sum, not one per triangle of its contour.
+std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
+  std::vector<std::vector<Vec3>> out;
+  for (const auto& tris : coplanar_groups(m, tol)) group_pieces(m, tris, tol, out);
   return out;
 }
 
@@ -147,30 +155,48 @@ constexpr size_t kMaxPieces = 4000;
 // per face of the ball): past this many, the contour's flat faces serve better.
 constexpr size_t kMaxConvexPieces = 256;
 
-/// A right prism (every vertex on one of two parallel planes, the two caps the same outline:
-/// a linear extrusion without twist or scale, however it was moved) as convex prisms over the
-/// convex pieces of its cap. False for any other mesh.
-bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
-  if (m.triangles.empty()) return false;
-  // The axis: a triangle's normal along which every vertex is on one of two planes (the caps';
-  // a wall's normal fails unless the prism is a box). The largest triangles are tried first.
+// A direction along which every vertex lies on one of two planes: a triangle's normal, the
+// largest triangles first (a cap's; a wall's fails unless the prism is a box).
+std::optional<Vec3> prism_axis(const TriMesh& m, double eps) {
   std::vector<std::pair<double, Vec3>> normals;
   for (const auto& t : m.triangles) {
     const Vec3 n = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
     if (const double a = norm3(n); a > 0) normals.push_back({a, scale3(n, 1 / a)});
   }
   std::sort(normals.begin(), normals.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-  const auto two_planes = [&](const Vec3& axis) {
+  for (size_t i = 0; i < normals.size() && i < 16; ++i) {
+    const Vec3& axis = normals[i].second;
     double z0 = 1e300, z1 = -1e300;
     for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
-    for (const Vec3& p : m.positions)
-      if (const double z = dot3(axis, p); std::abs(z - z0) > eps && std::abs(z - z1) > eps) return false;
-    return z1 - z0 > eps;
-  };
-  Vec3 axis{0, 0, 0};
-  for (size_t i = 0; i < normals.size() && i < 16 && axis == Vec3{0, 0, 0}; ++i)
-    if (two_planes(normals[i].second)) axis = normals[i].second;
-  if (axis == Vec3{0, 0, 0}) return false;
+    bool two = z1 - z0 > eps;
+    for (size_t k = 0; k < m.positions.size() && two; ++k) {
+      const double z = dot3(axis, m.positions[k]);
+      two = std::abs(z - z0) <= eps || std::abs(z - z1) <= eps;
+    }
+    if (two) return axis;
+  }
+  return std::nullopt;
+}
+
+// Whether two point sets are the same within eps.
+bool same_points(std::vector<P2> a, std::vector<P2> b, double eps) {
+  for (auto* v : {&a, &b}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a[i][0] - b[i][0]) > eps || std::abs(a[i][1] - b[i][1]) > eps) return false;
+  return true;
+}
+
+/// A right prism (every vertex on one of two parallel planes, the two caps the same outline:
+/// a linear extrusion without twist or scale, however it was moved) as convex prisms over the
+/// convex pieces of its cap. False for any other mesh.
+bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
+  const std::optional<Vec3> found = prism_axis(m, eps);
+  if (!found) return false;
+  const Vec3 axis = *found;
   double z0 = 1e300, z1 = -1e300;
   for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
   const Vec3 seed = std::abs(axis[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -185,17 +211,7 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
     else if (std::abs(z - z1) <= eps) top.push_back(q);
     else return false;  // a vertex between the caps: twisted, scaled in slices, or no prism
   }
-  const auto same = [&](std::vector<P2> a, std::vector<P2> b) {
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    a.erase(std::unique(a.begin(), a.end()), a.end());
-    b.erase(std::unique(b.begin(), b.end()), b.end());
-    if (a.size() != b.size()) return false;
-    for (size_t i = 0; i < a.size(); ++i)
-      if (std::abs(a[i][0] - b[i][0]) > eps || std::abs(a[i][1] - b[i][1]) > eps) return false;
-    return true;
-  };
-  if (!same(bottom, top)) return false;
+  if (!same_points(bottom, top, eps)) return false;
   // The cap: the union of the triangles on the bottom plane, seen from outside the solid.
   Region cap;
   for (const auto& t : m.triangles) {
@@ -223,10 +239,51 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
   return true;
 }
 
-/// The solid as convex polytopes whose union it is, or false (a non-convex leaf, a hull of a
-/// difference, too many pieces). P - Q for convex Q is the union over Q's faces of P beyond
-/// that face's plane (a point outside Q is beyond one of them); P n Q is P clipped by every
-/// face of Q. Pieces may overlap.
+// The part of a convex polytope on one side of a plane, as a hull (empty when none).
+TriMesh hull_of_side(const TriMesh& hull, const Plane& p, bool outside, double eps) {
+  const Convex c = clip_convex(hull, p, outside, eps);
+  return c.empty() ? TriMesh{} : convex_hull(c);
+}
+
+// P n Q for convex P and Q: P clipped by each face of Q.
+void intersect_convex(const Convex& part, const std::vector<Plane>& q_faces, double eps, std::vector<Convex>& out) {
+  TriMesh cut = convex_hull(part);
+  for (const Plane& pl : q_faces) {
+    cut = hull_of_side(cut, pl, false, eps);
+    if (cut.triangles.empty()) return;
+  }
+  out.push_back(cut.positions);
+}
+
+// P - Q for convex P and Q: outside Q's box, P in up to six slabs; inside it, P beyond each of
+// Q's faces (a point outside Q is beyond one of them). Splitting only the part inside the box
+// keeps a plate with holes in a row from being split by every hole once per piece of the
+// others.
+void subtract_convex(const Convex& part, const Convex& q, const std::vector<Plane>& q_faces, double eps,
+                     std::vector<Convex>& out) {
+  if (boxes_apart(part, q)) {
+    out.push_back(part);
+    return;
+  }
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Vec3& v : q)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  TriMesh rest = convex_hull(part);
+  for (int k = 0; k < 3; ++k) {
+    Vec3 axis{0, 0, 0};
+    axis[k] = 1;
+    for (const Plane& side : {Plane{scale3(axis, -1), -lo[k]}, Plane{axis, hi[k]}}) {
+      if (Convex c = clip_convex(rest, side, true, eps); !c.empty()) out.push_back(std::move(c));
+      rest = hull_of_side(rest, side, false, eps);
+      if (rest.triangles.empty()) return;
+    }
+  }
+  for (const Plane& pl : q_faces)
+    if (Convex c = clip_convex(rest, pl, true, eps); !c.empty()) out.push_back(std::move(c));
+}
+
+/// The solid as convex polytopes whose union it is (they may overlap), or false: a leaf that
+/// is neither convex nor a prism, a hull of a difference, too many pieces.
 bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) {
   switch (s.kind) {
     case Solid::Kind::Empty: return true;
@@ -248,47 +305,13 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
       for (size_t i = 1; i < s.children.size(); ++i) {
         std::vector<Convex> cutters;
         if (!convex_decomposition(s.children[i], eps, cutters)) return false;
-        if (!difference && cutters.size() != 1) return false;  // (A n (B u C): not needed yet)
+        if (!difference && cutters.size() != 1) return false;  // A n (B u C): not needed yet
         for (const Convex& q : cutters) {
-          const TriMesh qh = convex_hull(q);
-          const std::vector<Plane> planes = face_planes(qh);
+          const std::vector<Plane> q_faces = face_planes(convex_hull(q));
           std::vector<Convex> next;
           for (const Convex& part : parts) {
-            if (difference && boxes_apart(part, q)) {
-              next.push_back(part);
-              continue;
-            }
-            const TriMesh ph = convex_hull(part);
-            if (!difference) {
-              TriMesh cut = ph;
-              for (const Plane& pl : planes) {
-                const Convex c = clip_convex(cut, pl, false, eps);
-                cut = c.empty() ? TriMesh{} : convex_hull(c);
-                if (cut.triangles.empty()) break;
-              }
-              if (!cut.triangles.empty()) next.push_back(cut.positions);
-              continue;
-            }
-            // Outside q's box the part is kept in up to six slabs; only the part inside the box
-            // is split by q's faces (so a plate with holes in a row is not split by every hole
-            // once per piece left by the others).
-            TriMesh rest = ph;
-            Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-            for (const Vec3& v : q)
-              for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
-            for (int k = 0; k < 3 && !rest.triangles.empty(); ++k) {
-              Vec3 axis{0, 0, 0};
-              axis[k] = 1;
-              for (const Plane& side : {Plane{scale3(axis, -1), -lo[k]}, Plane{axis, hi[k]}}) {
-                if (Convex c = clip_convex(rest, side, true, eps); !c.empty()) next.push_back(std::move(c));
-                const Convex inner = clip_convex(rest, side, false, eps);
-                rest = inner.empty() ? TriMesh{} : convex_hull(inner);
-                if (rest.triangles.empty()) break;
-              }
-            }
-            if (rest.triangles.empty()) continue;
-            for (const Plane& pl : planes)
-              if (Convex c = clip_convex(rest, pl, true, eps); !c.empty()) next.push_back(std::move(c));
+            if (difference) subtract_convex(part, q, q_faces, eps, next);
+            else intersect_convex(part, q_faces, eps, next);
           }
           if (next.size() > kMaxConvexPieces) return false;
           parts = std::move(next);
