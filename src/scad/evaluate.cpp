@@ -21,16 +21,6 @@ using namespace detail::scad;
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-void bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& tris) {
-  if (s.kind == Solid::Kind::Mesh) {
-    ++leaves;
-    tris += s.mesh.triangles.size();
-    for (const Vec3& p : s.mesh.positions)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  }
-  for (const Solid& c : s.children) bounds(c, lo, hi, leaves, tris);
-}
-
 // Hull input: the vertices of the leaves, when the subtree is only unions (and hulls) of them.
 bool hull_points(const Solid& s, std::vector<Vec3>& out) {
   switch (s.kind) {
@@ -149,11 +139,21 @@ class Evaluator {
 }  // namespace
 
 namespace detail::scad {
+void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& triangles) {
+  if (s.kind == Solid::Kind::Mesh) {
+    ++leaves;
+    triangles += s.mesh.triangles.size();
+    for (const Vec3& p : s.mesh.positions)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  for (const Solid& c : s.children) solid_bounds(c, lo, hi, leaves, triangles);
+}
+
 TriMesh solid_surface(const Solid& s, const EvalOptions& options) {
   if (s.kind == Solid::Kind::Mesh) return s.mesh;
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   size_t leaves = 0, tris = 0;
-  bounds(s, lo, hi, leaves, tris);
+  solid_bounds(s, lo, hi, leaves, tris);
   if (leaves == 0) return {};
   TriMesh corners;
   corners.positions = {lo, hi};
@@ -193,7 +193,7 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
   if (options.smooth) first.smooth = false;
   Solid model = lower(0, &st.nodes);
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  bounds(model, lo, hi, st.leaves, st.triangles);
+  solid_bounds(model, lo, hi, st.leaves, st.triangles);
   if (model.kind == Solid::Kind::Empty || st.leaves == 0) throw InvalidInput(source + ": the model is empty");
   TriMesh corners;
   corners.positions = {lo, hi};
@@ -203,7 +203,7 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
     model = lower(st.cube.size / double(int64_t{1} << options.depth), nullptr);
     Vec3 lo2 = lo, hi2 = hi;
     st.leaves = st.triangles = 0;
-    bounds(model, lo2, hi2, st.leaves, st.triangles);
+    solid_bounds(model, lo2, hi2, st.leaves, st.triangles);
     corners.positions = {lo2, hi2};
     st.cube = bounding_cube(corners);
   }

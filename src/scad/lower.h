@@ -27,6 +27,8 @@ struct Solid {
 /// \throws InvalidInput for an unsupported node or bad arguments (naming the node's line).
 Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes);
 
+/// Grows [lo, hi] by the leaves' vertices; counts the leaves and their triangles.
+void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& triangles);
 /// The surface of a lowered 3D subtree: a leaf's own mesh, else its Booleans evaluated on
 /// octrees (options.depth, in the subtree's own cube) and contoured (evaluate.cpp).
 TriMesh solid_surface(const Solid& s, const EvalOptions& options);

@@ -2,6 +2,7 @@
 // non-convex parts and others without, as a union of convex hulls (and moved copies) that the
 // evaluator samples and unites on the octrees.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -116,12 +117,6 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
 
 // One part of a minkowski operand: a convex point set (its hull), or a closed non-convex
 // surface.
-void extent(const Solid& s, Vec3& lo, Vec3& hi) {
-  for (const Vec3& p : s.mesh.positions)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  for (const Solid& c : s.children) extent(c, lo, hi);
-}
-
 struct Part {
   std::vector<Vec3> points;  // convex: the hull's vertices
   TriMesh surface;           // non-convex (empty when convex)
@@ -137,13 +132,17 @@ Part surface_part(const TriMesh& m) {
 
 using Convex = std::vector<Vec3>;  // a convex polytope: its hull's vertices
 
-bool boxes_apart(const Convex& a, const Convex& b) {
-  for (int k = 0; k < 3; ++k) {
-    double alo = 1e300, ahi = -1e300, blo = 1e300, bhi = -1e300;
-    for (const Vec3& p : a) alo = std::min(alo, p[k]), ahi = std::max(ahi, p[k]);
-    for (const Vec3& p : b) blo = std::min(blo, p[k]), bhi = std::max(bhi, p[k]);
-    if (ahi < blo || bhi < alo) return true;
-  }
+// The bounding box of points: {lo, hi}.
+std::array<Vec3, 2> box_of(const std::vector<Vec3>& pts) {
+  std::array<Vec3, 2> b{Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}};
+  for (const Vec3& p : pts)
+    for (int k = 0; k < 3; ++k) b[0][k] = std::min(b[0][k], p[k]), b[1][k] = std::max(b[1][k], p[k]);
+  return b;
+}
+
+bool boxes_apart(const std::array<Vec3, 2>& a, const std::array<Vec3, 2>& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a[1][k] < b[0][k] || b[1][k] < a[0][k]) return true;
   return false;
 }
 
@@ -261,13 +260,11 @@ void intersect_convex(const Convex& part, const std::vector<Plane>& q_faces, dou
 // others.
 void subtract_convex(const Convex& part, const Convex& q, const std::vector<Plane>& q_faces, double eps,
                      std::vector<Convex>& out) {
-  if (boxes_apart(part, q)) {
+  const auto [lo, hi] = box_of(q);
+  if (boxes_apart(box_of(part), {lo, hi})) {
     out.push_back(part);
     return;
   }
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (const Vec3& v : q)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
   TriMesh rest = convex_hull(part);
   for (int k = 0; k < 3; ++k) {
     Vec3 axis{0, 0, 0};
@@ -332,18 +329,19 @@ void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
     for (const Solid& c : s.children) parts_of(c, o, out);
     return;
   }
-  if (s.kind == Solid::Kind::Mesh && is_convex(s.mesh)) {
-    out.push_back(surface_part(s.mesh));
-    return;
-  }
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  extent(s, lo, hi);
+  size_t leaves = 0, triangles = 0;
+  solid_bounds(s, lo, hi, leaves, triangles);
   std::vector<Convex> convex_parts;
   if (convex_decomposition(s, 1e-9 * norm3(sub3(hi, lo)), convex_parts)) {
     for (Convex& c : convex_parts) out.push_back({std::move(c), {}});
     return;
   }
-  const TriMesh m = s.kind == Solid::Kind::Mesh ? s.mesh : solid_surface(s, o);
+  if (s.kind == Solid::Kind::Mesh) {
+    out.push_back({{}, s.mesh});  // not convex: the decomposition took a convex leaf whole
+    return;
+  }
+  const TriMesh m = solid_surface(s, o);
   if (!m.triangles.empty()) out.push_back(surface_part(m));
 }
 
@@ -366,9 +364,7 @@ void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& ou
   Part moved{{}, n};
   for (Vec3& p : moved.surface.positions) p = add3(p, c0);
   out.push_back(std::move(moved));
-  Vec3 lo = n.positions[0], hi = lo;
-  for (const Vec3& p : n.positions)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const auto [lo, hi] = box_of(n.positions);
   // Float contour vertices on a flat face sit within ~1e-7 of a cell of its plane: 1e-6 of the
   // extent. (Faces of a tessellated curve are not recovered at any useful tolerance: the
   // contour's vertices between them are the sampler's, not the facets'.)
