@@ -81,6 +81,25 @@ TEST(Eval, FlushFacesDoNotRefine) {
   expect_volume(r, 46357.5454, 1e-4);  // OpenSCAD 2021's render
 }
 
+// Leaves whose boxes are apart are sampled together as one soup: the nine pins cost one
+// sampling and one Boolean, not nine of each; the two blocks that meet still need their union.
+TEST(Eval, LeavesApartAreSampledTogether) {
+  EvalOptions o;
+  o.depth = 8;
+  EvalStats st;
+  const Octree t = eval_csg_file(kData / "apart_leaves.csg", o, &st);
+  EXPECT_EQ(st.leaves, 13u);
+  // plate - soup of pins; (blocks A u B) and C apart, A u B meets the plate: 3 Booleans at most.
+  EXPECT_LE(st.booleans, 4u);
+  Result r;
+  r.mesh = unsplit_contour(t);
+  r.volume = volume(r.mesh);
+  expect_volume(r, 1560, 1e-3);
+  // One part (the blocks stand on the plate) with the nine holes through it: genus 9.
+  EXPECT_EQ(test::component_count(r.mesh), 1u);
+  EXPECT_EQ(test::euler_characteristic(r.mesh), 2 - 2 * 9);
+}
+
 TEST(Eval, HullOfTwoSpheres) {
   // The $fn = 16 sphere polytope: 8 rings of 16 points at polar angles 180 (i + 0.5) / 8; its
   // volume is the stack of frusta between rings (the caps are flat). The hull with its copy

@@ -145,8 +145,11 @@ void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, 
 
 std::vector<ITri> grid_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const std::vector<I3>& grid,
                                 size_t room) {
-  std::vector<ITri> out(tris.size());
+  // Room first: reserving after sizing moved every triangle once more (this VM pays dearly
+  // for each fresh page an allocation touches).
+  std::vector<ITri> out;
   out.reserve(tris.size() + room);
+  out.resize(tris.size());
   tbb::parallel_for(size_t{0}, tris.size(), [&](size_t i) {
     const auto& t = tris[i];
     out[i] = make_itri(grid[t[0]], grid[t[1]], grid[t[2]]);

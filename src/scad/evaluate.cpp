@@ -35,6 +35,25 @@ bool hull_points(const Solid& s, std::vector<Vec3>& out) {
   }
 }
 
+void append_mesh(TriMesh& to, const TriMesh& m) {
+  const auto base = static_cast<uint32_t>(to.positions.size());
+  to.positions.insert(to.positions.end(), m.positions.begin(), m.positions.end());
+  for (const auto& t : m.triangles) to.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+}
+
+// The mesh leaves of a subtree of unions only (none empty), or false when it holds anything
+// else.
+bool union_leaves(const Solid& s, std::vector<const TriMesh*>& out) {
+  switch (s.kind) {
+    case Solid::Kind::Mesh: out.push_back(&s.mesh); return true;
+    case Solid::Kind::Union:
+      for (const Solid& c : s.children)
+        if (!union_leaves(c, out)) return false;
+      return true;
+    default: return false;
+  }
+}
+
 class Evaluator {
  public:
   Evaluator(const EvalOptions& o, const Cube& cube, size_t leaves) : opt_(o), cube_(cube), total_(leaves) {
@@ -52,12 +71,17 @@ class Evaluator {
         report();
         return t;
       }
-      case Solid::Kind::Union: return balanced(s.children, 0, s.children.size(), CsgOp::Union);
+      case Solid::Kind::Union:
+        if (std::optional<Octree> t = folded_union(s.children, 0, s.children.size())) return t;
+        return balanced(s.children, 0, s.children.size(), CsgOp::Union);
       case Solid::Kind::Intersect: return balanced(s.children, 0, s.children.size(), CsgOp::Intersect);
       case Solid::Kind::Difference: {
         std::optional<Octree> a, b;
         invoke([&] { a = eval(s.children[0]); },
-               [&] { b = balanced(s.children, 1, s.children.size(), CsgOp::Union); });
+               [&] {
+                 b = folded_union(s.children, 1, s.children.size());
+                 if (!b) b = balanced(s.children, 1, s.children.size(), CsgOp::Union);
+               });
         if (!a || !b) return a;
         return boolean(std::move(*a), *b, CsgOp::Subtract);
       }
@@ -110,6 +134,42 @@ class Evaluator {
     ++booleans;
     report();
     return a;
+  }
+  /// A union of mesh leaves, with the leaves whose boxes are apart sampled together: a soup of
+  /// closed meshes that do not meet is the union's surface as it is, so one sampling pass
+  /// replaces a sampling per leaf and a Boolean per pair (the holes of a die, the teeth of a
+  /// gear). Leaves that meet are still combined by Booleans: sampled as one soup, the parts of
+  /// their triangles inside another leaf pull the cells' vertices off the surface and refine
+  /// them to the finest level (the Menger sponge's bars took 1.3x longer that way).
+  std::optional<Octree> folded_union(const std::vector<Solid>& kids, size_t b, size_t e) {
+    std::vector<const TriMesh*> leaves;
+    for (size_t i = b; i < e; ++i)
+      if (!union_leaves(kids[i], leaves)) return std::nullopt;
+    std::vector<std::array<Vec3, 2>> boxes;
+    for (const TriMesh* m : leaves) {
+      if (m->triangles.empty() || !(volume(*m) > 0)) return std::nullopt;
+      boxes.push_back(box_of(m->positions));
+    }
+    std::vector<std::vector<size_t>> groups;
+    std::vector<std::vector<std::array<Vec3, 2>>> group_boxes;
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      size_t g = 0;
+      for (; g < groups.size(); ++g)
+        if (std::none_of(group_boxes[g].begin(), group_boxes[g].end(), [&](const auto& x) { return !boxes_apart(x, boxes[i]); }))
+          break;
+      if (g == groups.size()) groups.emplace_back(), group_boxes.emplace_back();
+      groups[g].push_back(i);
+      group_boxes[g].push_back(boxes[i]);
+    }
+    if (groups.size() == leaves.size()) return std::nullopt;
+    std::vector<Solid> parts(groups.size());
+    for (size_t g = 0; g < groups.size(); ++g) {
+      parts[g].kind = Solid::Kind::Mesh;
+      for (size_t i : groups[g]) append_mesh(parts[g].mesh, *leaves[i]);
+    }
+    // The groups count as one leaf each from here: progress counts the others as done.
+    done_ += leaves.size() - groups.size();
+    return balanced(parts, 0, parts.size(), CsgOp::Union);
   }
   // n-ary union/intersection in a balanced order: halves evaluated in parallel, then combined.
   std::optional<Octree> balanced(const std::vector<Solid>& kids, size_t b, size_t e, CsgOp op) {

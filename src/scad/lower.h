@@ -4,6 +4,8 @@
 // with them). evaluate.cpp then samples the leaves and runs the Booleans on octrees.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -26,6 +28,20 @@ struct Solid {
 /// (EvalOptions::smooth); 0 follows $fn/$fa/$fs. `nodes` (optional) gets the number of nodes.
 /// \throws InvalidInput for an unsupported node or bad arguments (naming the node's line).
 Solid lower(const Node& root, const EvalOptions& options, double finest_cell, size_t* nodes);
+
+/// The bounding box of points: {lo, hi}.
+inline std::array<Vec3, 2> box_of(const std::vector<Vec3>& pts) {
+  std::array<Vec3, 2> b{Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}};
+  for (const Vec3& p : pts)
+    for (int k = 0; k < 3; ++k) b[0][k] = std::min(b[0][k], p[k]), b[1][k] = std::max(b[1][k], p[k]);
+  return b;
+}
+/// Whether two boxes {lo, hi} have no point in common.
+inline bool boxes_apart(const std::array<Vec3, 2>& a, const std::array<Vec3, 2>& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a[1][k] < b[0][k] || b[1][k] < a[0][k]) return true;
+  return false;
+}
 
 /// Grows [lo, hi] by the leaves' vertices; counts the leaves and their triangles.
 void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& triangles);

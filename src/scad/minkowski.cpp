@@ -132,20 +132,6 @@ Part surface_part(const TriMesh& m) {
 
 using Convex = std::vector<Vec3>;  // a convex polytope: its hull's vertices
 
-// The bounding box of points: {lo, hi}.
-std::array<Vec3, 2> box_of(const std::vector<Vec3>& pts) {
-  std::array<Vec3, 2> b{Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}};
-  for (const Vec3& p : pts)
-    for (int k = 0; k < 3; ++k) b[0][k] = std::min(b[0][k], p[k]), b[1][k] = std::max(b[1][k], p[k]);
-  return b;
-}
-
-bool boxes_apart(const std::array<Vec3, 2>& a, const std::array<Vec3, 2>& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a[1][k] < b[0][k] || b[1][k] < a[0][k]) return true;
-  return false;
-}
-
 // Each part of a sum is sampled and united on its own (tens of milliseconds): an operand with
 // more pieces than this is refused at once rather than left running for minutes (a difference
 // that decomposes into more falls back to its contour's flat faces first).

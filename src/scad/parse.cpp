@@ -2,6 +2,7 @@
 // `name(key = value, ...) { statement* }` or `name(...);`, values are numbers, true/false,
 // undef, "strings" and [vectors]. A small recursive-descent parser; errors name the line.
 #include <cctype>
+#include <cstring>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -133,6 +134,9 @@ class Parser {
     } else if (s_[i_] == '{') {
       ++i_;
       n.children = statements(true);
+    } else if (std::isalpha(static_cast<unsigned char>(s_[i_])) || std::strchr("!#%*_$", s_[i_])) {
+      // One child without braces, as OpenSCAD reads `translate(v) cube(1);`.
+      n.children.push_back(statement());
     } else {
       fail("expected ';' or '{' after " + n.name + "(...)" + near());
     }

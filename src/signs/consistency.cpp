@@ -396,6 +396,13 @@ const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, F
   s.flips.clear();
   const FaceFrame fr(big, f, signs_of(t.nodes[big.node]));
   if (!collect_face_points(t, big, fr, s)) return s.flips;
+  // The usual case: every point agrees with the face's four corners. The finer leaves tile the
+  // face, so their points are one region holding the corners, and no edge changes sign.
+  const bool s0 = fr.corner_sign(0, 0);
+  const auto agrees = [&](const std::pair<uint64_t, bool>& p) { return p.second == s0; };
+  if (fr.corner_sign(0, 1) == s0 && fr.corner_sign(1, 0) == s0 && fr.corner_sign(1, 1) == s0 &&
+      std::all_of(s.pts.begin(), s.pts.end(), agrees))
+    return s.flips;
   s.flipped.assign(s.pts.size(), 0);
   settle_face_edges(fr, s);
   flip_stray_regions(fr, s);
