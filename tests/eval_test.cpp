@@ -209,6 +209,50 @@ TEST(EvalCli, WritesMeshAndPic) {
   EXPECT_NEAR(volume(unsplit_contour(load(dir / "a.pic"))), 3 * std::sqrt(3.0), 0.01);
 }
 
+// STL holds 32-bit floats. Rounded to the nearest floats, the contour of two plates with flush
+// rounded edges folds 140 triangle pairs through each other (its vertices come within a float's
+// step of other triangles); round_to_float32 picks the other neighbouring float where that
+// keeps them apart, and the STL the CLI writes is the rounded mesh it checked.
+TEST(Float32, RoundingKeepsTheContourFromCrossingItself) {
+  EvalOptions o;
+  o.depth = 8;
+  const TriMesh m = contour(eval_csg_file(kData / "flush_plates.csg", o));
+  ASSERT_EQ(count_self_intersections(m), 0u);
+  TriMesh nearest = m;
+  for (Vec3& p : nearest.positions)
+    for (double& c : p) {
+      volatile float f = static_cast<float>(c);  // (g++ 12 -O3 drops a plain round trip in such a loop)
+      c = f;
+    }
+  EXPECT_GT(count_self_intersections(nearest), 0u);  // the case this is about
+  const TriMesh r = round_to_float32(m);
+  EXPECT_TRUE(check_validity(r).valid());
+  ASSERT_EQ(r.positions.size(), m.positions.size());
+  size_t moved = 0;
+  for (size_t i = 0; i < r.positions.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double x = m.positions[i][k], y = r.positions[i][k];
+      volatile float fy = static_cast<float>(y);
+      EXPECT_EQ(y, double(fy));
+      // one of the two floats around x
+      EXPECT_LE(std::abs(y - x), std::abs(double(std::nextafter(float(x), 2 * float(x) + 1)) - double(float(x))));
+      moved += y != nearest.positions[i][k];
+    }
+  EXPECT_GT(moved, 0u);
+}
+
+TEST(Float32, EvalToStlWritesWhatItChecked) {
+  test::TempDir dir("pic_eval");
+  ASSERT_EQ(run("eval " + quote((kData / "flush_plates.csg").string()) + " -o " + quote((dir / "a.stl").string()) +
+                    " --depth 8 --json > " + quote((dir / "a.json").string()),
+                dir.path()),
+            0);
+  const TriMesh m = read_mesh(dir / "a.stl");
+  EXPECT_TRUE(test::IsClosedManifold(m));
+  EXPECT_EQ(count_self_intersections(m), 0u);
+  EXPECT_NEAR(volume(m), 46357.5454, 46357.5454 * 1e-3);
+}
+
 TEST(EvalCli, UnsupportedNodeExits2WithOneLine) {
   test::TempDir dir("pic_eval");
   std::string err;

@@ -37,6 +37,9 @@ Geometry read_geometry(const std::filesystem::path& path);
 TriMesh read_mesh(const std::filesystem::path& path);
 /// Format from the extension; atomic write. \throws IoError.
 void write_mesh(const TriMesh& mesh, const std::filesystem::path& path);
+/// Whether the format of `path` (by its extension) stores 32-bit float coordinates (STL,
+/// GLB): round with round_to_float32 first to check what the file will hold.
+bool stores_float32(const std::filesystem::path& path);
 ///@}
 
 /// Writes a text file atomically (temp file + rename). \throws IoError.

@@ -52,6 +52,12 @@ struct MeshValidity {
 /// Topology after merging equal positions, and (unless `self_intersections` is false) the
 /// exact self-intersection count.
 MeshValidity check_validity(const TriMesh& mesh, bool self_intersections = true);
+/// The mesh with its positions rounded to 32-bit floats, as STL and GLB files hold them
+/// (src/measure/float32.cpp). Each coordinate goes to the nearest float, except at the vertices
+/// of triangles that rounding made cross: there each coordinate may take the float on its other
+/// side, whichever leaves the fewest crossings around the vertex. Exact tests on the rounded
+/// values; what no choice removes is left (count_self_intersections tells).
+TriMesh round_to_float32(const TriMesh& mesh);
 ///@}
 /// Signed volume (positive for outward orientation).
 double volume(const TriMesh& mesh);

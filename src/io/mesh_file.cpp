@@ -206,6 +206,11 @@ void write_with_assimp(const TriMesh& m, const std::filesystem::path& tmp, const
 
 }  // namespace
 
+bool stores_float32(const std::filesystem::path& path) {
+  const std::string ext = detail::lower_extension(path);
+  return ext == ".stl" || ext == ".glb";
+}
+
 void write_mesh(const TriMesh& mesh, const std::filesystem::path& path) {
   const std::string ext = detail::lower_extension(path);
   using Writer = void (*)(const TriMesh&, std::FILE*);
