@@ -13,8 +13,11 @@
 #include <numeric>
 #include <vector>
 
+#include <tbb/parallel_sort.h>
+
 #include "geometry/box_tree.h"
 #include "geometry/predicates.h"
+#include "measure/self_intersect.h"
 #include "pic/pic.h"
 
 namespace pic {
@@ -149,17 +152,23 @@ TriMesh round_to_float32(const TriMesh& mesh) {
   // Rounding can only add crossings where the doubles come within a float's step: nothing to
   // do when the rounded mesh has none, else choices at the crossings' vertices.
   std::vector<uint32_t> verts;
-  for (const auto& [a, b] : self_intersecting_pairs(out))
-    for (uint32_t t : {a, b}) verts.insert(verts.end(), out.triangles[t].begin(), out.triangles[t].end());
   // Distinct positions that became one: a reader would merge them (the copies of a split
   // vertex sit a 1/1024 step apart, often less than a float's).
   std::vector<uint32_t> order(out.positions.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return out.positions[a] < out.positions[b]; });
+  tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return out.positions[a] < out.positions[b]; });
+  bool distinct = true;
   for (size_t i = 1; i < order.size(); ++i)
-    if (out.positions[order[i]] == out.positions[order[i - 1]] &&
-        mesh.positions[order[i]] != mesh.positions[order[i - 1]])
-      verts.insert(verts.end(), {order[i], order[i - 1]});
+    if (out.positions[order[i]] == out.positions[order[i - 1]]) {
+      distinct = false;
+      if (mesh.positions[order[i]] != mesh.positions[order[i - 1]]) verts.insert(verts.end(), {order[i], order[i - 1]});
+    }
+  // Triangles the rounding flattened.
+  for (const Tri& t : out.triangles)
+    if (degenerate(out.positions, t) && !degenerate(mesh.positions, t)) verts.insert(verts.end(), t.begin(), t.end());
+  const auto pairs = distinct ? detail::intersecting_pairs_of_distinct(out) : self_intersecting_pairs(out);
+  for (const auto& [a, b] : pairs)
+    for (uint32_t t : {a, b}) verts.insert(verts.end(), out.triangles[t].begin(), out.triangles[t].end());
   if (!verts.empty()) choose_roundings(mesh, out.positions, std::move(verts));
   return out;
 }

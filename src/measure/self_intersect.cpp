@@ -23,6 +23,7 @@
 #include "geometry/box_tree.h"
 #include "geometry/predicates.h"
 #include "geometry/union_find.h"
+#include "measure/self_intersect.h"
 
 namespace pic {
 namespace {
@@ -88,6 +89,12 @@ std::vector<std::pair<uint32_t, uint32_t>> intersecting_pairs_merged(const TriMe
 std::vector<std::pair<uint32_t, uint32_t>> self_intersecting_pairs(const TriMesh& mesh) {
   return intersecting_pairs_merged(merged(mesh), nullptr);
 }
+
+namespace detail {
+std::vector<std::pair<uint32_t, uint32_t>> intersecting_pairs_of_distinct(const TriMesh& mesh) {
+  return intersecting_pairs_merged(mesh, nullptr);
+}
+}  // namespace detail
 
 size_t count_self_intersections(const TriMesh& mesh) { return self_intersecting_pairs(mesh).size(); }
 
