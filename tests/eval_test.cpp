@@ -211,7 +211,7 @@ TEST(EvalCli, WritesMeshAndPic) {
 
 // STL holds 32-bit floats. Rounded to the nearest floats, the contour of two plates with flush
 // rounded edges folds 140 triangle pairs through each other (its vertices come within a float's
-// step of other triangles); round_to_float32 picks the other neighbouring float where that
+// step of other triangles); round_to_float32 picks another float near the double where that
 // keeps them apart, and the STL the CLI writes is the rounded mesh it checked.
 TEST(Float32, RoundingKeepsTheContourFromCrossingItself) {
   EvalOptions o;
@@ -234,8 +234,8 @@ TEST(Float32, RoundingKeepsTheContourFromCrossingItself) {
       const double x = m.positions[i][k], y = r.positions[i][k];
       volatile float fy = static_cast<float>(y);
       EXPECT_EQ(y, double(fy));
-      // one of the two floats around x
-      EXPECT_LE(std::abs(y - x), std::abs(double(std::nextafter(float(x), 2 * float(x) + 1)) - double(float(x))));
+      // at most three float steps from x (one of the two around it, unless that left a crossing)
+      EXPECT_LE(std::abs(y - x), 3 * std::abs(double(std::nextafter(float(x), 2 * float(x) + 1)) - double(float(x))));
       moved += y != nearest.positions[i][k];
     }
   EXPECT_GT(moved, 0u);

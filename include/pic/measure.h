@@ -54,9 +54,10 @@ struct MeshValidity {
 MeshValidity check_validity(const TriMesh& mesh, bool self_intersections = true);
 /// The mesh with its positions rounded to 32-bit floats, as STL and GLB files hold them
 /// (src/measure/float32.cpp). Each coordinate goes to the nearest float, except at the vertices
-/// of triangles that rounding made cross: there each coordinate may take the float on its other
-/// side, whichever leaves the fewest crossings around the vertex. Exact tests on the rounded
-/// values; what no choice removes is left (count_self_intersections tells).
+/// of triangles that rounding made cross, flattened or made share a position: there each
+/// coordinate may take the float on its other side (or, where that is not enough, one up to
+/// three steps out), whichever leaves the fewest crossings around the vertex. Exact tests on
+/// the rounded values; what no choice removes is left (count_self_intersections tells).
 TriMesh round_to_float32(const TriMesh& mesh);
 ///@}
 /// Signed volume (positive for outward orientation).

@@ -6,8 +6,9 @@
 // coordinate to the nearest float then folds a few such pairs through each other (spot: 7 of
 // 148,722 triangles, a CSG result with flush faces: 827 of 64,478). Each coordinate has two
 // floats around it; where the nearest makes a crossing, the vertices of the crossing triangles
-// try the other combinations and keep the one with the fewest crossings around them. Every
-// test is exact on the rounded values.
+// try the other combinations and keep the one with the fewest crossings around them (then, for
+// what is left, floats up to three steps out: a point can sit so close beside a triangle that
+// no choice of the two nearest floats keeps it off). Every test is exact on the rounded values.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -35,14 +36,22 @@ double nearest_float(double x) {
   return f;
 }
 
-/// The float at or below x and the float at or above it (equal when x is a float).
-std::array<double, 2> float_neighbours(double x) {
+/// The floats a coordinate x may take: the one at or below it and the one at or above it
+/// (`wide`: two more steps out on each side).
+std::vector<double> float_choices(double x, bool wide) {
+  constexpr float kUp = std::numeric_limits<float>::infinity();
   float f = static_cast<float>(x);
   asm volatile("" : "+x"(f));
-  const double d = f;
-  if (d == x) return {d, d};
-  if (d < x) return {d, double(std::nextafter(f, std::numeric_limits<float>::infinity()))};
-  return {double(std::nextafter(f, -std::numeric_limits<float>::infinity())), d};
+  float lo = double(f) <= x ? f : std::nextafter(f, -kUp), hi = double(f) >= x ? f : std::nextafter(f, kUp);
+  std::vector<double> out;
+  if (wide) {
+    const float l2 = std::nextafter(lo, -kUp), h2 = std::nextafter(hi, kUp);
+    out = {std::nextafter(l2, -kUp), l2, lo, hi, h2, std::nextafter(h2, kUp)};
+  } else {
+    out = {lo, hi};
+  }
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 Box box_of(const std::vector<Vec3>& x, const Tri& t, double slack) {
@@ -58,89 +67,112 @@ bool degenerate(const std::vector<Vec3>& x, const Tri& t) {
   return t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || detail::projection_axis(x[t[0]], x[t[1]], x[t[2]]) < 0;
 }
 
-/// Repairs the crossings of `pairs` in the rounded positions `r` (of `m`'s positions) by
-/// choosing, vertex by vertex, the rounding direction of each coordinate. Returns the crossings
-/// left: only triangles at the vertices it may move can cross anew, so counting around them
-/// answers for the whole mesh.
+/// The vertices that may move, their triangles, and every triangle near those: the only part
+/// of the mesh the choices look at.
+struct Neighbourhood {
+  std::vector<std::vector<uint32_t>> around;  // per vertex: its triangles (moving ones only)
+  std::vector<uint32_t> near;                 // mesh triangle of each box in `tree`
+  std::vector<uint32_t> slot;                 // mesh triangle -> its box, or none
+  std::vector<Box> boxes;
+  BoxTree tree{{}};
+
+  Neighbourhood(const TriMesh& m, const std::vector<Vec3>& r, const std::vector<uint32_t>& verts, double slack)
+      : around(m.positions.size()), slot(m.triangles.size(), ~uint32_t{0}) {
+    std::vector<char> moving(m.positions.size(), 0);
+    for (uint32_t v : verts) moving[v] = 1;
+    std::vector<Box> reach;
+    for (uint32_t t = 0; t < m.triangles.size(); ++t)
+      for (uint32_t v : m.triangles[t])
+        if (moving[v]) {
+          around[v].push_back(t);
+          reach.push_back(box_of(r, m.triangles[t], 2 * slack));
+        }
+    const BoxTree reach_tree(reach);
+    for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+      const Box b = box_of(r, m.triangles[t], slack);
+      bool hit = false;
+      reach_tree.query(b, [&](uint32_t) { hit = true; });
+      if (!hit) continue;
+      slot[t] = uint32_t(near.size());
+      near.push_back(t);
+      boxes.push_back(b);
+    }
+    tree = BoxTree(boxes);
+  }
+  /// Calls f(u) for each triangle u that triangle t (a triangle at a moving vertex) crosses.
+  /// By index: the rounded positions are all distinct, as the doubles were, unless a choice
+  /// makes two equal — then their triangles count as crossing, so no choice merges vertices.
+  template <class F>
+  void crossings_of(const TriMesh& m, const std::vector<Vec3>& r, uint32_t t, F&& f) const {
+    const Tri& a = m.triangles[t];
+    tree.query(boxes[slot[t]], [&](uint32_t k) {
+      const uint32_t u = near[k];
+      if (u != t && !degenerate(r, m.triangles[u]) && detail::triangles_intersect(r, a, m.triangles[u])) f(u);
+    });
+  }
+  size_t count_at(const TriMesh& m, const std::vector<Vec3>& r, uint32_t v) const {
+    size_t count = 0;
+    for (uint32_t t : around[v]) {
+      if (degenerate(r, m.triangles[t])) count += 4;  // flattening a triangle is worse than most crossings
+      else crossings_of(m, r, t, [&](uint32_t) { ++count; });
+    }
+    return count;
+  }
+};
+
+/// Chooses, vertex by vertex, the rounding direction of each coordinate of `verts` in the
+/// rounded positions `r` (of `m`'s) for the fewest crossings around it. A crossing left brings
+/// the vertices of both its triangles into the next round. Only triangles at the vertices
+/// moved can cross anew, so counting around them answers for the whole mesh: returns how many
+/// crossings are left.
 size_t choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint32_t> verts) {
-  const size_t n = m.triangles.size();
-  // A vertex moves by less than a float's step: boxes grown by two steps of the largest
+  // A vertex moves by at most three float steps: boxes grown by four steps of the largest
   // coordinate cover every choice.
   double big = 0;
   for (const Vec3& p : r)
     for (double c : p) big = std::max(big, std::abs(c));
-  const double slack = 2 * big * 0x1p-23;
-  std::sort(verts.begin(), verts.end());
-  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-  std::vector<char> moving(m.positions.size(), 0);
-  for (uint32_t v : verts) moving[v] = 1;
-  // The triangles at the vertices that may move, and every triangle near them: the only ones
-  // the tests below look at (a handful of the mesh's).
-  std::vector<std::vector<uint32_t>> around(m.positions.size());
-  std::vector<Box> reach;
-  for (uint32_t t = 0; t < n; ++t)
-    for (uint32_t v : m.triangles[t])
-      if (moving[v]) {
-        around[v].push_back(t);
-        reach.push_back(box_of(r, m.triangles[t], 2 * slack));
-      }
-  const BoxTree reach_tree(reach);
-  std::vector<uint32_t> near;  // mesh triangle of each box below
-  std::vector<Box> boxes;
-  std::vector<uint32_t> slot(n, ~uint32_t{0});
-  for (uint32_t t = 0; t < n; ++t) {
-    const Box b = box_of(r, m.triangles[t], slack);
-    bool hit = false;
-    reach_tree.query(b, [&](uint32_t) { hit = true; });
-    if (!hit) continue;
-    slot[t] = uint32_t(near.size());
-    near.push_back(t);
-    boxes.push_back(b);
-  }
-  const BoxTree tree(boxes);
-  // Crossings of triangle t with the triangles near it (by index: the rounded positions are
-  // all distinct, as the doubles were, unless a choice makes two equal — then the two
-  // triangles count as crossing, so no choice merges two vertices).
-  auto crossings_of = [&](uint32_t t) {
-    const Tri& a = m.triangles[t];
-    if (degenerate(r, a)) return size_t{4};  // flattening a triangle is worse than most crossings
-    size_t count = 0;
-    tree.query(boxes[slot[t]], [&](uint32_t k) {
-      const uint32_t u = near[k];
-      if (u != t && !degenerate(r, m.triangles[u])) count += detail::triangles_intersect(r, a, m.triangles[u]);
-    });
-    return count;
-  };
-  auto crossings_at = [&](uint32_t v) {
-    size_t count = 0;
-    for (uint32_t t : around[v]) count += crossings_of(t);
-    return count;
-  };
-  for (int round = 0; round < 3; ++round) {
+  const double slack = 4 * big * 0x1p-23;
+  size_t left = 0;
+  for (int round = 0; round < 4; ++round) {
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    const Neighbourhood nb(m, r, verts, slack);
+    // First the two floats around each coordinate; where that leaves a crossing, up to three
+    // steps out (a vertex a hair's breadth beside another triangle may need the room).
+    const bool wide = round > 0;
     for (uint32_t v : verts) {
-      std::array<std::array<double, 2>, 3> choice;
-      for (int k = 0; k < 3; ++k) choice[k] = float_neighbours(m.positions[v][k]);
+      std::array<std::vector<double>, 3> choice;
+      for (int k = 0; k < 3; ++k) choice[k] = float_choices(m.positions[v][k], wide);
       Vec3 best = r[v];
-      size_t best_count = crossings_at(v);
-      for (int c = 0; c < 8 && best_count > 0; ++c) {
-        r[v] = {choice[0][c & 1], choice[1][(c >> 1) & 1], choice[2][(c >> 2) & 1]};
-        if (r[v] == best) continue;
-        const size_t count = crossings_at(v);
-        if (count < best_count) best_count = count, best = r[v];
-      }
+      size_t best_count = nb.count_at(m, r, v);
+      for (double x : choice[0])
+        for (double y : choice[1])
+          for (double z : choice[2]) {
+            if (best_count == 0) break;
+            r[v] = {x, y, z};
+            if (r[v] == best) continue;
+            const size_t count = nb.count_at(m, r, v);
+            if (count < best_count) best_count = count, best = r[v];
+          }
       r[v] = best;
     }
-    // Each crossing counted from both triangles when both are at moved vertices: any left?
-    std::vector<uint32_t> tris;
-    for (uint32_t v : verts) tris.insert(tris.end(), around[v].begin(), around[v].end());
-    std::sort(tris.begin(), tris.end());
-    tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-    size_t left = 0;
-    for (uint32_t t : tris) left += crossings_of(t);
-    if (left == 0) return 0;
-    if (round == 2) return left;
+    left = 0;
+    const size_t before = verts.size();
+    for (size_t i = 0; i < before; ++i)
+      for (uint32_t t : nb.around[verts[i]]) {
+        if (degenerate(r, m.triangles[t])) {
+          ++left;
+          continue;
+        }
+        nb.crossings_of(m, r, t, [&](uint32_t u) {
+          ++left;
+          verts.insert(verts.end(), m.triangles[t].begin(), m.triangles[t].end());
+          verts.insert(verts.end(), m.triangles[u].begin(), m.triangles[u].end());
+        });
+      }
+    if (left == 0) break;
   }
-  return 0;
+  return left;
 }
 
 }  // namespace
