@@ -30,8 +30,9 @@ class BoxTree {
     order_.resize(boxes.size());
     std::iota(order_.begin(), order_.end(), 0u);
     if (boxes.empty()) return;
-    nodes_.resize(node_count(uint32_t(boxes.size())));
-    build(0, uint32_t(boxes.size()), 0);
+    Counts counts;
+    nodes_.resize(node_count(uint32_t(boxes.size()), counts));
+    build(0, uint32_t(boxes.size()), 0, counts);
   }
   /// Replaces the boxes (same count) and refits every node's box to them, keeping the
   /// hierarchy: much cheaper than building anew when few boxes changed or all grew alike.
@@ -92,18 +93,18 @@ class BoxTree {
     for (uint32_t k = begin + 1; k < end; ++k) grow(b, boxes_[order_[k]]);
     return b;
   }
-  /// Nodes of the tree over n boxes (median splits down to leaves of up to 4): the layout is
-  /// fixed by n alone, so both halves can be built at once into their own slots.
-  uint32_t node_count(uint32_t n) {
+  using Counts = std::map<uint32_t, uint32_t>;  // nodes over a range, by its size (above 4)
+  /// Nodes of the tree over n boxes (median splits down to leaves of up to 4), filling `counts`
+  /// for every size below: the layout is fixed by n alone, so both halves can be built at once
+  /// into their own slots.
+  static uint32_t node_count(uint32_t n, Counts& counts) {
     if (n <= 4) return 1;
-    if (const auto it = counts_.find(n); it != counts_.end()) return it->second;
-    const uint32_t c = 1 + node_count(n / 2) + node_count(n - n / 2);
-    counts_[n] = c;
-    return c;
+    if (const auto it = counts.find(n); it != counts.end()) return it->second;
+    return counts[n] = 1 + node_count(n / 2, counts) + node_count(n - n / 2, counts);
   }
   /// Node `id` over order_[begin, end), its subtree in pre-order after it (children after
-  /// their parent, as refit needs). counts_ holds every size reached (read-only here).
-  void build(uint32_t begin, uint32_t end, uint32_t id) {
+  /// their parent, as refit needs). `counts` is complete here: only read.
+  void build(uint32_t begin, uint32_t end, uint32_t id, const Counts& counts) {
     const Box b = span_of(begin, end);
     if (end - begin <= 4) {
       nodes_[id] = {b, begin, end - begin, 0};
@@ -116,9 +117,9 @@ class BoxTree {
     std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t x, uint32_t y) {
       return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
     });
-    const uint32_t left = id + 1, right = left + (mid - begin <= 4 ? 1 : counts_.at(mid - begin));
-    const auto build_left = [&] { build(begin, mid, left); };
-    const auto build_right = [&] { build(mid, end, right); };
+    const uint32_t left = id + 1, right = left + (mid - begin <= 4 ? 1 : counts.at(mid - begin));
+    const auto build_left = [&] { build(begin, mid, left, counts); };
+    const auto build_right = [&] { build(mid, end, right, counts); };
     if (end - begin > 16384) tbb::parallel_invoke(build_left, build_right);
     else build_left(), build_right();
     nodes_[id] = {b, left, 0, right};
@@ -126,7 +127,6 @@ class BoxTree {
   std::vector<Box> boxes_;
   std::vector<uint32_t> order_;
   std::vector<N> nodes_;
-  std::map<uint32_t, uint32_t> counts_;  // node_count by size
 };
 
 }  // namespace pic::detail

@@ -11,6 +11,7 @@
 // no choice of the two nearest floats keeps it off). Every test is exact on the rounded values.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -123,16 +124,14 @@ struct Neighbourhood {
 /// Chooses, vertex by vertex, the rounding direction of each coordinate of `verts` in the
 /// rounded positions `r` (of `m`'s) for the fewest crossings around it. A crossing left brings
 /// the vertices of both its triangles into the next round. Only triangles at the vertices
-/// moved can cross anew, so counting around them answers for the whole mesh: returns how many
-/// crossings are left.
-size_t choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint32_t> verts) {
+/// moved can cross anew, so counting around them answers for the whole mesh.
+void choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint32_t> verts) {
   // A vertex moves by at most three float steps: boxes grown by four steps of the largest
   // coordinate cover every choice.
   double big = 0;
   for (const Vec3& p : r)
     for (double c : p) big = std::max(big, std::abs(c));
   const double slack = 4 * big * 0x1p-23;
-  size_t left = 0;
   for (int round = 0; round < 4; ++round) {
     std::sort(verts.begin(), verts.end());
     verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
@@ -156,7 +155,7 @@ size_t choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint
           }
       r[v] = best;
     }
-    left = 0;
+    size_t left = 0;
     const size_t before = verts.size();
     for (size_t i = 0; i < before; ++i)
       for (uint32_t t : nb.around[verts[i]]) {
@@ -170,9 +169,8 @@ size_t choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint
           verts.insert(verts.end(), m.triangles[u].begin(), m.triangles[u].end());
         });
       }
-    if (left == 0) break;
+    if (left == 0) return;
   }
-  return left;
 }
 
 }  // namespace

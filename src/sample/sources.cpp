@@ -145,8 +145,7 @@ void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, 
 
 std::vector<ITri> grid_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const std::vector<I3>& grid,
                                 size_t room) {
-  // Room first: reserving after sizing moved every triangle once more (this VM pays dearly
-  // for each fresh page an allocation touches).
+  // Room first: reserving after sizing would move every triangle once more.
   std::vector<ITri> out;
   out.reserve(tris.size() + room);
   out.resize(tris.size());

@@ -71,17 +71,12 @@ class Evaluator {
         report();
         return t;
       }
-      case Solid::Kind::Union:
-        if (std::optional<Octree> t = folded_union(s.children, 0, s.children.size())) return t;
-        return balanced(s.children, 0, s.children.size(), CsgOp::Union);
+      case Solid::Kind::Union: return united(s.children, 0, s.children.size());
       case Solid::Kind::Intersect: return balanced(s.children, 0, s.children.size(), CsgOp::Intersect);
       case Solid::Kind::Difference: {
         std::optional<Octree> a, b;
         invoke([&] { a = eval(s.children[0]); },
-               [&] {
-                 b = folded_union(s.children, 1, s.children.size());
-                 if (!b) b = balanced(s.children, 1, s.children.size(), CsgOp::Union);
-               });
+               [&] { b = united(s.children, 1, s.children.size()); });
         if (!a || !b) return a;
         return boolean(std::move(*a), *b, CsgOp::Subtract);
       }
@@ -135,33 +130,34 @@ class Evaluator {
     report();
     return a;
   }
-  /// A union of mesh leaves, with the leaves whose boxes are apart sampled together: a soup of
-  /// closed meshes that do not meet is the union's surface as it is, so one sampling pass
-  /// replaces a sampling per leaf and a Boolean per pair (the holes of a die, the teeth of a
-  /// gear). Leaves that meet are still combined by Booleans: sampled as one soup, the parts of
-  /// their triangles inside another leaf pull the cells' vertices off the surface and refine
-  /// them to the finest level (the Menger sponge's bars took 1.3x longer that way).
-  std::optional<Octree> folded_union(const std::vector<Solid>& kids, size_t b, size_t e) {
+  /// The union of kids[b, e). Where they are all mesh leaves (or unions of them), the leaves
+  /// whose boxes are apart are sampled together: a soup of closed meshes that do not meet is
+  /// the union's surface as it is, so one sampling pass replaces a sampling per leaf and a
+  /// Boolean per pair (the holes of a die, the teeth of a gear). Leaves that meet are still
+  /// combined by Booleans: sampled as one soup, the parts of their triangles inside another
+  /// leaf pull the cells' vertices off the surface and refine them to the finest level (the
+  /// Menger sponge's bars took 1.3x longer that way).
+  std::optional<Octree> united(const std::vector<Solid>& kids, size_t b, size_t e) {
+    const auto pairwise = [&] { return balanced(kids, b, e, CsgOp::Union); };
     std::vector<const TriMesh*> leaves;
     for (size_t i = b; i < e; ++i)
-      if (!union_leaves(kids[i], leaves)) return std::nullopt;
+      if (!union_leaves(kids[i], leaves)) return pairwise();
     std::vector<std::array<Vec3, 2>> boxes;
     for (const TriMesh* m : leaves) {
-      if (m->triangles.empty() || !(volume(*m) > 0)) return std::nullopt;
+      if (m->triangles.empty() || !(volume(*m) > 0)) return pairwise();
       boxes.push_back(box_of(m->positions));
     }
+    // Greedily: each leaf joins the first group whose every box is apart from its own.
     std::vector<std::vector<size_t>> groups;
-    std::vector<std::vector<std::array<Vec3, 2>>> group_boxes;
     for (size_t i = 0; i < leaves.size(); ++i) {
-      size_t g = 0;
-      for (; g < groups.size(); ++g)
-        if (std::none_of(group_boxes[g].begin(), group_boxes[g].end(), [&](const auto& x) { return !boxes_apart(x, boxes[i]); }))
-          break;
-      if (g == groups.size()) groups.emplace_back(), group_boxes.emplace_back();
-      groups[g].push_back(i);
-      group_boxes[g].push_back(boxes[i]);
+      const auto apart = [&](const std::vector<size_t>& g) {
+        return std::all_of(g.begin(), g.end(), [&](size_t j) { return boxes_apart(boxes[j], boxes[i]); });
+      };
+      const auto g = std::find_if(groups.begin(), groups.end(), apart);
+      if (g == groups.end()) groups.push_back({i});
+      else g->push_back(i);
     }
-    if (groups.size() == leaves.size()) return std::nullopt;
+    if (groups.size() == leaves.size()) return pairwise();
     std::vector<Solid> parts(groups.size());
     for (size_t g = 0; g < groups.size(); ++g) {
       parts[g].kind = Solid::Kind::Mesh;

@@ -2,7 +2,6 @@
 // `name(key = value, ...) { statement* }` or `name(...);`, values are numbers, true/false,
 // undef, "strings" and [vectors]. A small recursive-descent parser; errors name the line.
 #include <cctype>
-#include <cstring>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -74,6 +73,8 @@ class Parser {
     if (at_end()) return " at end of file";
     return " near '" + s_.substr(i_, std::min<size_t>(12, s_.size() - i_)) + "'";
   }
+  /// OpenSCAD's modifiers before a statement: `!`, `#`, `%`, `*`.
+  static bool modifier(char c) { return c == '!' || c == '#' || c == '%' || c == '*'; }
   static bool ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '$'; }
   std::string identifier() {
     skip();
@@ -89,7 +90,7 @@ class Parser {
     // OpenSCAD's modifiers: `%` (background) and `*` (disabled) leave the object out of the
     // rendered model (its .csg export keeps them); `#` (highlight) and `!` change display only.
     bool left_out = false;
-    while (!at_end() && (s_[i_] == '!' || s_[i_] == '#' || s_[i_] == '%' || s_[i_] == '*')) {
+    while (!at_end() && modifier(s_[i_])) {
       left_out = left_out || s_[i_] == '%' || s_[i_] == '*';
       ++i_;
       skip();
@@ -134,7 +135,7 @@ class Parser {
     } else if (s_[i_] == '{') {
       ++i_;
       n.children = statements(true);
-    } else if (std::isalpha(static_cast<unsigned char>(s_[i_])) || std::strchr("!#%*_$", s_[i_])) {
+    } else if (std::isalpha(static_cast<unsigned char>(s_[i_])) || s_[i_] == '_' || s_[i_] == '$' || modifier(s_[i_])) {
       // One child without braces, as OpenSCAD reads `translate(v) cube(1);`.
       n.children.push_back(statement());
     } else {
