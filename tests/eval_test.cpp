@@ -60,6 +60,36 @@ TEST(Eval, Fn6CylinderIsHexagonalPrism) {
 
 TEST(Eval, LinearExtrudeTwistAndScale) { expect_volume(eval_file("twist_scale.csg"), 280.0 / 3, 2e-3); }
 
+// A band along 300 degrees of a circle far from the axis, twisted by 1500 degrees in 80 slices
+// (example020's spring): the twisted wall quads are far from flat. By Cavalieri the solid's
+// volume is area x height; OpenSCAD's walls (each quad split along its shorter diagonal) keep
+// it to 2e-4 here, where one diagonal for the whole extrusion gives +7 % or -11 %.
+TEST(Eval, TwistedBandKeepsItsVolume) {
+  detail::scad::Ring band;
+  const int arc = 16;
+  for (int side = 0; side < 2; ++side)
+    for (int i = 0; i <= arc; ++i) {
+      const double a = (side ? arc - i : i) * (300.0 / arc) * std::numbers::pi / 180;
+      const double r = side ? 90 : 110;
+      band.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+  double area = 0;
+  for (size_t i = 0; i < band.size(); ++i) {
+    const auto& p = band[i];
+    const auto& q = band[(i + 1) % band.size()];
+    area += (p[0] * q[1] - q[0] * p[1]) / 2;
+  }
+  detail::scad::LinearExtrude e;
+  e.height = 100;
+  e.twist = 1500;
+  e.slices = 80;
+  const TriMesh m = detail::scad::extrude_linear(band, e);
+  EXPECT_TRUE(test::IsClosedManifold(m));
+  EXPECT_NEAR(volume(m), area * e.height, 5e-3 * area * e.height);
+  e.twist = -1500;  // the mirror image
+  EXPECT_NEAR(volume(detail::scad::extrude_linear(band, e)), area * e.height, 5e-3 * area * e.height);
+}
+
 TEST(Eval, RotateExtrudeFn4) { expect_volume(eval_file("rotate_square.csg"), 6, 1e-3); }
 
 TEST(Eval, PolyhedronClockwiseFaces) { expect_volume(eval_file("polyhedron.csg"), 2000.0 / 3, 1e-3); }

@@ -235,6 +235,39 @@ TEST(Sample, ThinPlateOnOctreePlaneIsKept) {
   EXPECT_LE(s.hausdorff, 1e-5);
 }
 
+TEST(Sample, PrismEdgeOnAnOctreeLineIsKept) {
+  // A hexagonal prism (OpenSCAD's cylinder with $fn = 6) whose leftmost vertical edge lies on
+  // the octree line x = y = 1/2, the solid to its right: the cells left of the line meet the
+  // prism only along their edge, so no area of it lies in them, yet every lattice point on
+  // the line is inside (the perturbation puts it at x = 1/2 + e). Those cells must split, or
+  // the contour has a hole along the edge.
+  TriMesh prism;
+  const double cx = 0.62, r = 0.12, z0 = 0.3, z1 = 0.38;
+  for (int k = 0; k < 6; ++k) {
+    const double a = std::numbers::pi * (1 + k / 3.0);
+    prism.positions.push_back({cx + r * std::cos(a), 0.5 + r * std::sin(a), z0});
+    prism.positions.push_back({cx + r * std::cos(a), 0.5 + r * std::sin(a), z1});
+  }
+  prism.positions[0] = {0.5, 0.5, z0};  // exactly on the line, not 1 ulp off
+  prism.positions[1] = {0.5, 0.5, z1};
+  for (uint32_t k = 0; k < 6; ++k) {
+    const uint32_t a = 2 * k, b = 2 * ((k + 1) % 6);
+    prism.triangles.push_back({a, b, b + 1});
+    prism.triangles.push_back({a, b + 1, a + 1});
+  }
+  for (uint32_t k = 1; k + 1 < 6; ++k) {
+    prism.triangles.push_back({0, 2 * (k + 1), 2 * k});
+    prism.triangles.push_back({1, 2 * k + 1, 2 * (k + 1) + 1});
+  }
+  ASSERT_GT(volume(prism), 0);
+  for (int depth : {6, 9}) {
+    const Sampled s = sample_and_contour(prism, depth, Cube{{0, 0, 0}, 1});
+    ASSERT_TRUE(IsClosedManifold(s.out)) << "depth " << depth;
+    EXPECT_NEAR(s.volume_out, s.volume_in, 1e-6 * s.volume_in);
+    EXPECT_LE(s.hausdorff, 1e-6);
+  }
+}
+
 TEST(Sample, NestedShellsGiveAHollowSolid) {
   // Outer sphere plus an inward-facing inner sphere: crossing parity makes a hollow ball.
   TriMesh m = make_sphere({0.5, 0.5, 0.5}, 0.4, 48);

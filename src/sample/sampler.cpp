@@ -248,8 +248,12 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   }
   const bool at_cap = cell.level >= p.max_depth;
   if (uniform) {
-    // No vertex here: only whether surface enters the cell matters, not its QEF.
-    const bool meets = src.surface_matters(cell, signs, wind, idx);
+    // No vertex here: only whether surface enters the cell matters, not its QEF. A surface
+    // that only touches one of the cell's edges (a prism's edge lying on an octree line,
+    // the solid on the far side) has no area in the box, yet the edge's perturbed segment
+    // runs through the solid: the finer lattice points on it are inside, so it must split.
+    const bool meets = src.surface_matters(cell, signs, wind, idx) ||
+                       (!at_cap && has_double_crossing(src.tris(), idx, cell, signs, p.memo_id));
     if (!meets || at_cap) {
       if (meets) ++capped;  // a feature thinner than the deepest cell is dropped
       out.set_uniform(slot, (written & 1) != 0);

@@ -57,7 +57,7 @@ struct LinearExtrude {
 };
 /// Extrudes one simple ring (any orientation) as OpenSCAD does: slice j rotated by
 /// -twist j / slices degrees, then scaled by 1 + (scale - 1) j / slices; each twisted wall
-/// quad split along the diagonal OpenSCAD picks. Empty mesh for a degenerate ring.
+/// quad split along its shorter diagonal, as OpenSCAD does. Empty mesh for a degenerate ring.
 TriMesh extrude_linear(Ring ring, const LinearExtrude& e);
 /// Revolves one simple ring of the x >= 0 half plane about z through `angle` degrees in
 /// `fragments` steps, with OpenSCAD's vertex placement (a full turn starts on the -x axis).

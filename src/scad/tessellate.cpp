@@ -193,15 +193,22 @@ TriMesh extrude_linear(Ring ring, const LinearExtrude& e) {
       m.positions.push_back({sx * (c * p[0] - s * p[1]), sy * (s * p[0] + c * p[1]), z});
     }
   }
-  // OpenSCAD's add_slice: the diagonal runs from the lower "prev" to the upper "curr" vertex
-  // when sin((rot1 - rot2)) > 0, i.e. for a negative twist; holes use the mirrored rule, which
-  // is the same diagonal once the hole is traversed counter-clockwise as here.
-  const bool split_first = std::sin(rad(e.twist / slices)) > 0;
+  // Each twisted side quad is split along its shorter diagonal, as OpenSCAD 2021 does (measured
+  // on its output: on a twisted ring the outer and inner arcs need opposite diagonals, so no
+  // single rule per extrusion matches). Ties (flat quads) keep the diagonal p1-c2.
+  auto shorter_first = [&](uint32_t p1, uint32_t c1, uint32_t p2, uint32_t c2) {
+    const auto d2 = [&](uint32_t a, uint32_t b) {
+      const auto& u = m.positions[a];
+      const auto& v = m.positions[b];
+      return (u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) + (u[2] - v[2]) * (u[2] - v[2]);
+    };
+    return d2(p1, c2) <= d2(c1, p2);
+  };
   for (int j = 0; j < slices; ++j)
     for (size_t i = 0; i < n; ++i) {
       const size_t k = (i + 1) % n;
       const uint32_t p1 = ids[j][i], c1 = ids[j][k], p2 = ids[j + 1][i], c2 = ids[j + 1][k];
-      if (split_first) {
+      if (shorter_first(p1, c1, p2, c2)) {
         m.triangles.push_back({p1, c1, c2});
         if (p2 != c2) m.triangles.push_back({p1, c2, p2});
       } else {
