@@ -35,10 +35,12 @@ Geometry read_geometry(const std::filesystem::path& path);
 ///@{
 /// \throws IoError (missing/unreadable/unknown format) or InvalidInput (empty, non-finite).
 TriMesh read_mesh(const std::filesystem::path& path);
-/// Format from the extension; atomic write. \throws IoError.
+/// Format from the extension; atomic write. STL and GLB store 32-bit floats: the positions are
+/// rounded by round_to_float32 (which keeps a valid solid valid), not cast. \throws IoError.
 void write_mesh(const TriMesh& mesh, const std::filesystem::path& path);
 /// Whether the format of `path` (by its extension) stores 32-bit float coordinates (STL,
-/// GLB): round with round_to_float32 first to check what the file will hold.
+/// GLB): round with round_to_float32 first to check what the file will hold (write_mesh then
+/// writes it unchanged).
 bool stores_float32(const std::filesystem::path& path);
 ///@}
 

@@ -21,6 +21,7 @@
 #include "io/file_util.h"
 #include "mesh/clean.h"
 #include "io/readers.h"
+#include "pic/measure.h"
 #include "pic/pic.h"
 
 namespace pic {
@@ -211,8 +212,12 @@ bool stores_float32(const std::filesystem::path& path) {
   return ext == ".stl" || ext == ".glb";
 }
 
-void write_mesh(const TriMesh& mesh, const std::filesystem::path& path) {
+void write_mesh(const TriMesh& input, const std::filesystem::path& path) {
   const std::string ext = detail::lower_extension(path);
+  // STL and GLB hold floats: the rounding that keeps the solid free of crossings, not a cast
+  // (a no-op for a mesh rounded already).
+  const TriMesh rounded = stores_float32(path) ? round_to_float32(input) : TriMesh{};
+  const TriMesh& mesh = stores_float32(path) ? rounded : input;
   using Writer = void (*)(const TriMesh&, std::FILE*);
   static const std::map<std::string, Writer> plain = {
       {".obj", write_obj}, {".off", write_off}, {".stl", write_stl}, {".ply", write_ply}};
