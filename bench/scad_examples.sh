@@ -2,7 +2,7 @@
 # `pic eval` against OpenSCAD 2021's own renderer on every example Debian's openscad ships.
 #   bench/scad_examples.sh [OUTDIR] [DEPTH]     (default: /tmp/pic_scad_examples, depth 12)
 # For each /usr/share/openscad/examples/*/*.scad: export the .csg; run
-# `pic eval x.scad -o pic.stl` (timeout 60 s); render the reference with
+# `pic eval x.scad -o pic.stl` (timeout 120 s); render the reference with
 # `openscad -o ref.stl x.scad` (timeout 100 s); compare volume and two-sided Hausdorff distance in finest cells (`pic compare`);
 # evaluate the same .csg with Manifold (/work/shared/tools/manifold/scad.mjs) as a second
 # reference. Each example runs whole under the CPU lock (/work/notes/cpu.lock) when it
@@ -27,7 +27,7 @@ one() {
     timeout "$lim" "$@"
     echo "$? $(echo "$(date +%s.%N) - $t0" | bc)" >"$rc"
   }
-  t "$d/pic.rc" 60 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
+  t "$d/pic.rc" 120 "$pic" eval "$scad" -o "$d/pic.stl" --depth "$depth" --json >"$d/pic.json" 2>"$d/pic.err"
   if grep -q "a 2D model" "$d/pic.err"; then  # its outline, against OpenSCAD's DXF export
     t "$d/pic.rc" 60 "$pic" eval "$scad" -o "$d/pic.dxf" --json >"$d/pic.json" 2>"$d/pic.err"
     t "$d/openscad.rc" 100 openscad -o "$d/ref.dxf" "$scad" >"$d/openscad.log" 2>&1
@@ -122,7 +122,7 @@ for name in sorted(os.listdir(out)):
         err = open(f"{d}/pic.err").read().strip().splitlines()
         why = err[-1].replace("pic: error: ", "") if err else f"exit {prc}"
         why = why.split(": ", 1)[-1] if ".scad: " in why else why
-        if prc == "124": why = "PIC timed out (60 s)"
+        if prc == "124": why = "PIC timed out (120 s)"
         rows.append(f"| {name} | no | {why} | | | | | | |")
         continue
     ok_n += 1

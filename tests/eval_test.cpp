@@ -90,6 +90,10 @@ TEST(Eval, TwistedBandKeepsItsVolume) {
   EXPECT_NEAR(volume(detail::scad::extrude_linear(band, e)), area * e.height, 5e-3 * area * e.height);
 }
 
+// A leaf thinner than a finest cell (here a 1e-7 thick box; in GEB.scad a sliver ring of a 2D
+// difference, extruded) is empty at that depth, not an error that stops the whole model.
+TEST(Eval, FlatLeafIsEmpty) { expect_volume(eval_file("flat_leaf.csg"), 1000, 1e-3); }
+
 TEST(Eval, RotateExtrudeFn4) { expect_volume(eval_file("rotate_square.csg"), 6, 1e-3); }
 
 TEST(Eval, PolyhedronClockwiseFaces) { expect_volume(eval_file("polyhedron.csg"), 2000.0 / 3, 1e-3); }

@@ -20,6 +20,26 @@ namespace pic {
 
 using namespace detail;
 
+double detail::plane_spread(const TriMesh& mesh) {
+  Vec3 n{0, 0, 0}, origin{0, 0, 0};
+  double best = 0;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const Vec3 x{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double area2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    if (area2 > best) best = area2, n = x, origin = a;
+  }
+  if (best == 0) return -1;
+  const double len = std::sqrt(best);
+  double lo = 0, hi = 0;
+  for (const Vec3& p : mesh.positions) {
+    const double d = ((p[0] - origin[0]) * n[0] + (p[1] - origin[1]) * n[1] + (p[2] - origin[2]) * n[2]) / len;
+    lo = std::min(lo, d), hi = std::max(hi, d);
+  }
+  return hi - lo;
+}
+
 Cube bounding_cube(const TriMesh& mesh, double margin) {
   if (mesh.positions.empty()) throw InvalidInput("mesh has no vertices");
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
@@ -61,27 +81,13 @@ void check_mesh(const TriMesh& mesh) {
 
 /// A mesh whose vertices all lie within a finest cell of one plane (a 2D drawing exported as a
 /// mesh, a single sheet) has no solid the octree can hold: its thickness is below the
-/// resolution everywhere. The plane is that of the largest triangle.
+/// resolution everywhere.
 void check_not_flat(const TriMesh& mesh, const Cube& cube, int depth) {
-  Vec3 n{0, 0, 0}, origin{0, 0, 0};
-  double best = 0;
-  for (const auto& t : mesh.triangles) {
-    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const Vec3 x{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    const double area2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-    if (area2 > best) best = area2, n = x, origin = a;
-  }
-  if (best == 0) throw InvalidInput("mesh has no triangles (all degenerate or cancelling)");
-  const double len = std::sqrt(best);
-  double lo = 0, hi = 0;
-  for (const Vec3& p : mesh.positions) {
-    const double d = ((p[0] - origin[0]) * n[0] + (p[1] - origin[1]) * n[1] + (p[2] - origin[2]) * n[2]) / len;
-    lo = std::min(lo, d), hi = std::max(hi, d);
-  }
+  const double spread = plane_spread(mesh);
+  if (spread < 0) throw InvalidInput("mesh has no triangles (all degenerate or cancelling)");
   const double cell = cube.size / double(int64_t{1} << depth);
-  if (hi - lo < cell)
-    throw InvalidInput("mesh encloses no solid: it is flat (all its vertices lie within " + std::to_string(hi - lo) +
+  if (spread < cell)
+    throw InvalidInput("mesh encloses no solid: it is flat (all its vertices lie within " + std::to_string(spread) +
                        " of one plane, less than a finest cell; a 2D drawing?)");
 }
 

@@ -117,6 +117,10 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
 /// lying in one of the cell's low faces belongs to the neighbour below).
 bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell);
 
+/// How far the mesh's vertices spread across the plane of its largest triangle (-1 when every
+/// triangle is degenerate). Below a finest cell the mesh is flat: no solid the octree holds.
+double plane_spread(const TriMesh& mesh);
+
 /// Triangles of `idx` overlapping the closed boxes of the 8 children of `cell` (conservative;
 /// the same lists as filter_tris per child, in one pass).
 void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,

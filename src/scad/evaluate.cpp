@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "pic/pic.h"
+#include "sample/sampler.h"
 #include "scad/lower.h"
 
 namespace pic {
@@ -66,7 +67,10 @@ class Evaluator {
     switch (s.kind) {
       case Solid::Kind::Empty: return std::nullopt;
       case Solid::Kind::Mesh: {
-        auto t = sample_leaf(s.mesh);
+        // A leaf thinner than a finest cell (a sliver ring of a 2D Boolean, extruded) holds no
+        // solid at this depth: it is empty here, where a mesh given to `pic sample` is an error.
+        std::optional<Octree> t;
+        if (detail::plane_spread(s.mesh) >= cube_.size / double(int64_t{1} << opt_.depth)) t = sample_leaf(s.mesh);
         ++done_;
         report();
         return t;
