@@ -211,7 +211,16 @@ class Combiner {
     return gray_cell(cell, a, b);
   }
 
-  Node subdivide(const Cell& cell, const Side& a, const Side& b) {
+  /// Both operands' sign grids over a gray pair's cell, computed on first use.
+  struct PairGrids {
+    std::optional<std::pair<SignGrid, SignGrid>> g;
+  };
+  const std::pair<SignGrid, SignGrid>& grids(PairGrids& pg, const Cell& cell, const Side& a, const Side& b) {
+    if (!pg.g) pg.g.emplace(sign_grid(a_, a, cell), sign_grid(b_, b, cell));
+    return *pg.g;
+  }
+
+  Node subdivide(const Cell& cell, const Side& a, const Side& b, const PairGrids* given = nullptr) {
     // Children of A's internal node are written in place; otherwise new slots.
     uint32_t first;
     if (a.kind == Side::Internal) {
@@ -223,8 +232,15 @@ class Combiner {
     if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
     std::array<Node, 8> kids;
     if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) kids = split_in_tasks(cell, a, b);
-    else
-      for (int c = 0; c < 8; ++c) kids[c] = combine(cell.child(c), child_side(a_, a, cell, c), child_side(b_, b, cell, c));
+    else {
+      std::optional<SignGrid> ga, gb;
+      if (given && given->g) ga = given->g->first, gb = given->g->second;
+      if (!ga && a.kind == Side::Gray) ga = sign_grid(a_, a, cell);
+      if (!gb && b.kind == Side::Gray) gb = sign_grid(b_, b, cell);
+      for (int c = 0; c < 8; ++c)
+        kids[c] = combine(cell.child(c), child_side(a_, a, cell, c, ga ? &*ga : nullptr),
+                          child_side(b_, b, cell, c, gb ? &*gb : nullptr));
+    }
     bool all_uniform = true;
     for (int c = 0; c < 8; ++c) {
       out_.set(first + c, kids[c]);
@@ -267,10 +283,11 @@ class Combiner {
       return copy_side(a_, a, cell, false, true);
     }
     const bool at_cap = cell.level >= max_depth_;
+    PairGrids pg;
     if (!unresolved(a) && !unresolved(b)) {
       const EdgeVerdict ev = edge_verdict(op_, a_, a, b_, b, cell);
       if (!ev.must_split)
-        if (const std::optional<Node> leaf = gray_leaf(cell, a, b, sr, ev, at_cap)) return *leaf;
+        if (const std::optional<Node> leaf = gray_leaf(cell, a, b, sr, ev, at_cap, pg)) return *leaf;
     }
     if (at_cap) {
       if (sr == 0 || sr == 0xff) return uniform(sr != 0);
@@ -279,14 +296,17 @@ class Combiner {
         if (const std::optional<SignHint> h = sign_hint(op_, a_, b_, cell, sr)) out_.hint(*h);
       return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr).position, kFlagCapped);
     }
-    return subdivide(cell, a, b);
+    return subdivide(cell, a, b, &pg);
   }
 
   /// The cell as one leaf, if it may be one: triangle-fan culling where the surfaces do not
   /// meet, Q_sum's vertex where they do (paper eq. 3); nothing when the cell must split.
   std::optional<Node> gray_leaf(const Cell& cell, const Side& a, const Side& b, uint8_t sr, const EdgeVerdict& ev,
-                                bool at_cap) {
-    const bool simple = at_cap || refinement_is_simple(op_, a_, a, b_, b, cell, sr);
+                                bool at_cap, PairGrids& pg) {
+    const bool simple = at_cap || [&] {
+      const auto& [ga, gb] = grids(pg, cell, a, b);
+      return refinement_is_simple(op_, ga, gb);
+    }();
     if (!simple) return std::nullopt;
     // The result as uniform, or as one operand's cell, where the signs agree (and the caller
     // allows that case).

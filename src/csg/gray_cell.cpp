@@ -225,17 +225,9 @@ bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, co
 
 /// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a
 /// leaf here would meet finer neighbours showing a second sheet on its faces.
-bool refinement_is_simple(CsgOp op, Operand& xa, const Side& a, Operand& xb, const Side& b, const Cell& cell,
-                          uint8_t sr) {
+bool refinement_is_simple(CsgOp op, const SignGrid& a, const SignGrid& b) {
   std::array<bool, 27> g{};
-  for (int k = 0; k < 8; ++k) g[grid_index_of_corner(k)] = (sr >> k) & 1;
-  const int64_t h = cell.span() / 2;
-  for (int i = 0; i < 27; ++i) {
-    const int x = i % 3, y = (i / 3) % 3, z = i / 9;
-    if (x != 1 && y != 1 && z != 1) continue;
-    const Lat p{cell.lat[0] + x * h, cell.lat[1] + y * h, cell.lat[2] + z * h};
-    g[i] = apply(op, xa.sign_in(p, a.node, a.leaf_cell), xb.sign_in(p, b.node, b.leaf_cell));
-  }
+  for (int i = 0; i < 27; ++i) g[i] = apply(op, a[i], b[i]);
   return grid_is_simple(g);
 }
 

@@ -39,9 +39,9 @@ bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Si
 bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, const Vec3& x, double error,
                       std::vector<uint32_t>& scratch);
 
-/// Whether the result's signs on the cell's child grid are simple (grid_is_simple).
-bool refinement_is_simple(CsgOp op, Operand& xa, const Side& a, Operand& xb, const Side& b, const Cell& cell,
-                          uint8_t sr);
+/// Whether the result's signs on the cell's child grid (op of the operands' sign_grid) are
+/// simple (grid_is_simple).
+bool refinement_is_simple(CsgOp op, const SignGrid& a, const SignGrid& b);
 
 /// The two operands' QEFs over the cell, and their sum.
 struct CellQefs {

@@ -24,7 +24,18 @@ Side side_of(Operand& x, uint32_t node, const Cell& cell) {
 /// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
 /// (signs from sign_X, the leaf's triangles that reach the child), or uniform when such a
 /// virtual cell has neither a sign change nor a triangle.
-Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
+SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell) {
+  SignGrid g{};
+  const int64_t h = cell.span() / 2;
+  for (int i = 0; i < 27; ++i) {
+    const int gx = i % 3, gy = (i / 3) % 3, gz = i / 9;
+    if (gx != 1 && gy != 1 && gz != 1) g[i] = (s.signs >> (gx / 2 | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
+    else g[i] = x.sign_in({cell.lat[0] + gx * h, cell.lat[1] + gy * h, cell.lat[2] + gz * h}, s.node, s.leaf_cell);
+  }
+  return g;
+}
+
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid* grid) {
   const Cell cc = cell.child(c);
   if (s.kind == Side::Uniform) return s;
   if (s.kind == Side::Internal) return side_of(x, x.t.nodes[s.node].index + c, cc);
@@ -36,7 +47,9 @@ Side child_side(Operand& x, const Side& s, const Cell& cell, int c) {
   for (int k = 0; k < 8; ++k) {
     const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
     bool sign;
-    if (gx != 1 && gy != 1 && gz != 1) {
+    if (grid) {
+      sign = (*grid)[gx + 3 * gy + 9 * gz];
+    } else if (gx != 1 && gy != 1 && gz != 1) {
       sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
     } else {
       sign = x.sign_in(cc.corner(k), s.node, s.leaf_cell);

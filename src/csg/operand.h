@@ -285,8 +285,14 @@ struct Side {
 
 /// The operand over `node` (cell `cell`): a uniform or internal node, or a gray leaf.
 Side side_of(Operand& x, uint32_t node, const Cell& cell);
-/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf.
-Side child_side(Operand& x, const Side& s, const Cell& cell, int c);
+/// The operand's signs on the 27-point child grid of a gray side's cell (index x + 3y + 9z in
+/// half cells): asked once per cell, not by each of its eight children (every sign that is
+/// not a stored corner is a lookup in a large memo, and those lookups miss the cache).
+using SignGrid = std::array<bool, 27>;
+SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell);
+/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
+/// (its corner signs from `grid` when given: sign_grid of s over cell).
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid* grid = nullptr);
 /// A virtual cell with no sign change that still holds surface: it must be refined until the
 /// surface shows in the signs.
 inline bool unresolved(const Side& s) { return !s.real && (s.signs == 0 || s.signs == 0xff); }
