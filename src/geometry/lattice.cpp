@@ -142,6 +142,21 @@ bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
   return perturbed_plane_sign(t, a) != perturbed_plane_sign(t, b);
 }
 
+bool crosses_box_edge(const ITri& t, const IBox& box) {
+  for (int k = 0; k < 3; ++k)
+    if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    for (int e = 0; e < 4; ++e) {
+      I3 a = box.lo;
+      a[i] = (e & 1) ? box.hi[i] : box.lo[i];
+      a[j] = (e & 2) ? box.hi[j] : box.lo[j];
+      if (crosses(t, a, axis, box.hi[axis] - box.lo[axis])) return true;
+    }
+  }
+  return false;
+}
+
 int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
                     int axis, i64 len) {
   int n = 0;

@@ -81,6 +81,8 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi);
 struct IBox {
   I3 lo, hi;
 };
+/// Whether `t` crosses any of the 12 edges of the box (crosses() on each).
+bool crosses_box_edge(const ITri& t, const IBox& box);
 
 /// edges_may_touch_box for the 8 children of one box (split_tris asks it for several): the
 /// triangle's projections on the 9 axes are taken once about the box's centre and shifted to

@@ -92,17 +92,25 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
   // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
   constexpr double kFloor = 0.1;
-  bool any = false;
+  bool area_or_edge = false;
   auto add = [&](const ITri& t, double w) { q.add_plane(t.unit_normal, t.plane, w); };
   for (uint32_t k : idx) {
     const ITri& t = tris[k];
     if (is_degenerate(t) || !(t.use & kUseQef)) continue;
     const double area = clipped_area(t, box);
-    if (area < 0) continue;
-    any = true;
+    if (area < 0) {
+      // No area in the box under the perturbation, yet it may cross one of the box's edges
+      // (a slanted face through an edge that is high on one axis and low on another): that
+      // crossing is a sign change of this cell, so its plane is part of the cell's surface.
+      if (!crosses_box_edge(t, box)) continue;
+      area_or_edge = true;
+      add(t, kFloor);
+      continue;
+    }
+    area_or_edge = true;
     add(t, area / face + kFloor);
   }
-  if (!any) {
+  if (!area_or_edge) {
     // The surface only grazes the cell (e.g. a mesh vertex exactly on a cell corner): the
     // perturbation still puts a sliver inside, so use the planes that touch the closed cell.
     for (uint32_t k : idx)
