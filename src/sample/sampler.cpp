@@ -102,7 +102,8 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
       // No area in the box under the perturbation, yet it may cross one of the box's edges
       // (a slanted face through an edge that is high on one axis and low on another): that
       // crossing is a sign change of this cell, so its plane is part of the cell's surface.
-      if (!crosses_box_edge(t, box)) continue;
+      // Only a triangle that touches the closed box (in a low face) can.
+      if (area != kTouchesLowFace || !crosses_box_edge(t, box)) continue;
       area_or_edge = true;
       add(t, kFloor);
       continue;
