@@ -325,9 +325,7 @@ TEST_F(AlgebraTest, InPlaceEditsSaveAndLoad) {
   EXPECT_EQ(analyze(back).pics, analyze(r).pics);
   const TriMesh m = unsplit_contour(back);
   EXPECT_TRUE(IsClosedManifold(m));
-  // The file holds each vertex to 2^-16 of its cell: the contour's region tests may then choose
-  // another triangulation somewhere, within a few thousandths of a finest cell.
-  EXPECT_LT(two_sided_distance(m, unsplit_contour(r)), 1e-5);
+  EXPECT_LT(two_sided_distance(m, unsplit_contour(r)), 1e-6);
 }
 
 TEST(Csg, OperandsInDifferentCubesShareOneFrame) {
