@@ -59,6 +59,9 @@ MeshValidity check_validity(const TriMesh& mesh, bool self_intersections = true)
 /// three steps out), whichever leaves the fewest crossings around the vertex. Exact tests on
 /// the rounded values; what no choice removes is left (count_self_intersections tells).
 TriMesh round_to_float32(const TriMesh& mesh);
+/// Whether every coordinate is a 32-bit float already (round_to_float32 returns such a mesh
+/// as it is).
+bool holds_floats(const TriMesh& mesh);
 ///@}
 /// Signed volume (positive for outward orientation).
 double volume(const TriMesh& mesh);

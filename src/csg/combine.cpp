@@ -212,15 +212,14 @@ class Combiner {
   }
 
   /// Both operands' sign grids over a gray pair's cell, computed on first use.
-  struct PairGrids {
-    std::optional<std::pair<SignGrid, SignGrid>> g;
-  };
+  using PairGrids = std::optional<std::pair<SignGrid, SignGrid>>;
   const std::pair<SignGrid, SignGrid>& grids(PairGrids& pg, const Cell& cell, const Side& a, const Side& b) {
-    if (!pg.g) pg.g.emplace(sign_grid(a_, a, cell), sign_grid(b_, b, cell));
-    return *pg.g;
+    if (!pg) pg.emplace(sign_grid(a_, a, cell), sign_grid(b_, b, cell));
+    return *pg;
   }
 
-  Node subdivide(const Cell& cell, const Side& a, const Side& b, const PairGrids* given = nullptr) {
+  /// `pg`: the grids if gray_cell computed them already (both sides gray).
+  Node subdivide(const Cell& cell, const Side& a, const Side& b, PairGrids pg = std::nullopt) {
     // Children of A's internal node are written in place; otherwise new slots.
     uint32_t first;
     if (a.kind == Side::Internal) {
@@ -233,13 +232,11 @@ class Combiner {
     std::array<Node, 8> kids;
     if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) kids = split_in_tasks(cell, a, b);
     else {
-      std::optional<SignGrid> ga, gb;
-      if (given && given->g) ga = given->g->first, gb = given->g->second;
-      if (!ga && a.kind == Side::Gray) ga = sign_grid(a_, a, cell);
-      if (!gb && b.kind == Side::Gray) gb = sign_grid(b_, b, cell);
+      // Only a gray side's grid is read.
+      const SignGrid ga = pg ? pg->first : a.kind == Side::Gray ? sign_grid(a_, a, cell) : SignGrid{};
+      const SignGrid gb = pg ? pg->second : b.kind == Side::Gray ? sign_grid(b_, b, cell) : SignGrid{};
       for (int c = 0; c < 8; ++c)
-        kids[c] = combine(cell.child(c), child_side(a_, a, cell, c, ga ? &*ga : nullptr),
-                          child_side(b_, b, cell, c, gb ? &*gb : nullptr));
+        kids[c] = combine(cell.child(c), child_side(a_, a, cell, c, ga), child_side(b_, b, cell, c, gb));
     }
     bool all_uniform = true;
     for (int c = 0; c < 8; ++c) {
@@ -260,7 +257,8 @@ class Combiner {
     auto task = [&](int c) {
       Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
       Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
-      kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c), child_side(cb, b, cell, c));
+      // Both sides internal here: no sign grid is read.
+      kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c, {}), child_side(cb, b, cell, c, {}));
     };
     if (parallel_) tbb::parallel_for(0, 8, task);
     else for (int c = 0; c < 8; ++c) task(c);
@@ -296,7 +294,7 @@ class Combiner {
         if (const std::optional<SignHint> h = sign_hint(op_, a_, b_, cell, sr)) out_.hint(*h);
       return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr).position, kFlagCapped);
     }
-    return subdivide(cell, a, b, &pg);
+    return subdivide(cell, a, b, pg);
   }
 
   /// The cell as one leaf, if it may be one: triangle-fan culling where the surfaces do not

@@ -21,9 +21,6 @@ Side side_of(Operand& x, uint32_t node, const Cell& cell) {
   return s;
 }
 
-/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
-/// (signs from sign_X, the leaf's triangles that reach the child), or uniform when such a
-/// virtual cell has neither a sign change nor a triangle.
 SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell) {
   SignGrid g{};
   const int64_t h = cell.span() / 2;
@@ -35,7 +32,10 @@ SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell) {
   return g;
 }
 
-Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid* grid) {
+/// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
+/// (signs from the grid, the leaf's triangles that reach the child), or uniform when such a
+/// virtual cell has neither a sign change nor a triangle.
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid& grid) {
   const Cell cc = cell.child(c);
   if (s.kind == Side::Uniform) return s;
   if (s.kind == Side::Internal) return side_of(x, x.t.nodes[s.node].index + c, cc);
@@ -46,15 +46,7 @@ Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGr
   v.leaf_cell = s.leaf_cell;
   for (int k = 0; k < 8; ++k) {
     const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
-    bool sign;
-    if (grid) {
-      sign = (*grid)[gx + 3 * gy + 9 * gz];
-    } else if (gx != 1 && gy != 1 && gz != 1) {
-      sign = (s.signs >> ((gx / 2) | (gy / 2) << 1 | (gz / 2) << 2)) & 1;
-    } else {
-      sign = x.sign_in(cc.corner(k), s.node, s.leaf_cell);
-    }
-    v.signs |= uint8_t(sign) << k;
+    v.signs |= uint8_t(grid[gx + 3 * gy + 9 * gz]) << k;
   }
   filter_tris(x.tris, s.idx, cc, v.idx);
   if ((v.signs == 0 || v.signs == 0xff) && !meets_cell(x.tris, v.idx, cc)) {

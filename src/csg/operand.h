@@ -291,8 +291,8 @@ Side side_of(Operand& x, uint32_t node, const Cell& cell);
 using SignGrid = std::array<bool, 27>;
 SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell);
 /// The operand over child `c` of `cell`: a child node, or a virtual cell inside a gray leaf
-/// (its corner signs from `grid` when given: sign_grid of s over cell).
-Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid* grid = nullptr);
+/// (its corner signs from `grid`, sign_grid of s over cell; read only when s is gray).
+Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGrid& grid);
 /// A virtual cell with no sign change that still holds surface: it must be refined until the
 /// surface shows in the signs.
 inline bool unresolved(const Side& s) { return !s.real && (s.signs == 0 || s.signs == 0xff); }

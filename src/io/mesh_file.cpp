@@ -215,9 +215,10 @@ bool stores_float32(const std::filesystem::path& path) {
 void write_mesh(const TriMesh& input, const std::filesystem::path& path) {
   const std::string ext = detail::lower_extension(path);
   // STL and GLB hold floats: the rounding that keeps the solid free of crossings, not a cast
-  // (a no-op for a mesh rounded already).
-  const TriMesh rounded = stores_float32(path) ? round_to_float32(input) : TriMesh{};
-  const TriMesh& mesh = stores_float32(path) ? rounded : input;
+  // (a mesh rounded already is written as it is, without a copy).
+  const bool round = stores_float32(path) && !holds_floats(input);
+  const TriMesh rounded = round ? round_to_float32(input) : TriMesh{};
+  const TriMesh& mesh = round ? rounded : input;
   using Writer = void (*)(const TriMesh&, std::FILE*);
   static const std::map<std::string, Writer> plain = {
       {".obj", write_obj}, {".off", write_off}, {".stl", write_stl}, {".ply", write_ply}};

@@ -175,12 +175,15 @@ void choose_roundings(const TriMesh& m, std::vector<Vec3>& r, std::vector<uint32
 
 }  // namespace
 
-TriMesh round_to_float32(const TriMesh& mesh) {
-  // Already floats (rounded before, or read from an STL): nothing moves, nothing to check.
-  const bool exact = std::all_of(mesh.positions.begin(), mesh.positions.end(), [](const Vec3& p) {
+bool holds_floats(const TriMesh& mesh) {
+  return std::all_of(mesh.positions.begin(), mesh.positions.end(), [](const Vec3& p) {
     return nearest_float(p[0]) == p[0] && nearest_float(p[1]) == p[1] && nearest_float(p[2]) == p[2];
   });
-  if (exact) return mesh;
+}
+
+TriMesh round_to_float32(const TriMesh& mesh) {
+  // Already floats (rounded before, or read from an STL): nothing moves, nothing to check.
+  if (holds_floats(mesh)) return mesh;
   TriMesh out = mesh;
   for (Vec3& p : out.positions)
     for (double& c : p) c = nearest_float(c);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "geometry/vec3.h"
 #include "scad/scad_detail.h"
 
 namespace pic::detail::scad {
@@ -198,9 +199,8 @@ TriMesh extrude_linear(Ring ring, const LinearExtrude& e) {
   // single rule per extrusion matches). Ties (flat quads) keep the diagonal p1-c2.
   auto shorter_first = [&](uint32_t p1, uint32_t c1, uint32_t p2, uint32_t c2) {
     const auto d2 = [&](uint32_t a, uint32_t b) {
-      const auto& u = m.positions[a];
-      const auto& v = m.positions[b];
-      return (u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) + (u[2] - v[2]) * (u[2] - v[2]);
+      const Vec3 d = sub3(m.positions[a], m.positions[b]);
+      return dot3(d, d);
     };
     return d2(p1, c2) <= d2(c1, p2);
   };
