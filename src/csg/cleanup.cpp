@@ -105,9 +105,10 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
     if (k < 0 || !stamped(r.node) || t.nodes[r.node].kind == CellKind::Internal) return f;
     if (r.cell.level < t.max_depth && strands_finer_points(t, r, k, h.inside)) return f;
     const uint8_t s = signs_of(t.nodes[r.node]);
-    f.needed = bool((s >> k) & 1) != h.inside;
+    const uint8_t set = with_corner(s, k, h.inside);
+    f.needed = f.needed || set != s;
     f.before += multi_component(s);
-    f.after += multi_component(uint8_t(s ^ (1 << k)));
+    f.after += multi_component(set);
     f.around[f.count] = r;
     f.corner[f.count++] = k;
   }
@@ -125,7 +126,10 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
   for (const SignHint& h : hints) {
     const HintedFlip f = examine_hint(t, h, stamped);
     if (!f.possible || !f.needed || f.after >= f.before) continue;
-    for (int i = 0; i < f.count; ++i) flip_corner(t, f.around[i].node, f.corner[i], f.around[i].cell);
+    for (int i = 0; i < f.count; ++i) {
+      const LeafRef& r = f.around[i];
+      if (bool((signs_of(t.nodes[r.node]) >> f.corner[i]) & 1) != h.inside) flip_corner(t, r.node, f.corner[i], r.cell);
+    }
     pinned.insert(lattice_key(h.point));
   }
 }

@@ -110,6 +110,8 @@ uint8_t signs_of(const Node& n) {
 
 bool multi_component(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
 
+uint8_t with_corner(uint8_t s, int c, bool inside) { return uint8_t(s & ~(1 << c)) | uint8_t(int(inside) << c); }
+
 void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
   Node& n = t.nodes[node];
   if (n.kind == CellKind::Gray) {
@@ -134,16 +136,19 @@ std::optional<bool> point_sign(const Octree& t, const Lat& p) {
   return std::nullopt;
 }
 
-namespace {
-
-/// Flips lattice point p's sign in every leaf that has it as a corner (consistently), and
-/// reports the nodes on the way to them.
-void flip_point(Octree& t, const Lat& p, const std::function<void(uint32_t)>* touched) {
+/// Gives lattice point p the sign `inside` in every leaf that has it as a corner, and reports
+/// the nodes on the way to them. Set, not toggled: around a crack (a uniform leaf beside a
+/// sign change) the leaves disagree, and a toggle would keep them disagreeing — the gray
+/// leaves' sign flips one way and the uniform leaf's the other, and the contour has a hole.
+void set_point_sign(Octree& t, const Lat& p, bool inside, const std::function<void(uint32_t)>* touched) {
   std::vector<uint32_t> path;
-  for (const auto& a : leaves_around(t, p, touched ? &path : nullptr)) flip_corner(t, a.node, a.corner, a.cell);
+  for (const auto& a : leaves_around(t, p, touched ? &path : nullptr))
+    if (bool((signs_of(t.nodes[a.node]) >> a.corner) & 1) != inside) flip_corner(t, a.node, a.corner, a.cell);
   if (touched)
     for (uint32_t x : path) (*touched)(x);
 }
+
+namespace {
 
 /// Whether lattice point p, of sign sp, on the boundary of gray leaf `big` (not one of its
 /// corners) disagrees with all of big's corners on the smallest face or edge through it.
@@ -267,8 +272,9 @@ struct FaceScratch {
   std::vector<std::pair<uint64_t, uint64_t>> links;
   std::vector<size_t> run;
   std::vector<char> flipped, anchored;
+  std::vector<char> original;  // the points' signs as collected, before the passes
   UnionFind regions{0};
-  std::vector<Lat> flips;
+  std::vector<std::pair<Lat, bool>> flips;  // point, sign to give it
 
   size_t index_of(uint64_t k) const {
     return size_t(std::lower_bound(pts.begin(), pts.end(), std::pair{k, false}) - pts.begin());
@@ -390,9 +396,9 @@ void flip_stray_regions(const FaceFrame& fr, FaceScratch& s) {
 /// - every connected region of one sign on the face reaches a corner of the face with that
 ///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
 ///   vertex).
-/// Returns the lattice points to flip (as few as possible along edges; whole stray regions
+/// Returns the lattice points to flip, with their new sign (as few as possible along edges; whole stray regions
 /// on the face).
-const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
+const std::vector<std::pair<Lat, bool>>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
   s.flips.clear();
   const FaceFrame fr(big, f, signs_of(t.nodes[big.node]));
   if (!collect_face_points(t, big, fr, s)) return s.flips;
@@ -404,10 +410,12 @@ const std::vector<Lat>& face_flips(const Octree& t, const LeafRef& big, int f, F
       std::all_of(s.pts.begin(), s.pts.end(), agrees))
     return s.flips;
   s.flipped.assign(s.pts.size(), 0);
+  s.original.resize(s.pts.size());
+  for (size_t i = 0; i < s.pts.size(); ++i) s.original[i] = s.pts[i].second;
   settle_face_edges(fr, s);
   flip_stray_regions(fr, s);
   for (size_t i = 0; i < s.pts.size(); ++i)
-    if (s.flipped[i]) s.flips.push_back(fr.lat_of(s.pts[i].first));
+    if (s.flipped[i]) s.flips.push_back({fr.lat_of(s.pts[i].first), !s.original[i]});
   return s.flips;
 }
 
@@ -452,7 +460,7 @@ void fine_corners_on_coarse_leaves(const Octree& t, const IslandSearch& search, 
       for (int a = 0; a < 3 && touches; ++a)
         touches = p[a] >= big.cell.lat[a] && p[a] <= big.cell.lat[a] + big.cell.span();
       if (!touches || !is_island(t.nodes[big.node], big.cell, p, sp)) continue;
-      flip(p);
+      flip(p, !sp);
       break;
     }
   }
@@ -492,7 +500,7 @@ void finer_corners_on_coarse_leaf(const Octree& t, const IslandSearch& search, c
           const Lat p = c.corner(k);
           if (p[d] != plane || cell.corner_index(p) >= 0) continue;
           const bool sp = (signs_of(m) >> k) & 1;
-          if (is_island(t.nodes[big], cell, p, sp)) flip(p);
+          if (is_island(t.nodes[big], cell, p, sp)) flip(p, !sp);
         }
       };
       visit(n.node, n.cell);
@@ -509,8 +517,8 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     search.collect(0, Cell{}, active, path);
   }
   size_t flipped = 0;
-  auto flip = [&](const Lat& p) {
-    flip_point(t, p, touched);
+  auto flip = [&](const Lat& p, bool inside) {
+    set_point_sign(t, p, inside, touched);
     if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
   };
@@ -531,7 +539,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
               faces.end());
   for (const auto& [big, f] : faces) {
     if (t.nodes[big.node].kind != CellKind::Gray) continue;
-    for (const Lat& p : face_flips(t, big, f, face_scratch)) flip(p);
+    for (const auto& [p, inside] : face_flips(t, big, f, face_scratch)) flip(p, inside);
   }
   return flipped;
 }
@@ -570,9 +578,10 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
       for (int k = 0; k < 8; ++k) {
         if (multi_component(uint8_t(s ^ (1 << k)))) continue;
         const auto around = leaves_around(t, l.cell.corner(k));
+        const bool inside = !((s >> k) & 1);
         int cost = 0;
         for (const auto& a : around) {
-          const uint8_t flipped = uint8_t(signs_of(t.nodes[a.node]) ^ (1 << a.corner));
+          const uint8_t flipped = with_corner(signs_of(t.nodes[a.node]), a.corner, inside);
           cost += 2 * multi_component(flipped);
           cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
         }
@@ -585,7 +594,7 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         }
       }
       if (best < 0) continue;
-      flip_point(t, l.cell.corner(best), touched);
+      set_point_sign(t, l.cell.corner(best), !((s >> best) & 1), touched);
       ++fix.flipped;
     }
   }

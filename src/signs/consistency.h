@@ -39,6 +39,12 @@ inline uint64_t lattice_key(const std::array<int64_t, 3>& p) {
 uint8_t signs_of(const Node& n);
 /// Whether corner signs make more than one surface component in a cell.
 bool multi_component(uint8_t signs);
+/// `signs` with corner c set to `inside`.
+uint8_t with_corner(uint8_t signs, int c, bool inside);
+/// Gives lattice point p the sign `inside` in every leaf that has it as a corner (a uniform
+/// leaf of the other sign turns gray); `touched` is told of the nodes on the way to them.
+void set_point_sign(Octree& t, const std::array<int64_t, 3>& p, bool inside,
+                    const std::function<void(uint32_t)>* touched);
 /// Flips corner c of a leaf (its cell `cell`). A uniform leaf becomes gray with its vertex
 /// right next to that corner (the only place its surface can be).
 void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell);
