@@ -325,7 +325,9 @@ TEST_F(AlgebraTest, InPlaceEditsSaveAndLoad) {
   EXPECT_EQ(analyze(back).pics, analyze(r).pics);
   const TriMesh m = unsplit_contour(back);
   EXPECT_TRUE(IsClosedManifold(m));
-  EXPECT_LT(two_sided_distance(m, unsplit_contour(r)), 1e-6);
+  // The file holds each vertex to 2^-16 of its cell: the contour's region tests may then choose
+  // another triangulation somewhere, within a few thousandths of a finest cell.
+  EXPECT_LT(two_sided_distance(m, unsplit_contour(r)), 1e-5);
 }
 
 TEST(Csg, OperandsInDifferentCubesShareOneFrame) {

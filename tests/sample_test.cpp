@@ -268,6 +268,38 @@ TEST(Sample, PrismEdgeOnAnOctreeLineIsKept) {
   }
 }
 
+TEST(Sample, SlantedFaceThroughAnOctreeLineKeepsItsEdge) {
+  // A square prism along y turned 45 degrees (OpenSCAD's cylinder with $fn = 4): one of its
+  // slanted faces contains the octree line x = z = 1/2. A cell beside that line meets the face
+  // only along its edge, so the face has no area in it, but the face crosses the cell's edge
+  // there (a sign change): its plane must be in the cell's QEF, or the cell's vertex sits on
+  // the end cap alone and the contour cuts a notch out of the prism's end.
+  const double cx = 0.47, cz = 0.53, r = 0.06, y0 = 0.55, y1 = 0.70;
+  TriMesh prism;
+  const double ring[4][2] = {{cx + r, cz}, {cx, cz + r}, {cx - r, cz}, {cx, cz - r}};
+  for (const auto& p : ring) {
+    prism.positions.push_back({p[0], y0, p[1]});
+    prism.positions.push_back({p[0], y1, p[1]});
+  }
+  for (uint32_t k = 0; k < 4; ++k) {
+    const uint32_t a = 2 * k, b = 2 * ((k + 1) % 4);
+    prism.triangles.push_back({a, a + 1, b + 1});
+    prism.triangles.push_back({a, b + 1, b});
+  }
+  prism.triangles.push_back({0, 2, 4});
+  prism.triangles.push_back({0, 4, 6});
+  prism.triangles.push_back({1, 5, 3});
+  prism.triangles.push_back({1, 7, 5});
+  if (volume(prism) < 0)
+    for (auto& t : prism.triangles) std::swap(t[1], t[2]);
+  for (int depth : {8, 10}) {
+    const Sampled s = sample_and_contour(prism, depth, Cube{{0, 0, 0}, 1});
+    ASSERT_TRUE(IsClosedManifold(s.out)) << "depth " << depth;
+    EXPECT_NEAR(s.volume_out, s.volume_in, 1e-5 * s.volume_in) << "depth " << depth;
+    EXPECT_LE(s.hausdorff, 1e-6) << "depth " << depth;
+  }
+}
+
 TEST(Sample, NestedShellsGiveAHollowSolid) {
   // Outer sphere plus an inward-facing inner sphere: crossing parity makes a hollow ball.
   TriMesh m = make_sphere({0.5, 0.5, 0.5}, 0.4, 48);

@@ -142,6 +142,21 @@ bool crosses(const ITri& t, const I3& a, int axis, i64 len) {
   return perturbed_plane_sign(t, a) != perturbed_plane_sign(t, b);
 }
 
+bool crosses_box_edge(const ITri& t, const IBox& box) {
+  for (int k = 0; k < 3; ++k)
+    if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    for (int e = 0; e < 4; ++e) {
+      I3 a = box.lo;
+      a[i] = (e & 1) ? box.hi[i] : box.lo[i];
+      a[j] = (e & 2) ? box.hi[j] : box.lo[j];
+      if (crosses(t, a, axis, box.hi[axis] - box.lo[axis])) return true;
+    }
+  }
+  return false;
+}
+
 int count_crossings(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const I3& a,
                     int axis, i64 len) {
   int n = 0;
@@ -248,7 +263,8 @@ namespace {
 
 /// The part of `t` inside the closed box, under clipped_area's perturbation convention, in
 /// one of `bufs`; null when there is none. `whole`: no clipping was needed (bufs[0] is `t`).
-const Poly* clip_to_box(const ITri& t, const IBox& box, Poly (&bufs)[2], bool& whole) {
+/// `low_face`: the null is a piece lying in one of the box's low faces.
+const Poly* clip_to_box(const ITri& t, const IBox& box, Poly (&bufs)[2], bool& whole, bool* low_face = nullptr) {
   for (int k = 0; k < 3; ++k)
     if (t.hi[k] < box.lo[k] || t.lo[k] > box.hi[k]) return nullptr;
   int cur = 0;
@@ -276,7 +292,10 @@ const Poly* clip_to_box(const ITri& t, const IBox& box, Poly (&bufs)[2], bool& w
   for (int k = 0; k < 3; ++k) {
     bool all_low = true;
     for (int q = 0; q < poly.n && all_low; ++q) all_low = poly.p[q][k] == lo[k];
-    if (all_low) return nullptr;  // lies in a low face: the perturbation hands it to the neighbour
+    if (all_low) {  // lies in a low face: the perturbation hands it to the neighbour
+      if (low_face) *low_face = true;
+      return nullptr;
+    }
   }
   return &poly;
 }
@@ -285,9 +304,9 @@ const Poly* clip_to_box(const ITri& t, const IBox& box, Poly (&bufs)[2], bool& w
 
 double clipped_area(const ITri& t, const IBox& box) {
   Poly bufs[2];
-  bool whole = false;
-  const Poly* poly = clip_to_box(t, box, bufs, whole);
-  if (!poly) return -1;
+  bool whole = false, low_face = false;
+  const Poly* poly = clip_to_box(t, box, bufs, whole, &low_face);
+  if (!poly) return low_face ? kTouchesLowFace : -1;
   if (whole) return t.area;
   Vec3 acc{0, 0, 0};
   for (int q = 1; q + 1 < poly->n; ++q) {

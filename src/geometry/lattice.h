@@ -81,6 +81,8 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi);
 struct IBox {
   I3 lo, hi;
 };
+/// Whether `t` crosses any of the 12 edges of the box (crosses() on each).
+bool crosses_box_edge(const ITri& t, const IBox& box);
 
 /// edges_may_touch_box for the 8 children of one box (split_tris asks it for several): the
 /// triangle's projections on the 9 axes are taken once about the box's centre and shifted to
@@ -104,7 +106,9 @@ inline IBox cell_box(int level, const std::array<int64_t, 3>& lat) {
 /// Area of the part of the triangle inside the box, under the perturbation convention:
 /// a piece that lies entirely in one of the box's low faces belongs to the neighbour below,
 /// so it counts as 0; a piece of zero area inside the box counts as a tiny positive weight.
-/// Returns < 0 when the triangle does not meet the box. Double precision (used for QEFs).
+/// Returns < 0 when the triangle does not meet the box: kTouchesLowFace when it touches the
+/// closed box only in one of its low faces, else -1. Double precision (used for QEFs).
+inline constexpr double kTouchesLowFace = -0.5;
 double clipped_area(const ITri& t, const IBox& box);
 /// A point of the triangle inside the closed box (the mean of the clipped polygon's corners),
 /// under the same convention; nothing when they do not meet.

@@ -83,26 +83,35 @@ bool SurfaceSource::surface_matters(const Cell& cell, uint8_t, const Wind8*, con
 }
 
 void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-              Qef& q) {
-  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
+              Qef& q, bool edge_planes) {
+  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q, edge_planes);
 }
 
 void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
-             double face, Qef& q) {
+             double face, Qef& q, bool edge_planes) {
   // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
   constexpr double kFloor = 0.1;
-  bool any = false;
+  bool area_or_edge = false;
   auto add = [&](const ITri& t, double w) { q.add_plane(t.unit_normal, t.plane, w); };
   for (uint32_t k : idx) {
     const ITri& t = tris[k];
     if (is_degenerate(t) || !(t.use & kUseQef)) continue;
     const double area = clipped_area(t, box);
-    if (area < 0) continue;
-    any = true;
+    if (area < 0) {
+      // No area in the box under the perturbation, yet it may cross one of the box's edges
+      // (a slanted face through an edge that is high on one axis and low on another): that
+      // crossing is a sign change of this cell, so its plane is part of the cell's surface.
+      // Only a triangle that touches the closed box (in a low face) can.
+      if (!edge_planes || area != kTouchesLowFace || !crosses_box_edge(t, box)) continue;
+      area_or_edge = true;
+      add(t, kFloor);
+      continue;
+    }
+    area_or_edge = true;
     add(t, area / face + kFloor);
   }
-  if (!any) {
+  if (!area_or_edge) {
     // The surface only grazes the cell (e.g. a mesh vertex exactly on a cell corner): the
     // perturbation still puts a sliver inside, so use the planes that touch the closed cell.
     for (uint32_t k : idx)
@@ -262,7 +271,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   } else if (at_cap || one_component(signs)) {
     // (Two components by the signs always split, below the cap: no QEF needed to know.)
     Qef q;
-    cell_qef(src.tris(), idx, cell, q);
+    cell_qef(src.tris(), idx, cell, q, p.edge_planes);
     src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
