@@ -94,6 +94,25 @@ TEST(Eval, TwistedBandKeepsItsVolume) {
 // difference, extruded) is empty at that depth, not an error that stops the whole model.
 TEST(Eval, FlatLeafIsEmpty) { expect_volume(eval_file("flat_leaf.csg"), 1000, 1e-3); }
 
+// A sphere's flat facets sample into coarse leaves, which a Boolean nearby subdivides and
+// resamples from the sphere's partial contour. Two ways that went wrong, both at depth 10 and
+// in these models' own cubes (found by bench/scad_fuzz.py, seed 187), both measured against
+// OpenSCAD's render of the same model:
+// - facet_minus_inner_sphere: a resampled cell at a coarse leaf's corner held only polygons of
+//   unstamped neighbours, which the partial contour kept for parity walks alone: its sign
+//   changed but its QEF had no plane, and its vertex sat at a corner, 24 cells off the facet;
+// - crease_on_lattice_diagonal: the sphere's crease lies in the lattice plane x = y, so the
+//   facet beyond it crosses the resampled cells' edges without area in them; without those
+//   edge-crossing planes the vertices sat on one facet and the crease came out toothed (5.6).
+TEST(Eval, CoarseFacetsKeepTheirShapeWhereABooleanResamplesThem) {
+  for (const std::string name : {"facet_minus_inner_sphere", "crease_on_lattice_diagonal"}) {
+    const Result r = eval_file(name + ".csg", 10);
+    EXPECT_TRUE(test::IsClosedManifold(r.mesh)) << name;
+    const SurfaceDistance d = surface_distance(r.mesh, read_mesh(kData / (name + ".stl")), 20000);
+    EXPECT_LT(d.hausdorff / r.cell, 3.0) << name;  // 2.3 and 1.6: a tangency and a thin wedge
+  }
+}
+
 TEST(Eval, RotateExtrudeFn4) { expect_volume(eval_file("rotate_square.csg"), 6, 1e-3); }
 
 TEST(Eval, PolyhedronClockwiseFaces) { expect_volume(eval_file("polyhedron.csg"), 2000.0 / 3, 1e-3); }

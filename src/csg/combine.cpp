@@ -168,7 +168,6 @@ class Combiner {
     p.max_depth = max_depth_;
     p.error = error_;
     p.invert = invert;
-    p.edge_planes = false;  // see cell_qef
     Builder sub;
     sub.nodes.resize(1);
     size_t capped = 0;

@@ -92,13 +92,6 @@ class SignMemo {
 struct PartialContour {
   std::vector<ITri> tris;
   TriangleBvh bvh;
-  /// What the parity walks cross: `tris` and the polygons around stamped coarse leaves
-  /// (around_coarse_leaves), when there are any. Only signs use them: the QEFs and the edge
-  /// crossings keep to `tris`, the operation's own cells. Empty when there are none.
-  std::vector<ITri> parity_tris;
-  TriangleBvh parity_bvh;
-  /// Whether the parity walks cross more than `tris` (parity_tris holds tris and the rest).
-  bool wider() const { return !parity_tris.empty(); }
 };
 
 /// One operand as seen by one task of an operation: its tree, its partial contour, and the
@@ -108,10 +101,7 @@ struct Operand {
   const PartialContour& pc;
   const std::vector<ITri>& tris;
   const TriangleBvh& bvh;
-  const std::vector<ITri>& parity_tris;
-  const TriangleBvh& parity_bvh;
   std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
-  std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_parity_tris;  // the same, of parity_tris
   SignMemo memo;                                                  // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
@@ -119,9 +109,7 @@ struct Operand {
   uint32_t stamp = 0;
 
   Operand(const Octree& tree, const Stamps& tree_stamps, const PartialContour& contour, uint32_t op_stamp)
-      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh),
-        parity_tris(contour.wider() ? contour.parity_tris : contour.tris),
-        parity_bvh(contour.wider() ? contour.parity_bvh : contour.bvh), stamps(tree_stamps), stamp(op_stamp) {}
+      : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh), stamps(tree_stamps), stamp(op_stamp) {}
 
   /// The corner of a gray leaf farthest from its contour triangles. A corner within the
   /// contour's error of the surface may sit on the wrong side of it; starting the parity walk
@@ -129,13 +117,13 @@ struct Operand {
   /// right next to such corners (cached per leaf).
   int anchor_corner(uint32_t leaf, const Cell& cell) {
     if (const auto it = anchors.find(leaf); it != anchors.end()) return it->second;
-    const auto& idx = parity_triangles_in(leaf, cell);
+    const auto& idx = triangles_in(leaf, cell);
     int best = 0;
     double best_d = -1;
     for (int c = 0; c < 8; ++c) {
       const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
       double d = 1e300;
-      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, parity_tris[k]));
+      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, tris[k]));
       if (d > best_d) {
         best_d = d;
         best = c;
@@ -147,21 +135,10 @@ struct Operand {
 
   /// Partial-contour triangles meeting a leaf's cell (cached per leaf).
   const std::vector<uint32_t>& triangles_in(uint32_t leaf, const Cell& cell) {
-    return cached_query(leaf_tris, tris, bvh, leaf, cell);
-  }
-  /// The same for the triangles the parity walks cross.
-  const std::vector<uint32_t>& parity_triangles_in(uint32_t leaf, const Cell& cell) {
-    if (&parity_tris == &tris) return triangles_in(leaf, cell);
-    return cached_query(leaf_parity_tris, parity_tris, parity_bvh, leaf, cell);
-  }
-  /// The triangles of `in` (indexed by `index`) meeting a leaf's cell, cached in `cache`.
-  static const std::vector<uint32_t>& cached_query(std::unordered_map<uint32_t, std::vector<uint32_t>>& cache,
-                                                   const std::vector<ITri>& in, const TriangleBvh& index,
-                                                   uint32_t leaf, const Cell& cell) {
-    auto [it, fresh] = cache.try_emplace(leaf);
+    auto [it, fresh] = leaf_tris.try_emplace(leaf);
     if (fresh) {
       const IBox b = cell.box();
-      index.query(in, b.lo, b.hi, it->second);
+      bvh.query(tris, b.lo, b.hi, it->second);
       std::sort(it->second.begin(), it->second.end());  // deterministic order
     }
     return it->second;
@@ -234,18 +211,18 @@ struct Operand {
     const uint64_t key = lattice_key(p);
     // Crossing parity along x, then y, then z from the leaf's most reliable corner.
     const Node& n = t.nodes[h.leaf];
-    const auto& idx = parity_triangles_in(h.leaf, h.cell);
+    const auto& idx = triangles_in(h.leaf, h.cell);
     const int c = anchor_corner(h.leaf, h.cell);
     bool s = (n.signs >> c) & 1;
     I3 a = lattice_to_grid(h.cell.corner(c));
     const I3 g = lattice_to_grid(p);
     for (int axis = 0; axis < 3; ++axis) {
       const i64 len = g[axis] - a[axis];
-      if (len > 0) s ^= count_crossings(parity_tris, idx, a, axis, len) & 1;
+      if (len > 0) s ^= count_crossings(tris, idx, a, axis, len) & 1;
       if (len < 0) {
         I3 b = a;
         b[axis] = g[axis];
-        s ^= count_crossings(parity_tris, idx, b, axis, -len) & 1;
+        s ^= count_crossings(tris, idx, b, axis, -len) & 1;
       }
       a[axis] = g[axis];
     }

@@ -101,19 +101,19 @@ std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, const Stamps&
   return out;
 }
 
-/// The partial contour: dual polygons around stamped cells, indexed for box queries; for the
-/// parity walks also those around the edges of stamped coarse leaves. One walk: a polygon
-/// with a stamped leaf is the operation's own.
+/// The partial contour: dual polygons around stamped cells and around the edges of stamped
+/// coarse leaves, indexed for box queries. The second kind are the operand's surface as much
+/// as the first: a parity walk needs them, and so does the QEF of a cell that a coarse leaf
+/// is resampled into when such a polygon is all the surface it holds (a sphere's flat facet
+/// in a coarse leaf beside an unstamped one: with only the stamped leaves' polygons, a
+/// resampled cell had its sign change but no plane, and its vertex sat 9 cells off the facet).
 void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x) {
   const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamps, stamp);
   const std::function<bool(uint32_t)> active = [&](uint32_t n) {
     return stamps[n] == stamp || around.count(n) != 0;
   };
-  std::vector<ITri> extra;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
-    bool own = false;
-    for (int k = 0; k < poly.count; ++k) own = own || stamps[poly.leaf[k]] == stamp;
-    std::vector<ITri>& out = own ? x.tris : extra;
+    std::vector<ITri>& out = x.tris;
     std::array<I3, 4> g;
     for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
     auto add = [&](int i, int j, int k) {
@@ -127,10 +127,6 @@ void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, Part
   };
   dual_walk(t, &active, emit);
   x.bvh.build(x.tris);
-  if (extra.empty()) return;
-  x.parity_tris = x.tris;
-  x.parity_tris.insert(x.parity_tris.end(), extra.begin(), extra.end());
-  x.parity_bvh.build(x.parity_tris);
 }
 
 }  // namespace

@@ -83,12 +83,12 @@ bool SurfaceSource::surface_matters(const Cell& cell, uint8_t, const Wind8*, con
 }
 
 void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-              Qef& q, bool edge_planes) {
-  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q, edge_planes);
+              Qef& q) {
+  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
 }
 
 void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
-             double face, Qef& q, bool edge_planes) {
+             double face, Qef& q) {
   // Weight of a plane that only touches the cell: well above the pseudo-inverse cutoff, so a
   // sharp edge lying on the cell boundary still pins the vertex (box edges on octree planes).
   constexpr double kFloor = 0.1;
@@ -103,7 +103,7 @@ void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, co
       // (a slanted face through an edge that is high on one axis and low on another): that
       // crossing is a sign change of this cell, so its plane is part of the cell's surface.
       // Only a triangle that touches the closed box (in a low face) can.
-      if (!edge_planes || area != kTouchesLowFace || !crosses_box_edge(t, box)) continue;
+      if (area != kTouchesLowFace || !crosses_box_edge(t, box)) continue;
       area_or_edge = true;
       add(t, kFloor);
       continue;
@@ -271,7 +271,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   } else if (at_cap || one_component(signs)) {
     // (Two components by the signs always split, below the cap: no QEF needed to know.)
     Qef q;
-    cell_qef(src.tris(), idx, cell, q, p.edge_planes);
+    cell_qef(src.tris(), idx, cell, q);
     src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&

@@ -92,7 +92,6 @@ struct SampleParams {
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
   uint32_t memo_id = 0;    // nonzero: one triangle set, whose edge crossing counts may be memoized
-  bool edge_planes = true; // QEFs take the planes of triangles crossing the cell's edges without area in it
 };
 
 /// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped,
@@ -107,15 +106,13 @@ uint32_t new_memo_id();
 
 /// QEF of the triangles meeting `cell` (weights: clipped area / cell face area + a floor, so
 /// planes that touch the cell only along its boundary still count — box corners on octree
-/// planes need them). `edge_planes`: also, at the floor weight, those that touch the cell
-/// only in a low face but cross one of its edges (an input mesh's slanted face through an
-/// octree line). Off for CSG's partial contours, whose vertices often sit on cell faces: there
-/// the extra planes only refined the result (+5 % PICs in sculpting) without changing it.
+/// planes need them), and, at the floor weight, those that touch the cell only in a low face
+/// but cross one of its edges (a slanted face or a crease through an octree line).
 void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-              Qef& q, bool edge_planes = false);
+              Qef& q);
 /// The same over an arbitrary box; `face_area` normalizes the weights (unit-space area).
 void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
-             double face_area, Qef& q, bool edge_planes = false);
+             double face_area, Qef& q);
 
 /// Whether any triangle of `idx` meets the cell under the perturbation convention (a triangle
 /// lying in one of the cell's low faces belongs to the neighbour below).
