@@ -574,16 +574,19 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
       // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
       // preferring to flip the minority sign (removing the thinner feature).
       int best = -1, best_cost = 1 << 30;
+      bool best_breaks_coarse = false;  // the best flip leaves a coarser leaf two components
       const bool minority_inside = __builtin_popcount(s) <= 4;
       for (int k = 0; k < 8; ++k) {
         if (multi_component(uint8_t(s ^ (1 << k)))) continue;
         const auto around = leaves_around(t, l.cell.corner(k));
         const bool inside = !((s >> k) & 1);
         int cost = 0;
+        bool breaks_coarse = false;
         for (const auto& a : around) {
           const uint8_t flipped = with_corner(signs_of(t.nodes[a.node]), a.corner, inside);
           cost += 2 * multi_component(flipped);
           cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
+          breaks_coarse = breaks_coarse || (a.cell.level < t.max_depth && multi_component(flipped));
         }
         cost += (((s >> k) & 1) != 0) != minority_inside;
         // Undoing what remove_islands just set would bring its defect back.
@@ -591,9 +594,17 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         if (cost < best_cost) {
           best_cost = cost;
           best = k;
+          best_breaks_coarse = breaks_coarse;
         }
       }
       if (best < 0) continue;
+      if (best_breaks_coarse && l.cell.level == t.max_depth) {
+        // Two components in a finest leaf are the depth cap's to keep (the contour's sheets
+        // are split apart); in a coarser leaf no PIC can hold them. Trading the one for the
+        // other made the two leaves flip the same points back and forth.
+        t.nodes[l.node].flags |= kFlagCapped;
+        continue;
+      }
       set_point_sign(t, l.cell.corner(best), !((s >> best) & 1), touched);
       ++fix.flipped;
     }
