@@ -396,8 +396,8 @@ void flip_stray_regions(const FaceFrame& fr, FaceScratch& s) {
 /// - every connected region of one sign on the face reaches a corner of the face with that
 ///   sign, else the coarse vertex gets a second fan of polygons (a pinched, non-manifold
 ///   vertex).
-/// Returns the lattice points to flip, with their new sign (as few as possible along edges; whole stray regions
-/// on the face).
+/// Returns the lattice points to flip, with their new sign (as few as possible along edges;
+/// whole stray regions on the face).
 const std::vector<std::pair<Lat, bool>>& face_flips(const Octree& t, const LeafRef& big, int f, FaceScratch& s) {
   s.flips.clear();
   const FaceFrame fr(big, f, signs_of(t.nodes[big.node]));
