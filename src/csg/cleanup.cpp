@@ -43,12 +43,10 @@ bool speck_is_inherited(const Speck& sp, CsgOp op, const std::function<bool(cons
   return all_neutral || b_shows;
 }
 
-/// What setting a hinted sign would do: the leaves around the point (each has it as a corner)
-/// and how many of them hold more than one component before and after.
+/// What setting a hinted sign would do: how many of the leaves around the point (each has it
+/// as a corner) hold more than one component before and after.
 struct HintedFlip {
-  std::array<LeafRef, 8> around;
-  std::array<int, 8> corner;
-  int count = 0, before = 0, after = 0;
+  int before = 0, after = 0;
   bool possible = false;  // every leaf around is a stamped leaf with the point as a corner
   bool needed = false;    // the point's sign differs from the hint's
 };
@@ -109,8 +107,6 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
     f.needed = f.needed || set != s;
     f.before += multi_component(s);
     f.after += multi_component(set);
-    f.around[f.count] = r;
-    f.corner[f.count++] = k;
   }
   f.possible = true;
   return f;
@@ -126,10 +122,7 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
   for (const SignHint& h : hints) {
     const HintedFlip f = examine_hint(t, h, stamped);
     if (!f.possible || !f.needed || f.after >= f.before) continue;
-    for (int i = 0; i < f.count; ++i) {
-      const LeafRef& r = f.around[i];
-      if (bool((signs_of(t.nodes[r.node]) >> f.corner[i]) & 1) != h.inside) flip_corner(t, r.node, f.corner[i], r.cell);
-    }
+    set_point_sign(t, h.point, h.inside, nullptr);
     pinned.insert(lattice_key(h.point));
   }
 }
