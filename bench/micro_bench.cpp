@@ -16,7 +16,9 @@
 //   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
 //                                punched (winding), 2 = the Stanford bunny (open base, winding),
 //                                3 = the bunny with its holes closed by fans (parity): the per-PIC
-//                                cost of 2 against 3 is the winding path's overhead
+//                                cost of 2 against 3 is the winding path's overhead; 4 = the car
+//                                shell (2,016 triangles, open windows and floor: winding), 5 = it
+//                                with its holes closed by fans (parity)
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 #include <tbb/blocked_range.h>
@@ -277,19 +279,22 @@ BENCHMARK(BM_DipoleTreeQuery)->ArgName("near")->Arg(0)->Arg(1);
 
 /// The bunny with each boundary loop closed by fans on its own vertices: the same surface away
 /// from the holes, and closed, so it takes the parity path.
-pic::TriMesh bunny_closed() {
-  pic::detail::CleanMesh c = pic::detail::clean_mesh(mesh_of("stanford-bunny.obj"));
+pic::TriMesh fan_closed(const char* name) {
+  pic::detail::CleanMesh c = pic::detail::clean_mesh(mesh_of(name));
   for (const auto& t : pic::detail::cap_loops(pic::detail::boundary_chain(c.mesh))) c.mesh.triangles.push_back(t);
   return c.mesh;
 }
 
 void BM_SampleAnyInput(benchmark::State& state) {
-  static const pic::TriMesh holes = spot_with_holes(), closed = bunny_closed();
+  static const pic::TriMesh holes = spot_with_holes(), closed = fan_closed("stanford-bunny.obj"),
+                            car_closed = fan_closed("car_shell.obj");
   const int k = static_cast<int>(state.range(0));
   const pic::TriMesh& m = k == 0   ? mesh_of("spot.obj")
                           : k == 1 ? holes
                           : k == 2 ? mesh_of("stanford-bunny.obj")
-                                   : closed;
+                          : k == 3 ? closed
+                          : k == 4 ? mesh_of("car_shell.obj")
+                                   : car_closed;
   pic::SampleStats st;
   double seconds = 0;
   for (auto _ : state) {
@@ -298,12 +303,14 @@ void BM_SampleAnyInput(benchmark::State& state) {
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     benchmark::DoNotOptimize(t);
   }
-  state.SetLabel(k == 0 ? "spot" : k == 1 ? "spot with holes" : k == 2 ? "stanford bunny" : "bunny, holes fanned");
+  static const char* const kLabels[] = {"spot", "spot with holes", "stanford bunny", "bunny, holes fanned",
+                                        "car shell", "car shell, holes fanned"};
+  state.SetLabel(kLabels[k]);
   state.counters["PICs"] = static_cast<double>(st.pics);
   state.counters["ns_per_PIC"] = seconds * 1e9 / static_cast<double>(state.iterations()) / static_cast<double>(st.pics);
   state.counters["boundary_edges"] = static_cast<double>(st.defects.boundary_edges);
 }
-BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The allocator settings of the command-line tool, so both measure the same thing.
 int main(int argc, char** argv) {
