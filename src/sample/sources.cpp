@@ -113,6 +113,20 @@ CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
   return slots[edge_memo_slot(a, axis, len, kBits)];
 }
 
+/// The caps' winding number at a cell corner: the ends of the edges searched across a hole,
+/// shared by the corner's edges in each cell around it.
+struct CapValueEntry {
+  I3 p;
+  uint32_t id = 0;  // 0: empty
+  double w = 0;
+};
+
+CapValueEntry& cap_value_slot(const I3& p) {
+  constexpr int kBits = 12;
+  thread_local std::vector<CapValueEntry> slots(size_t{1} << kBits);
+  return slots[memo_slot(p, 0, kBits)];
+}
+
 /// Integer winding number at b from w at a, along the axes in turn (x, then y, then z) through
 /// the triangles `near` (all those the path can cross). Crossing a triangle along +axis changes
 /// w by -sign(n_axis), along -axis by +sign(n_axis).
@@ -402,6 +416,13 @@ void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_
   }
 }
 
+double WindingSource::cap_winding(const I3& p, bool memoize) const {
+  if (!memoize) return caps_.evaluate(to_unit(p), &p).w;
+  CapValueEntry& e = cap_value_slot(p);
+  if (e.id != cache_.id() || e.p != p) e = {p, cache_.id(), caps_.evaluate(to_unit(p), &p).w};
+  return e.w;
+}
+
 void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8* wind,
                                     const std::vector<uint32_t>& idx, Qef& q) const {
   if (!wind) return;
@@ -441,7 +462,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     if (surface == 0)
       level = level_on_edge(cell, c0, axis, s0, [&](i64 off) {
         const I3 p = along(a, axis, off);
-        return std::abs(double(winding_at(off)) - caps_.evaluate(to_unit(p), &p).w) - 0.5;
+        return std::abs(double(winding_at(off)) - cap_winding(p, off == 0 || off == len)) - 0.5;
       });
     const Vec3 x = level ? *level : bisect_edge(cell, c0, axis, s0, [&](i64 off) {
       return inside(along(a, axis, off), winding_at(off));

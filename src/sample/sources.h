@@ -92,6 +92,8 @@ class WindingSource : public SurfaceSource {
   /// Whether the caps' winding number is certainly below 1/2 in magnitude all over `box` (unit
   /// space): there the caps cannot move a decision.
   bool caps_below_half(const Box& box) const;
+  /// The caps' winding number at p (their tree's evaluate()); `memoize` for cell corners.
+  double cap_winding(const I3& p, bool memoize) const;
   /// Closed input with dropped walls: the planes of dropped triangles where they change a
   /// cell edge's sign (add_fill_planes).
   void add_dropped_wall_planes(const Cell& cell, uint8_t signs, const Wind8& wind, const std::vector<uint32_t>& idx,
