@@ -63,7 +63,7 @@ void stamp_under_surface(const PartialContour& a, const Octree& b, Stamps& sb, u
 /// Marks `node` and every node below it whose closed cell meets an edge of the lattice box
 /// [lo, hi]: meets the box, and holds one of its bounds along two axes.
 void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
-                         std::unordered_set<uint32_t>& out) {
+                         std::vector<uint8_t>& out) {
   const int64_t s = cell.span();
   int bounds = 0;
   for (int k = 0; k < 3; ++k) {
@@ -72,7 +72,7 @@ void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const
     bounds += holds(lo[k]) || holds(hi[k]);
   }
   if (bounds < 2) return;
-  out.insert(node);
+  out[node] = 1;
   const Node& n = t.nodes[node];
   if (n.kind == CellKind::Internal)
     for (int c = 0; c < 8; ++c) mark_touching_edges(t, n.index + c, cell.child(c), lo, hi, out);
@@ -85,15 +85,17 @@ void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const
 /// leaf took a cone's tip for outside the box: a stray shell 4 cells from the exact result,
 /// harness seed 81). Only cells at the leaf's edges matter: a polygon's vertices lie in their
 /// cells, and cells that touch only the inside of one face all lie beyond that face's plane,
-/// and so do their polygons.
-std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, const Stamps& stamps, uint32_t stamp) {
-  std::unordered_set<uint32_t> out;
+/// and so do their polygons. A flag per node (none when no such leaf is stamped): a hash set
+/// of the nodes along the leaves' edges was slower.
+std::vector<uint8_t> around_coarse_leaves(const Octree& t, const Stamps& stamps, uint32_t stamp) {
+  std::vector<uint8_t> out;
   std::function<void(uint32_t, const Cell&)> walk = [&](uint32_t node, const Cell& cell) {
     if (stamps[node] != stamp) return;
     const Node& n = t.nodes[node];
     if (n.kind == CellKind::Internal) {
       for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c));
     } else if (n.kind == CellKind::Gray && cell.level < t.max_depth) {
+      if (out.empty()) out.assign(t.nodes.size(), 0);
       mark_touching_edges(t, 0, Cell{}, cell.lat, cell.corner(7), out);
     }
   };
@@ -108,24 +110,34 @@ std::unordered_set<uint32_t> around_coarse_leaves(const Octree& t, const Stamps&
 /// in a coarse leaf beside an unstamped one: with only the stamped leaves' polygons, a
 /// resampled cell had its sign change but no plane, and its vertex sat 9 cells off the facet).
 void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x) {
-  const std::unordered_set<uint32_t> around = around_coarse_leaves(t, stamps, stamp);
+  const std::vector<uint8_t> around = around_coarse_leaves(t, stamps, stamp);
   const std::function<bool(uint32_t)> active = [&](uint32_t n) {
-    return stamps[n] == stamp || around.count(n) != 0;
+    return stamps[n] == stamp || (!around.empty() && around[n] != 0);
   };
+  // The polygons first, then their triangles in parallel into a vector sized once: a
+  // triangle is 272 bytes, and growing the vector one at a time copied them over and over.
+  std::vector<std::array<Vec3, 4>> quads;
+  std::vector<uint8_t> counts;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
-    std::vector<ITri>& out = x.tris;
-    std::array<I3, 4> g;
-    for (int k = 0; k < poly.count; ++k) g[k] = to_grid(poly.pos[k]);
-    auto add = [&](int i, int j, int k) {
-      out.push_back(make_itri(g[i], g[j], g[k]));
-    };
-    if (poly.count == 3) {
-      add(0, 1, 2);
-      return;
-    }
-    for (const auto& tri : split_quad({poly.pos[0], poly.pos[1], poly.pos[2], poly.pos[3]})) add(tri[0], tri[1], tri[2]);
+    quads.push_back(poly.pos);
+    counts.push_back(uint8_t(poly.count));
   };
   dual_walk(t, &active, emit);
+  std::vector<uint32_t> first(quads.size() + 1, 0);
+  for (size_t i = 0; i < quads.size(); ++i) first[i + 1] = first[i] + (counts[i] == 3 ? 1 : 2);
+  const size_t base = x.tris.size();
+  x.tris.resize(base + first.back());
+  tbb::parallel_for(size_t{0}, quads.size(), [&](size_t i) {
+    const std::array<Vec3, 4>& q = quads[i];
+    std::array<I3, 4> g;
+    for (int k = 0; k < counts[i]; ++k) g[k] = to_grid(q[k]);
+    ITri* out = x.tris.data() + base + first[i];
+    if (counts[i] == 3) {
+      *out = make_itri(g[0], g[1], g[2]);
+      return;
+    }
+    for (const auto& tri : split_quad(q)) *out++ = make_itri(g[tri[0]], g[tri[1]], g[tri[2]]);
+  });
   x.bvh.build(x.tris);
 }
 
