@@ -3,7 +3,8 @@
 
 The body is a loft of rounded-rectangle cross sections along x (a hood, a cabin, a trunk), its two
 ends closed by fans; the quads of the side windows, the windscreen and the rear window are left
-out, so the mesh has six large holes whose inside the winding number has to settle.
+out (and with --open-bottom the floor, as in data/car_shell.obj), so the mesh has six (seven)
+large holes whose inside the winding number has to settle.
 
   python3 bench/make_car_shell.py OUT.obj [--stations 48] [--around 26] [--open-bottom]
 """

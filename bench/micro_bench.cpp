@@ -277,8 +277,8 @@ void BM_DipoleTreeQuery(benchmark::State& state) {
 }
 BENCHMARK(BM_DipoleTreeQuery)->ArgName("near")->Arg(0)->Arg(1);
 
-/// The bunny with each boundary loop closed by fans on its own vertices: the same surface away
-/// from the holes, and closed, so it takes the parity path.
+/// A bundled mesh with each boundary loop closed by fans on its own vertices: the same surface
+/// away from the holes, and closed, so it takes the parity path.
 pic::TriMesh fan_closed(const char* name) {
   pic::detail::CleanMesh c = pic::detail::clean_mesh(mesh_of(name));
   for (const auto& t : pic::detail::cap_loops(pic::detail::boundary_chain(c.mesh))) c.mesh.triangles.push_back(t);
