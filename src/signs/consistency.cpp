@@ -509,27 +509,82 @@ void finer_corners_on_coarse_leaf(const Octree& t, const IslandSearch& search, c
 
 }  // namespace
 
+namespace {
+
+/// Marks every node whose closed cell meets the closed lattice box [lo, hi].
+void mark_meeting(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                  std::vector<uint8_t>& out) {
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  out[node] = 1;
+  const Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal)
+    for (int c = 0; c < 8; ++c) mark_meeting(t, n.index + c, cell.child(c), lo, hi, out);
+}
+
+/// Marks the nodes whose closed cell meets that of a leaf among `touched` (which holds every
+/// node on the way down to each such leaf).
+void mark_near_touched(const Octree& t, const std::vector<uint32_t>& touched, std::vector<uint8_t>& out) {
+  std::vector<uint8_t> on(t.nodes.size(), 0);
+  for (uint32_t n : touched) on[n] = 1;
+  std::vector<LeafRef> leaves;
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    if (!on[node]) return;
+    const Node& n = t.nodes[node];
+    if (n.kind != CellKind::Internal) {
+      leaves.push_back({node, cell});
+      return;
+    }
+    for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+  };
+  if (!touched.empty()) walk(walk, 0, Cell{});
+  for (const LeafRef& l : leaves) mark_meeting(t, 0, Cell{}, l.cell.lat, l.cell.corner(7), out);
+}
+
+}  // namespace
+
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
-                      const std::function<void(uint32_t)>* touched, PinnedPoints* pinned) {
+                      const std::function<void(uint32_t)>* touched, PinnedPoints* pinned, IslandRounds* rounds) {
   IslandSearch search{t, {}, {}};
   {
     std::vector<uint32_t> path;
     search.collect(0, Cell{}, active, path);
   }
+  // Where this round looks (empty: everywhere). A flip in this round widens it as it goes, so
+  // a leaf later in the order sees what an earlier one changed, as in a full round.
+  std::vector<uint8_t> look;
+  if (rounds && !rounds->seen.empty()) {
+    look.assign(t.nodes.size(), 0);
+    mark_near_touched(t, rounds->touched, look);
+    for (const PathLeaf& l : search.leaves)
+      if (l.node >= rounds->seen.size() || !rounds->seen[l.node]) look[l.node] = 1;
+  }
+  if (rounds) rounds->touched.clear();  // from here on: this round's flips, for the next one
+  const auto looks_at = [&](uint32_t node) { return look.empty() || look[node] != 0; };
   size_t flipped = 0;
   auto flip = [&](const Lat& p, bool inside) {
     set_point_sign(t, p, inside, touched);
     if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
+    if (!look.empty())
+      for (const Around& a : leaves_around(t, p)) mark_meeting(t, 0, Cell{}, a.cell.lat, a.cell.corner(7), look);
   };
   std::vector<CoarseFace> faces;
   std::vector<LeafRef> near;
   for (const PathLeaf& l : search.leaves)
-    if (l.cell.level >= t.max_depth - 1)  // the finest leaves carry the islands
+    if (l.cell.level >= t.max_depth - 1 && looks_at(l.node))  // the finest leaves carry the islands
       fine_corners_on_coarse_leaves(t, search, l, flip, near, faces);
   for (const PathLeaf& l : search.leaves)
-    if (l.cell.level < t.max_depth) finer_corners_on_coarse_leaf(t, search, l, flip, faces);
-  // What the finer side shows on each coarse face (edges, stray regions), each face once.
+    if (l.cell.level < t.max_depth && looks_at(l.node)) finer_corners_on_coarse_leaf(t, search, l, flip, faces);
+  // What the finer side shows on each coarse face (edges, stray regions), each face once. A
+  // later round checks the faces queued now (some may be new) and those of earlier rounds
+  // that something changed near, in the order a full round would.
+  if (rounds) {
+    if (!look.empty())
+      for (const auto& f : faces) look[f.first.node] = 1;
+    faces.insert(faces.end(), rounds->faces.begin(), rounds->faces.end());
+  }
   FaceScratch face_scratch;
   std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
     return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
@@ -538,8 +593,13 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
                           [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
               faces.end());
   for (const auto& [big, f] : faces) {
-    if (t.nodes[big.node].kind != CellKind::Gray) continue;
+    if (t.nodes[big.node].kind != CellKind::Gray || !looks_at(big.node)) continue;
     for (const auto& [p, inside] : face_flips(t, big, f, face_scratch)) flip(p, inside);
+  }
+  if (rounds) {
+    rounds->seen.resize(t.nodes.size(), 0);
+    for (const PathLeaf& l : search.leaves) rounds->seen[l.node] = 1;
+    rounds->faces = std::move(faces);
   }
   return flipped;
 }

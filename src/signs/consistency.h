@@ -66,8 +66,20 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
 /// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
 /// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
 /// to match, in every leaf that has it as a corner. Returns how many points changed.
+/// What remove_islands carries from one round of a settling loop to the next. Every check reads
+/// only the stored signs of the leaves around it, so a later round need look again only near
+/// the leaves a flip touched since the last round began, and at leaves it has not seen: anywhere
+/// else it would find what the last round left, nothing.
+struct IslandRounds {
+  std::vector<uint32_t> touched;  ///< nodes set_point_sign reported since the last round began
+  std::vector<uint8_t> seen;      ///< per node: a leaf a round has looked at
+  std::vector<std::pair<LeafRef, int>> faces;  ///< the coarse faces (leaf, face) checked so far
+};
+/// With `rounds` (kept by the caller across rounds, and told of every node a flip touches
+/// between them), a round after the first looks only where something changed; same result.
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
-                      const std::function<void(uint32_t)>* touched = nullptr, PinnedPoints* pinned = nullptr);
+                      const std::function<void(uint32_t)>* touched = nullptr, PinnedPoints* pinned = nullptr,
+                      IslandRounds* rounds = nullptr);
 
 /// A speck: a few finest-level lattice points of one sign (`inside`) whose every neighbour
 /// (every other corner of the leaves around them) has the other sign, i.e. a closed shell or

@@ -7,9 +7,16 @@ namespace pic::detail {
 
 size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
   const auto* component_scope = plan.one_component_everywhere ? nullptr : plan.active;
+  // Every node a flip touches, logged for the island pass's next round (which looks only near
+  // them) and passed on to the plan's own record.
+  IslandRounds rounds;
+  const std::function<void(uint32_t)> touched = [&](uint32_t n) {
+    rounds.touched.push_back(n);
+    if (plan.touched) (*plan.touched)(n);
+  };
   for (int round = 0; round < 4; ++round) {
-    const size_t islands = remove_islands(t, plan.active, plan.touched, &pinned);
-    const TopologyFix fix = enforce_one_component(t, component_scope, plan.touched, &pinned, plan.spare_coarse);
+    const size_t islands = remove_islands(t, plan.active, &touched, &pinned, &rounds);
+    const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse);
     if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
   }
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
