@@ -5,6 +5,9 @@
 #include "geometry/union_find.h"
 
 #include <Eigen/Dense>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -551,8 +554,8 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     std::vector<uint32_t> path;
     search.collect(0, Cell{}, active, path);
   }
-  // Where this round looks (empty: everywhere). A flip in this round widens it as it goes, so
-  // a leaf later in the order sees what an earlier one changed, as in a full round.
+  // Where this round looks (empty: everywhere), and where its own flips have changed a stored
+  // sign since it began (`moved`: the nodes whose closed cells meet a flipped point's leaves).
   std::vector<uint8_t> look;
   if (rounds && !rounds->seen.empty()) {
     look.assign(t.nodes.size(), 0);
@@ -561,22 +564,49 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
       if (l.node >= rounds->seen.size() || !rounds->seen[l.node]) look[l.node] = 1;
   }
   if (rounds) rounds->touched.clear();  // from here on: this round's flips, for the next one
-  const auto looks_at = [&](uint32_t node) { return look.empty() || look[node] != 0; };
+  std::vector<uint8_t> moved(t.nodes.size(), 0);
+  const auto looks_at = [&](uint32_t node) { return look.empty() || look[node] != 0 || moved[node] != 0; };
   size_t flipped = 0;
   auto flip = [&](const Lat& p, bool inside) {
     set_point_sign(t, p, inside, touched);
     if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
-    if (!look.empty())
-      for (const Around& a : leaves_around(t, p)) mark_meeting(t, 0, Cell{}, a.cell.lat, a.cell.corner(7), look);
+    for (const Around& a : leaves_around(t, p)) mark_meeting(t, 0, Cell{}, a.cell.lat, a.cell.corner(7), moved);
   };
+  // Each pass first asks, in parallel and reading only, which of its leaves would flip a point
+  // as the tree stands; then it runs in order over those and over the ones a flip since has
+  // come near. A check whose inputs did not change finds what it found: nothing. So the flips
+  // are those of one pass in order over every leaf, in the same order.
   std::vector<CoarseFace> faces;
-  std::vector<LeafRef> near;
-  for (const PathLeaf& l : search.leaves)
-    if (l.cell.level >= t.max_depth - 1 && looks_at(l.node))  // the finest leaves carry the islands
-      fine_corners_on_coarse_leaves(t, search, l, flip, near, faces);
-  for (const PathLeaf& l : search.leaves)
-    if (l.cell.level < t.max_depth && looks_at(l.node)) finer_corners_on_coarse_leaf(t, search, l, flip, faces);
+  const auto pass = [&](auto&& eligible, auto&& check) {
+    const size_t n = search.leaves.size();
+    std::vector<uint8_t> hit(n, 0);
+    tbb::enumerable_thread_specific<std::vector<CoarseFace>> queued;
+    tbb::enumerable_thread_specific<std::vector<LeafRef>> nears;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        const PathLeaf& l = search.leaves[i];
+        if (!eligible(l) || !looks_at(l.node)) continue;
+        bool would = false;
+        check(l, [&](const Lat&, bool) { would = true; }, nears.local(), queued.local());
+        hit[i] = would;
+      }
+    });
+    for (const auto& q : queued) faces.insert(faces.end(), q.begin(), q.end());
+    std::vector<LeafRef> near;
+    for (size_t i = 0; i < n; ++i)
+      if (eligible(search.leaves[i]) && (hit[i] || moved[search.leaves[i].node]))
+        check(search.leaves[i], flip, near, faces);
+  };
+  // The finest leaves carry the islands.
+  pass([&](const PathLeaf& l) { return l.cell.level >= t.max_depth - 1; },
+       [&](const PathLeaf& l, auto&& f, std::vector<LeafRef>& near, std::vector<CoarseFace>& q) {
+         fine_corners_on_coarse_leaves(t, search, l, f, near, q);
+       });
+  pass([&](const PathLeaf& l) { return l.cell.level < t.max_depth; },
+       [&](const PathLeaf& l, auto&& f, std::vector<LeafRef>&, std::vector<CoarseFace>& q) {
+         finer_corners_on_coarse_leaf(t, search, l, f, q);
+       });
   // What the finer side shows on each coarse face (edges, stray regions), each face once. A
   // later round checks the faces queued now (some may be new) and those of earlier rounds
   // that something changed near, in the order a full round would.
@@ -585,16 +615,24 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
       for (const auto& f : faces) look[f.first.node] = 1;
     faces.insert(faces.end(), rounds->faces.begin(), rounds->faces.end());
   }
-  FaceScratch face_scratch;
   std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) {
     return x.first.node != y.first.node ? x.first.node < y.first.node : x.second < y.second;
   });
   faces.erase(std::unique(faces.begin(), faces.end(),
                           [](const auto& x, const auto& y) { return x.first.node == y.first.node && x.second == y.second; }),
               faces.end());
-  for (const auto& [big, f] : faces) {
-    if (t.nodes[big.node].kind != CellKind::Gray || !looks_at(big.node)) continue;
-    for (const auto& [p, inside] : face_flips(t, big, f, face_scratch)) flip(p, inside);
+  const auto gray = [&](const CoarseFace& f) { return t.nodes[f.first.node].kind == CellKind::Gray; };
+  std::vector<uint8_t> hit(faces.size(), 0);
+  tbb::enumerable_thread_specific<FaceScratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, faces.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i)
+      if (gray(faces[i]) && looks_at(faces[i].first.node))
+        hit[i] = !face_flips(t, faces[i].first, faces[i].second, scratch.local()).empty();
+  });
+  FaceScratch face_scratch;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    if (!gray(faces[i]) || !(hit[i] || moved[faces[i].first.node])) continue;
+    for (const auto& [p, inside] : face_flips(t, faces[i].first, faces[i].second, face_scratch)) flip(p, inside);
   }
   if (rounds) {
     rounds->seen.resize(t.nodes.size(), 0);
