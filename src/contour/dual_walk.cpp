@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <type_traits>
 #include <cmath>
 #include <unordered_map>
 
@@ -226,12 +228,34 @@ struct MeshVisitor {
 
 void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
                const std::function<void(const DualPolygon&)>& emit, DualStats* stats) {
-  if (stats) {
-    CallbackVisitor<true> v{t, active, emit, stats};
-    DualWalker<CellRef, CallbackVisitor<true>>(t, v).cell_proc({0, Cell{}});
-  } else {
-    CallbackVisitor<false> v{t, active, emit, nullptr};
-    DualWalker<CellRef, CallbackVisitor<false>>(t, v).cell_proc({0, Cell{}});
+  // A leaf root, or an inactive one, has no dual polygons.
+  if (t.nodes[0].kind != CellKind::Internal || (active && !(*active)(0))) return;
+  // The 9 tasks of dual_polygons, each into its own lists, then emitted in that fixed order:
+  // the same polygons and cracks, in the same order, as one walk.
+  std::array<std::vector<DualPolygon>, 9> polys;
+  std::array<DualStats, 9> parts;
+  tbb::parallel_for(0, 9, [&](int task) {
+    const std::function<void(const DualPolygon&)> keep = [&](const DualPolygon& p) { polys[task].push_back(p); };
+    const auto walk = [&](auto& v) {
+      DualWalker<CellRef, std::remove_reference_t<decltype(v)>> w(t, v);
+      if (task < 8) w.cell_proc({t.nodes[0].index + uint32_t(task), Cell{}.child(task)});
+      else w.root_faces_and_edges({0, Cell{}});
+    };
+    if (stats) {
+      CallbackVisitor<true> v{t, active, keep, &parts[task]};
+      walk(v);
+    } else {
+      CallbackVisitor<false> v{t, active, keep, nullptr};
+      walk(v);
+    }
+  });
+  for (int task = 0; task < 9; ++task) {
+    for (const DualPolygon& p : polys[task]) emit(p);
+    if (!stats) continue;
+    const DualStats& d = parts[task];
+    stats->crack_leaves.insert(stats->crack_leaves.end(), d.crack_leaves.begin(), d.crack_leaves.end());
+    stats->crack_cells.insert(stats->crack_cells.end(), d.crack_cells.begin(), d.crack_cells.end());
+    stats->crack_points.insert(stats->crack_points.end(), d.crack_points.begin(), d.crack_points.end());
   }
 }
 
