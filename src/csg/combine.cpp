@@ -9,8 +9,12 @@ namespace pic::detail {
 namespace {
 
 
-/// Levels whose cells split into parallel tasks when both operands are subdivided there.
-constexpr int kParallelLevels = 4;
+/// How many times a path down the recursion may split into parallel tasks: where both operands
+/// are subdivided and at least two children hold surface of both (a sculpting stroke's few
+/// busy cells lie several levels down, under levels where only one child is busy).
+constexpr int kParallelSplits = 4;
+/// Cells this close to the depth cap are not split: too little work per task.
+constexpr int kMinTaskLevels = 3;
 
 /// What one task of the combine step builds, kept apart from A (which every task reads) until
 /// the tasks are done: new nodes and vertices, and writes into A's existing slots. Indices with
@@ -147,9 +151,9 @@ class FragmentWriter {
 class Combiner {
  public:
   Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
-           int parallel_levels, bool parallel, CombineCounts& stats)
+           int parallel_splits, bool parallel, CombineCounts& stats)
       : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
-        parallel_levels_(parallel_levels), parallel_(parallel), stats_(stats) {}
+        parallel_splits_(parallel_splits), parallel_(parallel), stats_(stats) {}
 
   /// The result's root node (its index may be fragment-local).
   Node run() {
@@ -230,7 +234,9 @@ class Combiner {
     }
     if (b.kind == Side::Gray && b.real) ++stats_.forced_subdivisions;
     std::array<Node, 8> kids;
-    if (cell.level < parallel_levels_ && a.kind == Side::Internal && b.kind == Side::Internal) kids = split_in_tasks(cell, a, b);
+    if (parallel_splits_ > 0 && cell.level + kMinTaskLevels < max_depth_ && a.kind == Side::Internal &&
+        b.kind == Side::Internal && busy_children(a, b) >= 2)
+      kids = split_in_tasks(cell, a, b);
     else {
       // Only a gray side's grid is read.
       const SignGrid ga = pg ? pg->first : a.kind == Side::Gray ? sign_grid(a_, a, cell) : SignGrid{};
@@ -250,13 +256,23 @@ class Combiner {
 
   /// Near the root, each child is a task with its own fragment and caches, merged in child
   /// order: the same bytes whether the tasks run in parallel or not.
+  /// Children of an internal pair where neither operand is uniform: where the work is.
+  int busy_children(const Side& a, const Side& b) const {
+    const auto uniform_node = [](const Node& n) { return n.kind == CellKind::White || n.kind == CellKind::Black; };
+    int busy = 0;
+    for (int c = 0; c < 8; ++c)
+      busy += !uniform_node(a_.t.nodes[a_.t.nodes[a.node].index + c]) &&
+              !uniform_node(b_.t.nodes[b_.t.nodes[b.node].index + c]);
+    return busy;
+  }
+
   std::array<Node, 8> split_in_tasks(const Cell& cell, const Side& a, const Side& b) {
     std::array<Node, 8> kids;
     std::array<Fragment, 8> frags;
     std::array<CombineCounts, 8> sub_stats;
     auto task = [&](int c) {
       Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
-      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_levels_, parallel_, sub_stats[c]);
+      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, sub_stats[c]);
       // Both sides internal here: no sign grid is read.
       kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c, {}), child_side(cb, b, cell, c, {}));
     };
@@ -341,7 +357,7 @@ class Combiner {
   double error_;
   int max_depth_;
   uint32_t stamp_;
-  int parallel_levels_;
+  int parallel_splits_;
   bool parallel_;
   CombineCounts& stats_;
   std::vector<uint32_t> scratch_;
@@ -357,7 +373,7 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   Fragment f;
   Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
   CombineCounts counts;
-  Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelLevels, options.parallel, counts);
+  Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelSplits, options.parallel, counts);
   const Node root = comb.run();
   stats.cells_visited = counts.cells_visited;
   stats.gray_pairs = counts.gray_pairs;

@@ -1,6 +1,6 @@
 // The combine step of a Boolean: the paired recursion over A's and B's stamped cells (paper
 // section 5.2): trivial cases, GraycellCSG where both are gray, forced subdivision by
-// resampling a leaf's partial contour; in parallel tasks near the root.
+// resampling a leaf's partial contour; in parallel tasks where the work fans out.
 #pragma once
 
 #include <vector>
