@@ -123,7 +123,10 @@ struct Operand {
     for (int c = 0; c < 8; ++c) {
       const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
       double d = 1e300;
-      for (uint32_t k : idx) d = std::min(d, point_triangle_distance2(p, tris[k]));
+      for (uint32_t k : idx) {
+        d = std::min(d, point_triangle_distance2(p, tris[k]));
+        if (d <= best_d) break;  // no farther than the best corner so far: cannot replace it
+      }
       if (d > best_d) {
         best_d = d;
         best = c;
