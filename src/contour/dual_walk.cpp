@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <array>
-#include <type_traits>
 #include <cmath>
+#include <type_traits>
 #include <unordered_map>
 
 namespace pic::detail {

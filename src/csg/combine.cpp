@@ -254,8 +254,6 @@ class Combiner {
     return Node{first, CellKind::Internal, 0, 0, 0};
   }
 
-  /// Near the root, each child is a task with its own fragment and caches, merged in child
-  /// order: the same bytes whether the tasks run in parallel or not.
   /// Children of an internal pair where neither operand is uniform: where the work is.
   int busy_children(const Side& a, const Side& b) const {
     const auto uniform_node = [](const Node& n) { return n.kind == CellKind::White || n.kind == CellKind::Black; };
@@ -266,6 +264,8 @@ class Combiner {
     return busy;
   }
 
+  /// Each child is a task with its own fragment and caches, merged in child order: the same
+  /// bytes whether the tasks run in parallel or not.
   std::array<Node, 8> split_in_tasks(const Cell& cell, const Side& a, const Side& b) {
     std::array<Node, 8> kids;
     std::array<Fragment, 8> frags;

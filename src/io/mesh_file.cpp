@@ -8,6 +8,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -115,30 +116,19 @@ Geometry read_geometry(const std::filesystem::path& path) {
 
 namespace {
 
-// Coordinates in the shortest text that reads back to the same double: a mesh checked in
-// memory (self-intersections, pinched vertices) is exactly the mesh in the file; 9 digits
-// moved vertices by up to 1e-8 and could fold a sliver triangle over its neighbour.
-void write_point(std::FILE* f, const char* prefix, const Vec3& p) {
+// One line: `prefix` and three numbers, through to_chars and fwrite (printf cost as much as the
+// contour on a mesh of a few hundred thousand triangles). Coordinates come out in the shortest
+// text that reads back to the same double: a mesh checked in memory (self-intersections,
+// pinched vertices) is exactly the mesh in the file; 9 digits moved vertices by up to 1e-8 and
+// could fold a sliver triangle over its neighbour.
+template <class T>
+void write_line(std::FILE* f, const char* prefix, const std::array<T, 3>& values) {
   char buf[96];
   char* e = buf;
   for (const char* c = prefix; *c; ++c) *e++ = *c;
   for (int k = 0; k < 3; ++k) {
     if (k > 0 || prefix[0]) *e++ = ' ';
-    e = std::to_chars(e, buf + sizeof buf - 1, p[k]).ptr;
-  }
-  *e++ = '\n';
-  std::fwrite(buf, 1, size_t(e - buf), f);
-}
-
-// A face line, "<prefix> a b c": to_chars, not printf (which costs as much as the contour on
-// a mesh of a few hundred thousand triangles).
-void write_face(std::FILE* f, const char* prefix, uint32_t a, uint32_t b, uint32_t c) {
-  char buf[48];
-  char* e = buf;
-  for (const char* x = prefix; *x; ++x) *e++ = *x;
-  for (const uint32_t v : {a, b, c}) {
-    *e++ = ' ';
-    e = std::to_chars(e, buf + sizeof buf - 1, v).ptr;
+    e = std::to_chars(e, buf + sizeof buf - 1, values[k]).ptr;
   }
   *e++ = '\n';
   std::fwrite(buf, 1, size_t(e - buf), f);
@@ -146,14 +136,14 @@ void write_face(std::FILE* f, const char* prefix, uint32_t a, uint32_t b, uint32
 
 void write_obj(const TriMesh& m, std::FILE* f) {
   std::fprintf(f, "# written by pic\n");
-  for (const auto& p : m.positions) write_point(f, "v", p);
-  for (const auto& t : m.triangles) write_face(f, "f", t[0] + 1, t[1] + 1, t[2] + 1);
+  for (const auto& p : m.positions) write_line(f, "v", p);
+  for (const auto& t : m.triangles) write_line(f, "f", std::array{t[0] + 1, t[1] + 1, t[2] + 1});
 }
 
 void write_off(const TriMesh& m, std::FILE* f) {
   std::fprintf(f, "OFF\n%zu %zu 0\n", m.positions.size(), m.triangles.size());
-  for (const auto& p : m.positions) write_point(f, "", p);
-  for (const auto& t : m.triangles) write_face(f, "3", t[0], t[1], t[2]);
+  for (const auto& p : m.positions) write_line(f, "", p);
+  for (const auto& t : m.triangles) write_line(f, "3", t);
 }
 
 void write_stl(const TriMesh& m, std::FILE* f) {

@@ -62,10 +62,6 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
                                   const std::function<void(uint32_t)>* touched = nullptr,
                                   const PinnedPoints* pinned = nullptr, bool spare_coarse = false);
 
-/// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
-/// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
-/// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
-/// to match, in every leaf that has it as a corner. Returns how many points changed.
 /// What remove_islands carries from one round of a settling loop to the next. Every check reads
 /// only the stored signs of the leaves around it, so a later round need look again only near
 /// the leaves a flip touched since the last round began, and at leaves it has not seen: anywhere
@@ -75,6 +71,11 @@ struct IslandRounds {
   std::vector<uint8_t> seen;      ///< per node: a leaf a round has looked at
   std::vector<std::pair<LeafRef, int>> faces;  ///< the coarse faces (leaf, face) checked so far
 };
+
+/// A lattice point inside an edge or face of a bigger gray leaf, whose sign differs from all of
+/// that leaf's corners on that edge or face, is an island finer than the leaf: dual contouring
+/// would hang a second sheet on the leaf's vertex (a non-manifold edge). Its sign is flipped
+/// to match, in every leaf that has it as a corner. Returns how many points changed.
 /// With `rounds` (kept by the caller across rounds, and told of every node a flip touches
 /// between them), a round after the first looks only where something changed; same result.
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
