@@ -6,6 +6,8 @@
 //   BM_Contour/threads:T         dual contouring of the fandisk PIC object on T threads (triangles/s)
 //   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
 //                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
+//   BM_RoundToFloat32/K          rounding a contour to floats for STL/GLB, exactly checked
+//                                (0 = spot, 1 = a box minus a faceted sphere; triangles/s)
 //   BM_WindingQuery/near         inside/outside by the winding number of the open bunny (69k
 //                                triangles) at 4096 random grid points, as the sampler decides
 //                                (integer winding of bunny + caps by a ray, caps' share near
@@ -175,6 +177,29 @@ void BM_CsgCadStep(benchmark::State& state) {
   state.counters["cleanup_ms"] = st.cleanup_seconds * 1e3;
 }
 BENCHMARK(BM_CsgCadStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+// Writing STL or GLB: the contour rounded to floats, with the exact search for triangle pairs
+// the rounding made cross. 0 = spot's contour (curved), 1 = a box minus a 48-segment sphere
+// (OpenSCAD's example004: flat faces and facets, many coplanar neighbours).
+void BM_RoundToFloat32(benchmark::State& state) {
+  static const std::array<pic::TriMesh, 2> meshes = [] {
+    const pic::Octree spot = pic::sample(pic::read_mesh(kData + "/spot.obj"), pic::SampleOptions{});
+    pic::SampleOptions o;
+    o.cube = pic::Cube{{-1.25, -1.25, -1.25}, 2.5};
+    const pic::Octree box = pic::sample(pic::make_box({-0.75, -0.75, -0.75}, {0.75, 0.75, 0.75}), o);
+    const pic::Octree ball = pic::sample(pic::make_sphere({0, 0, 0}, 1, 48), o);
+    return std::array<pic::TriMesh, 2>{pic::contour(spot), pic::contour(pic::csg(box, ball, pic::CsgOp::Subtract))};
+  }();
+  const pic::TriMesh& m = meshes[size_t(state.range(0))];
+  for (auto _ : state) {
+    auto r = pic::round_to_float32(m);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetLabel(state.range(0) == 0 ? "spot" : "box-sphere");
+  state.counters["triangles/s"] =
+      benchmark::Counter(static_cast<double>(m.triangles.size()), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_RoundToFloat32)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

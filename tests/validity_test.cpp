@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "geometry/predicates.h"
 #include "pic/pic.h"
 #include "pic/primitives.h"
 #include "support/csg_cases.h"
@@ -79,6 +80,41 @@ TEST(SelfIntersect, NearlyCoplanarNeedsExactArithmetic) {
   const TriMesh across = tris({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.2, 0.2, e}, {0.3, 0.2, -e}, {0.2, 0.3, e}},
                               {{0, 1, 2}, {3, 4, 5}});
   EXPECT_EQ(count_self_intersections(across), 1u);
+}
+
+TEST(SelfIntersect, CoplanarPairsAgreeWithTheSegmentTests) {
+  // Coplanar pairs on a small integer grid (so many share rays, edges' lines and vertices), in
+  // an axis plane and a tilted one: the 2D shortcut must answer as CGAL's rule does through
+  // the 3D segment tests (the opposite edges for a shared vertex, all six edges otherwise).
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> c(0, 4);
+  size_t meeting = 0, apart = 0;
+  for (int tilted = 0; tilted < 2; ++tilted)
+    for (int n = 0; n < 20000; ++n) {
+      std::vector<Vec3> x(6);
+      for (Vec3& p : x) {
+        const double u = c(rng), v = c(rng);
+        p = {u, v, tilted ? u + 2 * v : 3.0};
+      }
+      const bool share = n % 2 == 0;
+      const std::array<uint32_t, 3> a{0, 1, 2}, b = share ? std::array<uint32_t, 3>{0, 4, 5} : std::array<uint32_t, 3>{3, 4, 5};
+      bool distinct = true;
+      for (size_t i = 0; i < 6; ++i)
+        for (size_t j = i + 1; j < 6; ++j) distinct = distinct && x[i] != x[j];
+      if (!distinct || detail::projection_axis(x[0], x[1], x[2]) < 0 || detail::projection_axis(x[b[0]], x[4], x[5]) < 0)
+        continue;
+      using detail::segment_meets_triangle;
+      const auto meets = [&](uint32_t p, uint32_t q, const std::array<uint32_t, 3>& t) {
+        return segment_meets_triangle(x[p], x[q], x[t[0]], x[t[1]], x[t[2]]);
+      };
+      const bool expected = share ? meets(4, 5, a) || meets(1, 2, b)
+                                  : meets(0, 1, b) || meets(1, 2, b) || meets(2, 0, b) || meets(3, 4, a) ||
+                                        meets(4, 5, a) || meets(5, 3, a);
+      ASSERT_EQ(detail::triangles_intersect(x, a, b), expected) << "tilted " << tilted << " case " << n;
+      ++(expected ? meeting : apart);
+    }
+  EXPECT_GT(meeting, 1000u);
+  EXPECT_GT(apart, 1000u);
 }
 
 TEST(SelfIntersect, ClosedPrimitivesAreClean) {

@@ -49,12 +49,12 @@ class BoxTree {
       }
     }
   }
-  /// Calls f(j) for every box j > i overlapping box i.
+  /// Calls f(i, j), i < j, for every pair of overlapping boxes, in any order and from several
+  /// threads at once. One walk of the tree against itself: a pair of nodes whose boxes are
+  /// apart is dropped whole, where a query per box would walk down from the root each time.
   template <class F>
-  void pairs_of(uint32_t i, F&& f) const {
-    query(boxes_[i], [&](uint32_t j) {
-      if (j > i) f(j);
-    });
+  void for_each_pair(F&& f) const {
+    if (!nodes_.empty()) pairs_within(0, f, 0);
   }
   /// Calls f(j) for every box j overlapping q (closed boxes).
   template <class F>
@@ -83,6 +83,49 @@ class BoxTree {
       b.hi[a] = std::max(b.hi[a], c.hi[a]);
     }
   }
+  /// Pairs inside node a's subtree. Levels near the root run their three parts in parallel.
+  template <class F>
+  void pairs_within(uint32_t a, F& f, int level) const {
+    const N& n = nodes_[a];
+    if (n.count) {
+      for (uint32_t x = n.first; x < n.first + n.count; ++x)
+        for (uint32_t y = x + 1; y < n.first + n.count; ++y)
+          if (overlap(boxes_[order_[x]], boxes_[order_[y]])) report(order_[x], order_[y], f);
+      return;
+    }
+    const auto left = [&] { pairs_within(n.first, f, level + 1); };
+    const auto right = [&] { pairs_within(n.right, f, level + 1); };
+    const auto across = [&] { pairs_across(n.first, n.right, f, level + 1); };
+    if (level < kParallelLevels) tbb::parallel_invoke(left, right, across);
+    else left(), right(), across();
+  }
+  /// Pairs with one box under node a and the other under node b (disjoint subtrees).
+  template <class F>
+  void pairs_across(uint32_t a, uint32_t b, F& f, int level) const {
+    const N &na = nodes_[a], &nb = nodes_[b];
+    if (!overlap(na.box, nb.box)) return;
+    if (na.count && nb.count) {
+      for (uint32_t x = na.first; x < na.first + na.count; ++x)
+        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y)
+          if (overlap(boxes_[order_[x]], boxes_[order_[y]])) report(order_[x], order_[y], f);
+      return;
+    }
+    // Split the node with the larger box (a leaf cannot split).
+    const bool split_a = nb.count || (!na.count && extent(na.box) >= extent(nb.box));
+    const N& s = split_a ? na : nb;
+    const uint32_t other = split_a ? b : a;
+    const auto one = [&] { pairs_across(s.first, other, f, level + 1); };
+    const auto two = [&] { pairs_across(s.right, other, f, level + 1); };
+    if (level < kParallelLevels) tbb::parallel_invoke(one, two);
+    else one(), two();
+  }
+  template <class F>
+  void report(uint32_t x, uint32_t y, F& f) const {
+    if (x < y) f(x, y);
+    else f(y, x);
+  }
+  static double extent(const Box& b) { return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]); }
+  static constexpr int kParallelLevels = 10;
   struct N {
     Box box;
     uint32_t first, count, right;

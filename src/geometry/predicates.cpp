@@ -179,6 +179,44 @@ bool point_in_triangle_2d(const Vec3& p, const Vec3& a, const Vec3& b, const Vec
   return !(has_neg && has_pos);
 }
 
+/// Whether direction d - s lies in the closed cone at s spanned by p1 - s and p2 - s (counter-
+/// clockwise in the projection, less than a half turn).
+bool in_cone(const Vec3& s, const Vec3& p1, const Vec3& p2, const Vec3& d, int drop) {
+  return orient2d(s, p1, d, drop) >= 0 && orient2d(s, p2, d, drop) <= 0;
+}
+
+/// Two coplanar, non-degenerate triangles with `shared` (0 or 1) common vertices, by CGAL's
+/// rule, in the projection along `drop`. A few 2D orientations where the general test would
+/// run its segment tests in 3D first: flat regions of a mesh make many such pairs.
+bool coplanar_triangles_meet(const std::vector<Vec3>& x, const std::array<uint32_t, 3>& ta,
+                             const std::array<uint32_t, 3>& tb, int shared, int ia, int ib, int drop) {
+  if (shared == 1) {
+    // Sharing vertex s, they meet elsewhere iff their cones at s overlap (the shorter of the
+    // two along a common ray ends on an opposite edge, inside the other triangle). Turning
+    // counter-clockwise, their overlap (if any) starts on the first ray of one of them, which
+    // then lies in the other.
+    const Vec3& s = x[ta[size_t(ia)]];
+    const Vec3 *p1 = &x[ta[size_t(ia + 1) % 3]], *p2 = &x[ta[size_t(ia + 2) % 3]];
+    const Vec3 *q1 = &x[tb[size_t(ib + 1) % 3]], *q2 = &x[tb[size_t(ib + 2) % 3]];
+    if (orient2d(s, *p1, *p2, drop) < 0) std::swap(p1, p2);
+    if (orient2d(s, *q1, *q2, drop) < 0) std::swap(q1, q2);
+    return in_cone(s, *p1, *p2, *q1, drop) || in_cone(s, *q1, *q2, *p1, drop);
+  }
+  // Disjoint closed convex polygons have a separating line through an edge of one of them,
+  // with the other strictly outside.
+  const auto outside_an_edge = [&](const std::array<uint32_t, 3>& t, const std::array<uint32_t, 3>& o) {
+    const int turn = orient2d(x[t[0]], x[t[1]], x[t[2]], drop);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &u = x[t[size_t(k)]], &v = x[t[size_t(k + 1) % 3]];
+      if (orient2d(u, v, x[o[0]], drop) * turn < 0 && orient2d(u, v, x[o[1]], drop) * turn < 0 &&
+          orient2d(u, v, x[o[2]], drop) * turn < 0)
+        return true;
+    }
+    return false;
+  };
+  return !outside_an_edge(ta, tb) && !outside_an_edge(tb, ta);
+}
+
 }  // namespace
 
 /// Whether the closed segment pq meets the closed, non-degenerate triangle abc (exact).
@@ -206,7 +244,7 @@ bool triangles_intersect(const std::vector<Vec3>& x, const std::array<uint32_t, 
   // bookkeeping below assumes three distinct indices per triangle).
   for (const auto* t : {&ta, &tb})
     if ((*t)[0] == (*t)[1] || (*t)[1] == (*t)[2] || (*t)[0] == (*t)[2]) return false;
-  int ia[3], ib[3], shared = 0;
+  int ia[3] = {}, ib[3] = {}, shared = 0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (ta[i] == tb[j]) {
@@ -229,18 +267,30 @@ bool triangles_intersect(const std::vector<Vec3>& x, const std::array<uint32_t, 
   // strictly on one side of the other's plane touches that plane at most in the shared vertex,
   // so neither triangle's remaining edges can meet the other. Settles most pairs of a mesh in a
   // few orientation tests.
+  // `coplanar`: set when every vertex of t lies in the plane (then t and the other triangle
+  // are coplanar).
   auto one_side = [&](const std::array<uint32_t, 3>& t, const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                      const std::array<uint32_t, 3>& other) {
+                      const std::array<uint32_t, 3>& other, bool* coplanar) {
     int side = 0;
+    bool flat = true, one = true;
     for (int k = 0; k < 3; ++k) {
       if (other[0] == t[k] || other[1] == t[k] || other[2] == t[k]) continue;
       const int o = orient3d(p0, p1, p2, x[t[k]]);
-      if (o == 0 || (side != 0 && o != side)) return false;
+      flat = flat && o == 0;
+      if (o == 0 || (side != 0 && o != side)) one = false;
+      if (!one && !flat) break;
       side = o;
     }
-    return true;
+    if (coplanar) *coplanar = flat;
+    return one;
   };
-  if (one_side(tb, a0, a1, a2, ta) || one_side(ta, b0, b1, b2, tb)) return false;
+  bool coplanar = false;
+  if (one_side(tb, a0, a1, a2, ta, &coplanar)) return false;
+  if (coplanar) {
+    const int drop = projection_axis(a0, a1, a2);
+    return drop >= 0 && coplanar_triangles_meet(x, ta, tb, shared, ia[0], ib[0], drop);
+  }
+  if (one_side(ta, b0, b1, b2, tb, nullptr)) return false;
   if (shared == 1) {
     const int i = ia[0], j = ib[0];
     return segment_meets_triangle(x[tb[(j + 1) % 3]], x[tb[(j + 2) % 3]], a0, a1, a2) ||

@@ -69,14 +69,9 @@ std::vector<std::pair<uint32_t, uint32_t>> intersecting_pairs_merged(const TriMe
   if (collinear) *collinear = size_t(std::count(skip.begin(), skip.end(), char(1)));
   const BoxTree tree(boxes);
   tbb::enumerable_thread_specific<std::vector<std::pair<uint32_t, uint32_t>>> found;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
-    auto& out = found.local();
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (skip[i]) continue;
-      tree.pairs_of(uint32_t(i), [&](uint32_t j) {
-        if (!skip[j] && detail::triangles_intersect(m.positions, m.triangles[i], m.triangles[j])) out.push_back({uint32_t(i), j});
-      });
-    }
+  tree.for_each_pair([&](uint32_t i, uint32_t j) {
+    if (!skip[i] && !skip[j] && detail::triangles_intersect(m.positions, m.triangles[i], m.triangles[j]))
+      found.local().push_back({i, j});
   });
   std::vector<std::pair<uint32_t, uint32_t>> all;
   for (auto& v : found) all.insert(all.end(), v.begin(), v.end());
