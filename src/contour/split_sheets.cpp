@@ -10,11 +10,14 @@
 #include <unordered_map>
 #include <vector>
 
+#include <tbb/parallel_sort.h>
+
 #include "pic/pic.h"
 #include "geometry/box_tree.h"
 #include "geometry/predicates.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
+#include "measure/topology.h"
 
 namespace pic {
 namespace {
@@ -68,23 +71,50 @@ std::vector<std::pair<uint32_t, uint32_t>> pair_around_edge(const TriMesh& m, ui
   return pairs;
 }
 
-size_t split_sheets(TriMesh& m, bool solids_apart) {
-  const auto nt = static_cast<uint32_t>(m.triangles.size());
-  // Half-edges grouped by undirected edge.
+/// The triangles (ascending) with a vertex flagged in `off_fan`: all a split can change.
+std::vector<uint32_t> triangles_at(const TriMesh& m, const std::vector<uint8_t>& off_fan) {
+  std::vector<uint32_t> region;
+  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+    const auto& tri = m.triangles[t];
+    if (off_fan[tri[0]] || off_fan[tri[1]] || off_fan[tri[2]]) region.push_back(t);
+  }
+  return region;
+}
+
+/// What split_sheets changed, to take it back: corners (3 t + k) and the vertex each had.
+struct SplitUndo {
+  std::vector<std::pair<uint32_t, uint32_t>> corners;
+  size_t vertices = 0;  // the vertex count before
+  void apply(TriMesh& m) const {
+    for (const auto& [c, v] : corners) m.triangles[c / 3][c % 3] = v;
+    m.positions.resize(vertices);
+  }
+};
+
+/// Gives each fan of a flagged vertex (`off_fan`) but its first its own copy of the vertex.
+/// Fans join corners across the edges at the vertex, paired around edges of more than two
+/// triangles by pair_around_edge. Only `region` (triangles_at) is read: a vertex not flagged
+/// has one fan, and a flagged vertex's edges and fans lie in the region.
+size_t split_sheets(TriMesh& m, bool solids_apart, const std::vector<uint8_t>& off_fan,
+                    const std::vector<uint32_t>& region, SplitUndo& undo) {
+  const auto local = [&](uint32_t t) {
+    return uint32_t(std::lower_bound(region.begin(), region.end(), t) - region.begin());
+  };
+  // Half-edges (3 t + k) at a flagged vertex, grouped by undirected edge.
   std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(size_t(nt) * 3);
-  for (uint32_t t = 0; t < nt; ++t)
+  for (uint32_t t : region)
     for (uint32_t k = 0; k < 3; ++k) {
       const uint32_t a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
-      edges.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), 3 * t + k});
+      if (off_fan[a] || off_fan[b]) edges.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), 3 * t + k});
     }
   std::sort(edges.begin(), edges.end());
-  // Corners (3 t + k) of one vertex join when their triangles are paired across an edge there.
-  UnionFind fans(size_t(nt) * 3);
+  // Corners (3 i + k, i in the region) of one vertex join when their triangles are paired
+  // across an edge there.
+  UnionFind fans(region.size() * 3);
   auto corner_of = [&](uint32_t t, uint32_t vertex) {
     for (uint32_t k = 0; k < 3; ++k)
-      if (m.triangles[t][k] == vertex) return 3 * t + k;
-    return 3 * t;
+      if (m.triangles[t][k] == vertex) return 3 * local(t) + k;
+    return 3 * local(t);
   };
   auto join = [&](uint32_t h1, uint32_t h2, uint32_t u, uint32_t v) {
     fans.join(corner_of(h1 / 3, u), corner_of(h2 / 3, u));
@@ -104,31 +134,36 @@ size_t split_sheets(TriMesh& m, bool solids_apart) {
     i = j;
   }
   // One vertex per fan: the first fan (in corner order) keeps the index, the others get copies.
-  std::vector<uint32_t> first_root(m.positions.size(), UINT32_MAX);
+  std::unordered_map<uint32_t, uint32_t> first_root;   // vertex -> its first fan's root
   std::unordered_map<uint32_t, uint32_t> copy_of_fan;  // fan root -> its new vertex
+  undo = {{}, m.positions.size()};
   size_t added = 0;
-  for (uint32_t c = 0; c < 3 * nt; ++c) {
-    const uint32_t v = m.triangles[c / 3][c % 3];
-    const auto r = static_cast<uint32_t>(fans.root(c));
-    if (first_root[v] == UINT32_MAX) first_root[v] = r;
-    if (first_root[v] == r) continue;
-    auto [it, fresh] = copy_of_fan.try_emplace(r, static_cast<uint32_t>(m.positions.size()));
-    if (fresh) {
-      const Vec3 p = m.positions[v];
-      m.positions.push_back(p);
-      ++added;
+  for (uint32_t i = 0; i < region.size(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t t = region[i], v = m.triangles[t][k];
+      if (!off_fan[v]) continue;
+      const auto r = static_cast<uint32_t>(fans.root(3 * i + k));
+      const auto [first, fresh_vertex] = first_root.try_emplace(v, r);
+      if (first->second == r) continue;
+      auto [it, fresh] = copy_of_fan.try_emplace(r, static_cast<uint32_t>(m.positions.size()));
+      if (fresh) {
+        const Vec3 p = m.positions[v];
+        m.positions.push_back(p);
+        ++added;
+      }
+      undo.corners.push_back({3 * t + k, v});
+      m.triangles[t][k] = it->second;
     }
-    m.triangles[c / 3][c % 3] = it->second;
-  }
   return added;
 }
 
-/// Drops pairs of triangles on the same three vertices with opposite orientations: a pocket of
-/// no volume, which puts four triangles on each of its edges.
-void drop_flat_pockets(TriMesh& m) {
+/// Pairs of triangles on the same three vertices with opposite orientations (ascending): a
+/// pocket of no volume, which puts four triangles on each of its edges. Only `region`
+/// (triangles_at) is searched: a pocket's edges are not manifold.
+std::vector<uint32_t> flat_pockets(const TriMesh& m, const std::vector<uint32_t>& region) {
   std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> keyed;  // rotation starting at the smallest index
-  keyed.reserve(m.triangles.size());
-  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+  keyed.reserve(region.size());
+  for (uint32_t t : region) {
     auto tri = m.triangles[t];
     while (tri[0] > tri[1] || tri[0] > tri[2]) tri = {tri[1], tri[2], tri[0]};
     keyed.push_back({tri, t});
@@ -141,18 +176,31 @@ void drop_flat_pockets(TriMesh& m) {
     const auto kb = std::array<uint32_t, 3>{b.first[0], std::min(b.first[1], b.first[2]), std::max(b.first[1], b.first[2])};
     return ka != kb ? ka < kb : a.second < b.second;
   });
-  std::vector<char> drop(m.triangles.size(), 0);
+  std::vector<char> drop(keyed.size(), 0);  // by position in keyed
+  std::vector<uint32_t> dropped;
   for (size_t i = 0; i + 1 < keyed.size(); ++i) {
     const auto& a = keyed[i].first;
     const auto& b = keyed[i + 1].first;
-    if (same_set(a, b) && a[1] == b[2] && !drop[keyed[i].second] && !drop[keyed[i + 1].second]) {
-      drop[keyed[i].second] = drop[keyed[i + 1].second] = 1;
+    if (same_set(a, b) && a[1] == b[2] && !drop[i] && !drop[i + 1]) {
+      drop[i] = drop[i + 1] = 1;
+      dropped.insert(dropped.end(), {keyed[i].second, keyed[i + 1].second});
       ++i;
     }
   }
-  size_t k = 0;
-  for (size_t t = 0; t < m.triangles.size(); ++t)
-    if (!drop[t]) m.triangles[k++] = m.triangles[t];
+  std::sort(dropped.begin(), dropped.end());
+  return dropped;
+}
+
+/// Removes the triangles `gone` (ascending), keeping the others in order.
+void erase_triangles(TriMesh& m, const std::vector<uint32_t>& gone) {
+  size_t k = 0, d = 0;
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    if (d < gone.size() && gone[d] == t) {
+      ++d;
+      continue;
+    }
+    m.triangles[k++] = m.triangles[t];
+  }
   m.triangles.resize(k);
 }
 
@@ -165,7 +213,7 @@ void separate_copies(TriMesh& m) {
   const auto nv = static_cast<uint32_t>(m.positions.size());
   std::vector<uint32_t> order(nv);
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+  tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     return m.positions[a] < m.positions[b] || (m.positions[a] == m.positions[b] && a < b);
   });
   std::vector<uint32_t> moving;  // vertices sharing their position with another
@@ -196,35 +244,52 @@ void separate_copies(TriMesh& m) {
     }
     if (hit) touched.push_back(t);
   }
-  const std::vector<Vec3> home = m.positions;
-  std::vector<Vec3> dir(moving.size());
-  for (size_t k = 0; k < moving.size(); ++k)
-    for (int a = 0; a < 3; ++a) dir[k][a] = count[k] > 0 ? ring[k][a] / count[k] - home[moving[k]][a] : 0.0;
+  std::vector<Vec3> home(moving.size()), dir(moving.size());
+  for (size_t k = 0; k < moving.size(); ++k) {
+    home[k] = m.positions[moving[k]];
+    for (int a = 0; a < 3; ++a) dir[k][a] = count[k] > 0 ? ring[k][a] / count[k] - home[k][a] : 0.0;
+  }
   constexpr std::array<double, 4> kSteps{1.0 / 1024, 1.0 / 256, 1.0 / 64, 1.0 / 16};
   // Triangle boxes cover every step (a copy moves along a segment from its home).
-  std::vector<detail::Box> boxes(m.triangles.size());
-  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+  const auto box_of = [&](uint32_t t) {
     detail::Box b{m.positions[m.triangles[t][0]], m.positions[m.triangles[t][0]]};
     for (uint32_t v : m.triangles[t]) {
-      Vec3 far = home[v];
+      Vec3 far = m.positions[v];
       if (slot[v] >= 0)
         for (int a = 0; a < 3; ++a) far[a] += kSteps.back() * dir[size_t(slot[v])][a];
-      for (const Vec3& q : {home[v], far})
+      for (const Vec3& q : {m.positions[v], far})
         for (int a = 0; a < 3; ++a) {
           b.lo[a] = std::min(b.lo[a], q[a]);
           b.hi[a] = std::max(b.hi[a], q[a]);
         }
     }
-    boxes[t] = b;
+    return b;
+  };
+  // Only triangles whose boxes meet those around the moving vertices can be crossed.
+  std::vector<detail::Box> reach(touched.size());
+  for (size_t i = 0; i < touched.size(); ++i) reach[i] = box_of(touched[i]);
+  const detail::BoxTree reach_tree(reach);
+  std::vector<uint32_t> near;  // ascending
+  std::vector<detail::Box> boxes;
+  for (uint32_t t = 0; t < m.triangles.size(); ++t) {
+    const detail::Box b = box_of(t);
+    bool hit = false;
+    reach_tree.query(b, [&](uint32_t) { hit = true; });
+    if (!hit) continue;
+    near.push_back(t);
+    boxes.push_back(b);
   }
   const detail::BoxTree tree(boxes);
+  const auto box_at = [&](uint32_t t) -> const detail::Box& {
+    return boxes[size_t(std::lower_bound(near.begin(), near.end(), t) - near.begin())];
+  };
   // Vertices (by slot) still to place; a step is applied to all of them at once, then every
   // vertex with a triangle in a crossing goes on to the next step.
   std::vector<uint8_t> open(moving.size(), 1);
   for (double step : kSteps) {
     for (size_t k = 0; k < moving.size(); ++k)
       if (open[k])
-        for (int a = 0; a < 3; ++a) m.positions[moving[k]][a] = home[moving[k]][a] + step * dir[k][a];
+        for (int a = 0; a < 3; ++a) m.positions[moving[k]][a] = home[k][a] + step * dir[k][a];
     std::vector<uint8_t> crossed(moving.size(), 0);
     for (uint32_t t : touched) {
       const auto& ta = m.triangles[t];
@@ -233,7 +298,8 @@ void separate_copies(TriMesh& m) {
           if (slot[v] >= 0) crossed[size_t(slot[v])] = 1;
         continue;
       }
-      tree.query(boxes[t], [&](uint32_t u) {
+      tree.query(box_at(t), [&](uint32_t k) {
+        const uint32_t u = near[k];
         if (u == t) return;
         const auto& tb = m.triangles[u];
         if (!detail::triangles_intersect(m.positions, ta, tb)) return;
@@ -250,26 +316,34 @@ void separate_copies(TriMesh& m) {
     if (!any) return;
   }
   for (size_t k = 0; k < moving.size(); ++k)
-    if (open[k]) m.positions[moving[k]] = home[moving[k]];
+    if (open[k]) m.positions[moving[k]] = home[k];
 }
 
 }  // namespace
 
 size_t split_nonmanifold(TriMesh& m) {
-  if (analyze_topology(m).manifold()) return 0;
-  TriMesh base = m;
-  drop_flat_pockets(base);
+  std::vector<uint8_t> off_fan;
+  if (detail::analyze_topology(m, &off_fan).manifold()) return 0;
+  // Everything below reads and writes only the triangles at the flagged vertices.
+  std::vector<uint32_t> region = triangles_at(m, off_fan);
+  std::vector<std::array<uint32_t, 3>> before;  // kept only when pockets go
+  if (const std::vector<uint32_t> pockets = flat_pockets(m, region); !pockets.empty()) {
+    before = m.triangles;
+    erase_triangles(m, pockets);
+    region = triangles_at(m, off_fan);
+  }
   // The two pairings around a crowded edge are both manifold there; which one also gives
   // consistent fans at its end vertices depends on the neighbourhood, so try both.
   for (const bool solids_apart : {true, false}) {
-    TriMesh c = base;
-    const size_t added = split_sheets(c, solids_apart);
-    if (analyze_topology(c).manifold()) {
-      separate_copies(c);
-      m = std::move(c);
+    SplitUndo undo;
+    const size_t added = split_sheets(m, solids_apart, off_fan, region, undo);
+    if (analyze_topology(m).manifold()) {
+      separate_copies(m);
       return added;
     }
+    undo.apply(m);
   }
+  if (!before.empty()) m.triangles = std::move(before);
   return 0;
 }
 

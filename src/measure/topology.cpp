@@ -5,12 +5,15 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
+#include "measure/topology.h"
 #include "octree/cell.h"
 
 namespace pic {
+namespace detail {
 
-MeshTopology analyze_topology(const TriMesh& mesh) {
+MeshTopology analyze_topology(const TriMesh& mesh, std::vector<uint8_t>* off_fan) {
   MeshTopology r;
+  if (off_fan) off_fan->assign(mesh.positions.size(), 0);
   r.vertices = mesh.positions.size();
   r.triangles = mesh.triangles.size();
   const auto degenerate = [](const std::array<uint32_t, 3>& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; };
@@ -20,6 +23,8 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
   for (const auto& t : mesh.triangles) {
     if (degenerate(t)) {
       ++r.degenerate_triangles;
+      if (off_fan)
+        for (uint32_t v : t) (*off_fan)[v] = 1;
       continue;
     }
     for (uint32_t v : t) ++first[v + 1];
@@ -90,11 +95,14 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
       if (n == 0) continue;
       if (n <= kFastFan) {
         const int cycles = closed_fan_cycles(v, n);
-        if (cycles > 0) {
-          c.pinched += cycles > 1;
+        if (cycles == 1) continue;
+        if (off_fan) (*off_fan)[v] = 1;
+        if (cycles > 1) {
+          ++c.pinched;
           continue;
         }
       }
+      if (off_fan) (*off_fan)[v] = 1;
       spokes.clear();
       for (uint32_t i = 0; i < n; ++i) {
         const uint32_t h = corner[first[v] + i], f = h / 3, k = h % 3;
@@ -140,6 +148,10 @@ MeshTopology analyze_topology(const TriMesh& mesh) {
   });
   return r;
 }
+
+}  // namespace detail
+
+MeshTopology analyze_topology(const TriMesh& mesh) { return detail::analyze_topology(mesh, nullptr); }
 
 double volume(const TriMesh& mesh) {
   double v = 0;
