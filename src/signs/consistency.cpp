@@ -8,6 +8,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -745,18 +746,26 @@ double thickness(const std::vector<Vec3>& pts) {
 /// (both signs when tied), with that sign: where a speck's points must be.
 std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::function<bool(uint32_t)>* active,
                                                    int min_level) {
-  std::vector<std::pair<Lat, bool>> out;
+  // Sorted as (point, sign) pairs are, through one 64-bit key: 21 bits a coordinate (x
+  // highest), the sign lowest.
+  std::vector<uint64_t> keys;
   for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
     const uint8_t s = t.nodes[node].signs;
     if (cell.level < min_level || s == 0 || s == 0xff) return;
     const int in = std::popcount(s);
     for (int c = 0; c < 8; ++c) {
       const bool sign = (s >> c) & 1;
-      if (sign == (in <= 4) || in == 4) out.push_back({cell.corner(c), sign});
+      if (sign != (in <= 4) && in != 4) continue;
+      const Lat p = cell.corner(c);
+      keys.push_back(uint64_t(p[0]) << 43 | uint64_t(p[1]) << 22 | uint64_t(p[2]) << 1 | uint64_t(sign));
     }
   });
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  tbb::parallel_sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<std::pair<Lat, bool>> out(keys.size());
+  constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+  for (size_t i = 0; i < keys.size(); ++i)
+    out[i] = {Lat{int64_t(keys[i] >> 43), int64_t(keys[i] >> 22 & kMask), int64_t(keys[i] >> 1 & kMask)}, (keys[i] & 1) != 0};
   return out;
 }
 
