@@ -11,6 +11,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <memory>
 #include <array>
 #include <bit>
 #include <optional>
@@ -178,37 +179,34 @@ bool is_island(const Node& big, const Cell& cell, const Lat& p, bool sp) {
 
 namespace {
 
-/// A leaf with the nodes from the root down to it (path[l] = its ancestor at level l), so
-/// that searches around it can start from a near ancestor instead of the root.
+/// A leaf the island pass checks. Searches around it start from a near ancestor (found
+/// through IslandSearch::parent) instead of the root.
 struct PathLeaf {
   uint32_t node;
   Cell cell;
-  size_t path;  // offset of the ancestors in IslandSearch::paths
 };
 
 struct IslandSearch {
   const Octree& t;
   std::vector<PathLeaf> leaves;
-  std::vector<uint32_t> paths;
+  // Per node collect visited: its parent. Left uninitialised elsewhere (never read there), so
+  // a pass over a small part of a big tree touches few of its pages.
+  std::unique_ptr<uint32_t[]> parent;
 
-  /// The ancestor of `l` at `level`, with its cell.
-  LeafRef ancestor(const PathLeaf& l, int level) const {
-    Cell c{level, l.cell.lat};
-    const int64_t span = c.span();
-    for (auto& x : c.lat) x -= x % span;
-    return {paths[l.path + size_t(level)], c};
-  }
+  explicit IslandSearch(const Octree& tree) : t(tree), parent(new uint32_t[tree.nodes.size()]) {}
+
   /// The deepest ancestor of `l` whose cell holds the closed box [lo, hi] away from its
   /// boundary (`strict`) or anywhere inside it: every leaf meeting the box is below it.
   LeafRef start_for(const PathLeaf& l, const Lat& lo, const Lat& hi, bool strict) const {
-    for (int level = l.cell.level; level > 0; --level) {
-      const LeafRef a = ancestor(l, level);
-      const int64_t s = a.cell.span();
+    uint32_t node = l.node;
+    for (int level = l.cell.level; level > 0; --level, node = parent[node]) {
+      Cell c{level, l.cell.lat};
+      const int64_t s = c.span();
+      for (auto& x : c.lat) x -= x % s;
       bool inside = true;
       for (int k = 0; k < 3 && inside; ++k)
-        inside = strict ? (a.cell.lat[k] < lo[k] && hi[k] < a.cell.lat[k] + s)
-                        : (a.cell.lat[k] <= lo[k] && hi[k] <= a.cell.lat[k] + s);
-      if (inside) return a;
+        inside = strict ? (c.lat[k] < lo[k] && hi[k] < c.lat[k] + s) : (c.lat[k] <= lo[k] && hi[k] <= c.lat[k] + s);
+      if (inside) return {node, c};
     }
     return {0, Cell{}};
   }
@@ -224,20 +222,19 @@ struct IslandSearch {
     return from;
   }
 
-  void collect(uint32_t node, const Cell& cell, const std::function<bool(uint32_t)>* active,
-               std::vector<uint32_t>& path) {
+  void collect(uint32_t node, const Cell& cell, const std::function<bool(uint32_t)>* active) {
     if (active && !(*active)(node)) return;
     const Node& n = t.nodes[node];
-    path.push_back(node);
     if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) collect(n.index + c, cell.child(c), active, path);
+      for (int c = 0; c < 8; ++c) {
+        parent[n.index + c] = node;
+        collect(n.index + c, cell.child(c), active);
+      }
     } else if (n.kind == CellKind::Gray && cell.level >= t.max_depth - 5) {
       // Islands are features near the finest cell size, next to leaves up to 5 levels up (the
       // teapot had one on a leaf 5 levels up; coarser faces cost more than they find).
-      leaves.push_back({node, cell, paths.size()});
-      paths.insert(paths.end(), path.begin(), path.end());
+      leaves.push_back({node, cell});
     }
-    path.pop_back();
   }
 };
 
@@ -550,11 +547,8 @@ void mark_near_touched(const Octree& t, const std::vector<uint32_t>& touched, st
 
 size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
                       const std::function<void(uint32_t)>* touched, PinnedPoints* pinned, IslandRounds* rounds) {
-  IslandSearch search{t, {}, {}};
-  {
-    std::vector<uint32_t> path;
-    search.collect(0, Cell{}, active, path);
-  }
+  IslandSearch search(t);
+  search.collect(0, Cell{}, active);
   // Where this round looks (empty: everywhere), and where its own flips have changed a stored
   // sign since it began (`moved`: the nodes whose closed cells meet a flipped point's leaves).
   std::vector<uint8_t> look;
