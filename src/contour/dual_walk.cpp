@@ -172,13 +172,14 @@ class DualWalker {
   V& v_;
 };
 
-/// dual_walk's visitor: the optional `active` filter, polygons with positions, cracks.
+/// dual_walk's visitor: the optional `active` filter; polygons with positions, or (Cracks)
+/// cracks only.
 template <bool Cracks>
 struct CallbackVisitor {
   static constexpr bool kCracks = Cracks;
   const Octree& t;
   const std::function<bool(uint32_t)>* filter;
-  const std::function<void(const DualPolygon&)>& emit;
+  std::vector<DualPolygon>* polys;
   DualStats* stats;
 
   bool active(uint32_t node) const { return !filter || (*filter)(node); }
@@ -189,13 +190,14 @@ struct CallbackVisitor {
     stats->crack_points.push_back({a[0] + b[0], a[1] + b[1], a[2] + b[2]});
   }
   void polygon(const std::array<CellRef, 4>& refs, int count, const CellRef&, int, int) {
+    if constexpr (Cracks) return;
     DualPolygon poly{};
     poly.count = count;
     for (int k = 0; k < count; ++k) {
       poly.leaf[k] = refs[k].node;
       poly.pos[k] = vertex_unit(refs[k].cell, t.vertices[t.nodes[refs[k].node].index]);
     }
-    emit(poly);
+    polys->push_back(poly);
   }
 };
 
@@ -224,54 +226,51 @@ struct MeshVisitor {
   }
 };
 
+/// A walk of an internal root in 9 parallel tasks (the 8 root children, then the faces and
+/// edges between them), each with its own visitor from make(task): each task's findings,
+/// concatenated in task order, are what one serial walk finds, in its order.
+template <class MakeVisitor>
+void in_nine_tasks(const Octree& t, MakeVisitor&& make) {
+  tbb::parallel_for(0, 9, [&](int task) {
+    auto v = make(task);
+    DualWalker<CellRef, decltype(v)> w(t, v);
+    if (task < 8) w.cell_proc({t.nodes[0].index + uint32_t(task), Cell{}.child(task)});
+    else w.root_faces_and_edges({0, Cell{}});
+  });
+}
+
 }  // namespace
 
 void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
-               const std::function<void(const DualPolygon&)>& emit, DualStats* stats) {
+               const std::function<void(const DualPolygon&)>& emit) {
   // A leaf root, or an inactive one, has no dual polygons.
   if (t.nodes[0].kind != CellKind::Internal || (active && !(*active)(0))) return;
-  // The 9 tasks of dual_polygons, each into its own lists, then emitted in that fixed order:
-  // the same polygons and cracks, in the same order, as one walk.
+  // Each task into its own list, then emitted in the tasks' order: the same polygons in the
+  // same order as one walk.
   std::array<std::vector<DualPolygon>, 9> polys;
+  in_nine_tasks(t, [&](int task) { return CallbackVisitor<false>{t, active, &polys[size_t(task)], nullptr}; });
+  for (const auto& list : polys)
+    for (const DualPolygon& p : list) emit(p);
+}
+
+DualStats crack_edges(const Octree& t, const std::function<bool(uint32_t)>* active) {
+  DualStats all;
+  if (t.nodes[0].kind != CellKind::Internal || (active && !(*active)(0))) return all;
   std::array<DualStats, 9> parts;
-  tbb::parallel_for(0, 9, [&](int task) {
-    const std::function<void(const DualPolygon&)> keep = [&](const DualPolygon& p) { polys[task].push_back(p); };
-    const auto walk = [&](auto& v) {
-      DualWalker<CellRef, std::remove_reference_t<decltype(v)>> w(t, v);
-      if (task < 8) w.cell_proc({t.nodes[0].index + uint32_t(task), Cell{}.child(task)});
-      else w.root_faces_and_edges({0, Cell{}});
-    };
-    if (stats) {
-      CallbackVisitor<true> v{t, active, keep, &parts[task]};
-      walk(v);
-    } else {
-      CallbackVisitor<false> v{t, active, keep, nullptr};
-      walk(v);
-    }
-  });
-  for (int task = 0; task < 9; ++task) {
-    for (const DualPolygon& p : polys[task]) emit(p);
-    if (!stats) continue;
-    const DualStats& d = parts[task];
-    stats->crack_leaves.insert(stats->crack_leaves.end(), d.crack_leaves.begin(), d.crack_leaves.end());
-    stats->crack_cells.insert(stats->crack_cells.end(), d.crack_cells.begin(), d.crack_cells.end());
-    stats->crack_points.insert(stats->crack_points.end(), d.crack_points.begin(), d.crack_points.end());
+  in_nine_tasks(t, [&](int task) { return CallbackVisitor<true>{t, active, nullptr, &parts[size_t(task)]}; });
+  for (const DualStats& d : parts) {
+    all.crack_leaves.insert(all.crack_leaves.end(), d.crack_leaves.begin(), d.crack_leaves.end());
+    all.crack_cells.insert(all.crack_cells.end(), d.crack_cells.begin(), d.crack_cells.end());
+    all.crack_points.insert(all.crack_points.end(), d.crack_points.begin(), d.crack_points.end());
   }
+  return all;
 }
 
 std::vector<MeshPolygon> dual_polygons(const Octree& tree) {
-  const bool split = tree.nodes[0].kind == CellKind::Internal;
-  // Polygons found by 9 tasks — the 8 root children and the faces and edges between them —
-  // each into its own list; concatenated in that fixed order they are exactly what a serial
-  // walk finds.
+  // A leaf root has no dual polygons.
+  if (tree.nodes[0].kind != CellKind::Internal) return {};
   std::array<std::vector<MeshPolygon>, 9> parts;
-  tbb::parallel_for(0, split ? 9 : 1, [&](int task) {
-    MeshVisitor v{tree.nodes.data(), tree.cube, parts[task]};
-    DualWalker<CellRef, MeshVisitor> w(tree, v);
-    if (!split) w.cell_proc({0, Cell{}});
-    else if (task < 8) w.cell_proc({tree.nodes[0].index + uint32_t(task), Cell{}.child(task)});
-    else w.root_faces_and_edges({0, Cell{}});
-  });
+  in_nine_tasks(tree, [&](int task) { return MeshVisitor{tree.nodes.data(), tree.cube, parts[size_t(task)]}; });
   std::vector<MeshPolygon> polys;
   size_t total = 0;
   for (const auto& part : parts) total += part.size();

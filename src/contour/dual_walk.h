@@ -30,7 +30,10 @@ struct DualStats {
 /// Walks the dual of the whole tree, or — with `active` — only the parts that touch active
 /// nodes (partial contour, paper 5.2.1: `active` = stamped by the current operation).
 void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
-               const std::function<void(const DualPolygon&)>& emit, DualStats* stats = nullptr);
+               const std::function<void(const DualPolygon&)>& emit);
+
+/// The same walk, finding cracks instead of polygons, in the order it meets them.
+DualStats crack_edges(const Octree& t, const std::function<bool(uint32_t)>* active);
 
 /// A dual polygon of the whole contour: tree vertex indices (counter-clockwise from outside)
 /// and the minimal edge it is dual to, in output coordinates.

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include "geometry/bvh.h"
+#include "geometry/key_bits.h"
 #include "contour/dual_walk.h"
 #include "csg/cleanup.h"
 #include "sample/sampler.h"
@@ -43,50 +44,6 @@ inline uint8_t apply_mask(CsgOp op, uint8_t a, uint8_t b) {
   return 0;
 }
 
-/// Lattice point -> sign, open addressing with linear probing: the sign lookups are the CSG's
-/// hottest map. A key uses 63 bits (3 x 21); the sign rides in bit 63.
-class SignMemo {
- public:
-  /// The stored sign of `key`, or -1.
-  int find(uint64_t key) const {
-    if (slots_.empty()) return -1;
-    for (size_t i = home(key);; i = (i + 1) & mask_) {
-      const uint64_t v = slots_[i];
-      if (v == kEmpty) return -1;
-      if ((v & kKeyBits) == key) return int(v >> 63);
-    }
-  }
-  void insert(uint64_t key, bool sign) {
-    if (2 * (count_ + 1) > slots_.size()) grow();
-    for (size_t i = home(key);; i = (i + 1) & mask_) {
-      if (slots_[i] == kEmpty) {
-        slots_[i] = key | uint64_t(sign) << 63;
-        ++count_;
-        return;
-      }
-      if ((slots_[i] & kKeyBits) == key) return;
-    }
-  }
-
- private:
-  static constexpr uint64_t kEmpty = ~uint64_t{0};
-  static constexpr uint64_t kKeyBits = ~uint64_t{0} >> 1;
-  size_t home(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
-  void grow() {
-    std::vector<uint64_t> old = std::move(slots_);
-    const size_t n = old.empty() ? 1024 : 2 * old.size();
-    slots_.assign(n, kEmpty);
-    mask_ = n - 1;
-    shift_ = 64 - std::countr_zero(n);
-    count_ = 0;
-    for (uint64_t v : old)
-      if (v != kEmpty) insert(v & kKeyBits, v >> 63);
-  }
-  std::vector<uint64_t> slots_;
-  size_t mask_ = 0, count_ = 0;
-  int shift_ = 64;
-};
-
 /// An operand's partial contour (grid units), indexed for box queries. Read-only once built,
 /// shared by all the tasks of an operation.
 struct PartialContour {
@@ -102,7 +59,7 @@ struct Operand {
   const std::vector<ITri>& tris;
   const TriangleBvh& bvh;
   std::unordered_map<uint32_t, std::vector<uint32_t>> leaf_tris;  // gray leaf -> triangles in it
-  SignMemo memo;                                                  // signs of non-corner points
+  KeyBits memo;                                                   // signs of non-corner points
   std::unordered_map<uint32_t, int> anchors;                      // gray leaf -> anchor corner
 
   const Stamps& stamps;  // per node of t: the operation's stamp where it stamped it

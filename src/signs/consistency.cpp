@@ -2,6 +2,7 @@
 
 #include "contour/dual_walk.h"
 #include "octree/cell_vertex.h"
+#include "geometry/key_bits.h"
 #include "geometry/union_find.h"
 
 #include <Eigen/Dense>
@@ -11,9 +12,9 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
-#include <memory>
 #include <array>
 #include <bit>
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -767,16 +768,26 @@ std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::f
 /// every leaf around its points gray with the point as a corner (or, with `uniform_rim`,
 /// uniform of the other sign), one of them at least touched by this operation (active), and
 /// at most kMaxSpeckPoints points. `seen` gets the points visited either way.
-std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p,
-                                bool inside, bool uniform_rim, bool coarse_rim, std::unordered_set<uint64_t>& seen) {
+/// grow_speck's buffers, kept from one call to the next (most calls stop after a few leaves).
+struct SpeckScratch {
+  Speck sp;
+  std::vector<Vec3> vertices;  // of the speck's leaves, its surface (with coarse_rim)
+};
+
+bool grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p, bool inside,
+                bool uniform_rim, bool coarse_rim, KeyBits& seen, SpeckScratch& scratch) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
   constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  Speck sp;
+  Speck& sp = scratch.sp;
   sp.inside = inside;
-  std::vector<Lat> queue{p};
-  seen.insert(lattice_key(p));
+  sp.rim.clear();
+  sp.leaves.clear();
+  std::vector<Lat>& queue = sp.points;
+  queue.assign(1, p);
+  seen.insert(lattice_key(p), false);
   bool ok = true, touched = false, coarse = false;
-  std::vector<Vec3> vertices;  // of the speck's leaves, its surface (with coarse_rim)
+  std::vector<Vec3>& vertices = scratch.vertices;
+  vertices.clear();
   for (size_t i = 0; i < queue.size() && ok; ++i) {
     const Lat q = queue[i];
     for (int o = 0; o < 8 && ok; ++o) {
@@ -810,33 +821,34 @@ std::optional<Speck> grow_speck(const Octree& t, const std::function<bool(uint32
           sp.rim.push_back(r);
         } else if (std::find(queue.begin(), queue.end(), r) == queue.end()) {
           // A point seen before belongs to a region that was not a speck: so is this one.
-          ok = seen.insert(lattice_key(r)).second && queue.size() < kMaxSpeckPoints;
+          ok = seen.insert(lattice_key(r), false) && queue.size() < kMaxSpeckPoints;
           queue.push_back(r);
         }
       }
     }
   }
-  if (!ok || !touched) return std::nullopt;
+  if (!ok || !touched) return false;
   // Beside a coarser leaf the region may be a small real piece (harness seed 43: 4 cells
   // across, a component of the exact result too); only a flat one is the Boolean's noise.
-  if (coarse && thickness(vertices) * double(int64_t{1} << t.max_depth) >= kMaxSpeckThickness) return std::nullopt;
-  sp.points = std::move(queue);
+  if (coarse && thickness(vertices) * double(int64_t{1} << t.max_depth) >= kMaxSpeckThickness) return false;
   std::sort(sp.leaves.begin(), sp.leaves.end());
   sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());
-  return sp;
+  return true;
 }
 
 }  // namespace
 
 size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
                      const std::function<bool(const Speck&)>& keep, const SpeckSearch& search) {
-  std::unordered_set<uint64_t> seen;
+  KeyBits seen;
+  SpeckScratch scratch;
   size_t removed = 0;
   for (const auto& [p, inside] : speck_candidates(t, active, search.min_level < 0 ? t.max_depth : search.min_level)) {
-    if (seen.count(lattice_key(p))) continue;
-    const std::optional<Speck> sp = grow_speck(t, active, p, inside, search.uniform_rim, search.coarse_rim, seen);
-    if (!sp || keep(*sp)) continue;
-    for (uint32_t node : sp->leaves) t.nodes[node] = Node{0, sp->inside ? CellKind::White : CellKind::Black, 0, 0, 0};
+    if (seen.find(lattice_key(p)) >= 0) continue;
+    if (!grow_speck(t, active, p, inside, search.uniform_rim, search.coarse_rim, seen, scratch)) continue;
+    const Speck& sp = scratch.sp;
+    if (keep(sp)) continue;
+    for (uint32_t node : sp.leaves) t.nodes[node] = Node{0, sp.inside ? CellKind::White : CellKind::Black, 0, 0, 0};
     ++removed;
   }
   return removed;
@@ -847,9 +859,7 @@ size_t remove_specks(Octree& t, const std::function<bool(uint32_t)>* active,
 size_t repair_cracks(Octree& t, const std::function<bool(uint32_t)>* active) {
   size_t fixed = 0;
   for (int pass = 0; pass < 4; ++pass) {
-    DualStats ds;
-    std::function<void(const DualPolygon&)> emit = [](const DualPolygon&) {};
-    dual_walk(t, active, emit, &ds);
+    const DualStats ds = crack_edges(t, active);
     if (ds.crack_leaves.empty()) break;
     std::unordered_map<uint32_t, std::pair<Lat, int>> mid_sum;  // leaf -> (sum of 2x midpoints, count)
     std::unordered_map<uint32_t, Cell> cells;
