@@ -346,6 +346,37 @@ TEST(SplitNonmanifold, BoxesTouchingAtAVertexBecomeTwoSheets) {
   EXPECT_EQ(check_validity(m).nonmanifold_vertices, 0u);
 }
 
+TEST(SplitNonmanifold, FlatPocketIsDropped) {
+  // A face triangle of a box doubled both ways: a pocket of no volume, four triangles on
+  // each of its edges. The pocket goes; nothing needs a copy.
+  TriMesh m = make_box({0, 0, 0}, {1, 1, 1});
+  const TriMesh box = m;
+  const auto t = m.triangles[0];
+  m.triangles.push_back(t);
+  m.triangles.push_back({t[0], t[2], t[1]});
+  ASSERT_GT(analyze_topology(m).nonmanifold_edges, 0u);
+  EXPECT_EQ(split_nonmanifold(m), 0u);
+  EXPECT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(m.triangles.size(), box.triangles.size());
+  EXPECT_NEAR(volume(m), volume(box), 1e-12);
+}
+
+TEST(SplitNonmanifold, OnlyTheSpotChanges) {
+  // Two boxes touching along an edge, beside a sphere: the sphere's triangles and vertices
+  // keep their indices and positions; only the shared edge's ends get copies.
+  const TriMesh ball = make_sphere({5, 5, 5}, 1, 24);
+  TriMesh m = merged(ball, merged(make_box({0, 0, 0}, {1, 1, 1}), make_box({1, 1, 0}, {2, 2, 1})));
+  const TriMesh before = m;
+  EXPECT_EQ(split_nonmanifold(m), 2u);
+  EXPECT_TRUE(IsClosedManifold(m));
+  for (size_t t = 0; t < ball.triangles.size(); ++t) EXPECT_EQ(m.triangles[t], before.triangles[t]);
+  for (size_t v = 0; v < ball.positions.size(); ++v) EXPECT_EQ(m.positions[v], before.positions[v]);
+  size_t changed = 0;
+  for (size_t t = 0; t < m.triangles.size(); ++t) changed += m.triangles[t] != before.triangles[t];
+  EXPECT_GT(changed, 0u);
+  EXPECT_LE(changed, 12u);  // triangles at the two split vertices only
+}
+
 TEST(SplitNonmanifold, ManifoldMeshIsUnchanged) {
   TriMesh m = make_sphere({0, 0, 0}, 1, 16);
   const TriMesh before = m;
