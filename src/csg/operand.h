@@ -111,12 +111,6 @@ struct Operand {
     Cell cell;
   };
 
-  static bool contains(const Cell& c, const Lat& p) {
-    const int64_t s = c.span();
-    for (int k = 0; k < 3; ++k)
-      if (p[k] < c.lat[k] || p[k] > c.lat[k] + s) return false;
-    return true;
-  }
   Hit find(uint32_t node, const Cell& cell, const Lat& p) const {
     const Node& n = t.nodes[node];
     const int k = cell.corner_index(p);
@@ -128,11 +122,20 @@ struct Operand {
     if (n.kind == CellKind::White || n.kind == CellKind::Black) return {1, n.kind == CellKind::Black, node, cell};
     if (n.kind == CellKind::Gray) return {2, false, node, cell};
     // On a face shared by several gray leaves, prefer one stamped by this operation: only
-    // stamped leaves have their whole partial contour, which the parity walk needs.
+    // stamped leaves have their whole partial contour, which the parity walk needs. The
+    // children holding p: along each axis the low one, the high one, or both when p lies on
+    // the plane between them (visited in child order).
+    const int64_t half = cell.span() / 2;
+    int need = 0, open = 0;  // bits of the child index p fixes, and those it leaves open
+    for (int a = 0; a < 3; ++a) {
+      const int64_t mid = cell.lat[a] + half;
+      if (p[a] > mid) need |= 1 << a;
+      else if (p[a] == mid) open |= 1 << a;
+    }
     Hit gray;
     for (int c = 0; c < 8; ++c) {
+      if ((c & ~open) != need) continue;
       const Cell cc = cell.child(c);
-      if (!contains(cc, p)) continue;
       const Hit h = find(n.index + c, cc, p);
       if (h.state == 1) return h;
       if (h.state == 2 && (gray.state == 0 || (stamps[gray.leaf] != stamp && stamps[h.leaf] == stamp)))
