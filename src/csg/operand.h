@@ -172,10 +172,16 @@ struct Operand {
   bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
     const Hit h{2, false, leaf, cell};
     const uint64_t key = lattice_key(p);
-    // Crossing parity along x, then y, then z from the leaf's most reliable corner.
+    // Crossing parity along x, then y, then z from the leaf's most reliable corner. A cell's
+    // grid asks one leaf many times in a row: its triangles and anchor are kept at hand.
     const Node& n = t.nodes[h.leaf];
-    const auto& idx = triangles_in(h.leaf, h.cell);
-    const int c = anchor_corner(h.leaf, h.cell);
+    if (h.leaf != last_leaf_) {
+      last_tris_ = &triangles_in(h.leaf, h.cell);
+      last_anchor_ = anchor_corner(h.leaf, h.cell);
+      last_leaf_ = h.leaf;
+    }
+    const auto& idx = *last_tris_;
+    const int c = last_anchor_;
     bool s = (n.signs >> c) & 1;
     I3 a = lattice_to_grid(h.cell.corner(c));
     const I3 g = lattice_to_grid(p);
@@ -192,6 +198,11 @@ struct Operand {
     memo.insert(key, s);
     return s;
   }
+
+ private:
+  uint32_t last_leaf_ = ~uint32_t{0};  // the leaf classify asked last, its triangles and anchor
+  const std::vector<uint32_t>* last_tris_ = nullptr;
+  int last_anchor_ = 0;
 };
 
 /// Sampler source over an operand's partial contour (forced subdivision, paper 5.2.3).
