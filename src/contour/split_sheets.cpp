@@ -143,8 +143,7 @@ size_t split_sheets(TriMesh& m, bool solids_apart, const std::vector<uint8_t>& o
       const uint32_t t = region[i], v = m.triangles[t][k];
       if (!off_fan[v]) continue;
       const auto r = static_cast<uint32_t>(fans.root(3 * i + k));
-      const auto [first, fresh_vertex] = first_root.try_emplace(v, r);
-      if (first->second == r) continue;
+      if (first_root.try_emplace(v, r).first->second == r) continue;
       auto [it, fresh] = copy_of_fan.try_emplace(r, static_cast<uint32_t>(m.positions.size()));
       if (fresh) {
         const Vec3 p = m.positions[v];
