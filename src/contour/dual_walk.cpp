@@ -226,11 +226,12 @@ struct MeshVisitor {
   }
 };
 
-/// A walk of an internal root in 9 parallel tasks (the 8 root children, then the faces and
-/// edges between them), each with its own visitor from make(task): each task's findings,
-/// concatenated in task order, are what one serial walk finds, in its order.
+/// The dual walk in 9 parallel tasks (the 8 root children, then the faces and edges between
+/// them), each with its own visitor from make(task): each task's findings, concatenated in
+/// task order, are what one serial walk finds, in its order. A leaf root has no dual edges.
 template <class MakeVisitor>
 void in_nine_tasks(const Octree& t, MakeVisitor&& make) {
+  if (t.nodes[0].kind != CellKind::Internal) return;
   tbb::parallel_for(0, 9, [&](int task) {
     auto v = make(task);
     DualWalker<CellRef, decltype(v)> w(t, v);
@@ -243,8 +244,7 @@ void in_nine_tasks(const Octree& t, MakeVisitor&& make) {
 
 void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
                const std::function<void(const DualPolygon&)>& emit) {
-  // A leaf root, or an inactive one, has no dual polygons.
-  if (t.nodes[0].kind != CellKind::Internal || (active && !(*active)(0))) return;
+  if (active && !(*active)(0)) return;  // nothing active: no partial contour
   // Each task into its own list, then emitted in the tasks' order: the same polygons in the
   // same order as one walk.
   std::array<std::vector<DualPolygon>, 9> polys;
@@ -255,7 +255,7 @@ void dual_walk(const Octree& t, const std::function<bool(uint32_t)>* active,
 
 DualStats crack_edges(const Octree& t, const std::function<bool(uint32_t)>* active) {
   DualStats all;
-  if (t.nodes[0].kind != CellKind::Internal || (active && !(*active)(0))) return all;
+  if (active && !(*active)(0)) return all;  // nothing active: nothing to repair
   std::array<DualStats, 9> parts;
   in_nine_tasks(t, [&](int task) { return CallbackVisitor<true>{t, active, nullptr, &parts[size_t(task)]}; });
   for (const DualStats& d : parts) {
@@ -267,8 +267,6 @@ DualStats crack_edges(const Octree& t, const std::function<bool(uint32_t)>* acti
 }
 
 std::vector<MeshPolygon> dual_polygons(const Octree& tree) {
-  // A leaf root has no dual polygons.
-  if (tree.nodes[0].kind != CellKind::Internal) return {};
   std::array<std::vector<MeshPolygon>, 9> parts;
   in_nine_tasks(tree, [&](int task) { return MeshVisitor{tree.nodes.data(), tree.cube, parts[size_t(task)]}; });
   std::vector<MeshPolygon> polys;

@@ -170,20 +170,19 @@ struct Operand {
 
   /// Parity walk for p in gray leaf `leaf` (callers have checked the memo).
   bool classify(const Lat& p, uint32_t leaf, const Cell& cell) {
-    const Hit h{2, false, leaf, cell};
     const uint64_t key = lattice_key(p);
     // Crossing parity along x, then y, then z from the leaf's most reliable corner. A cell's
     // grid asks one leaf many times in a row: its triangles and anchor are kept at hand.
-    const Node& n = t.nodes[h.leaf];
-    if (h.leaf != last_leaf_) {
-      last_tris_ = &triangles_in(h.leaf, h.cell);
-      last_anchor_ = anchor_corner(h.leaf, h.cell);
-      last_leaf_ = h.leaf;
+    const Node& n = t.nodes[leaf];
+    if (leaf != last_leaf_) {
+      last_tris_ = &triangles_in(leaf, cell);
+      last_anchor_ = anchor_corner(leaf, cell);
+      last_leaf_ = leaf;
     }
     const auto& idx = *last_tris_;
     const int c = last_anchor_;
     bool s = (n.signs >> c) & 1;
-    I3 a = lattice_to_grid(h.cell.corner(c));
+    I3 a = lattice_to_grid(cell.corner(c));
     const I3 g = lattice_to_grid(p);
     for (int axis = 0; axis < 3; ++axis) {
       const i64 len = g[axis] - a[axis];

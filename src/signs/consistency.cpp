@@ -764,16 +764,17 @@ std::vector<std::pair<Lat, bool>> speck_candidates(const Octree& t, const std::f
   return out;
 }
 
-/// The region of p's sign (`inside`) connected to p through shared leaves, if it is a speck:
-/// every leaf around its points gray with the point as a corner (or, with `uniform_rim`,
-/// uniform of the other sign), one of them at least touched by this operation (active), and
-/// at most kMaxSpeckPoints points. `seen` gets the points visited either way.
 /// grow_speck's buffers, kept from one call to the next (most calls stop after a few leaves).
 struct SpeckScratch {
   Speck sp;
   std::vector<Vec3> vertices;  // of the speck's leaves, its surface (with coarse_rim)
 };
 
+/// Whether the region of p's sign (`inside`) connected to p through shared leaves is a speck
+/// (then it is in scratch.sp): every leaf around its points gray with the point as a corner
+/// (or, with `uniform_rim`, uniform of the other sign), one of them at least touched by this
+/// operation (active), and at most kMaxSpeckPoints points. `seen` gets the points visited
+/// either way.
 bool grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, const Lat& p, bool inside,
                 bool uniform_rim, bool coarse_rim, KeyBits& seen, SpeckScratch& scratch) {
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
