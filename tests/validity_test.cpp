@@ -130,6 +130,22 @@ TEST(SelfIntersect, ClosedPrimitivesAreClean) {
   EXPECT_EQ(check_validity(two).components, 2u);
 }
 
+// ---- distances between surfaces -------------------------------------------------------------
+
+// A unit box against the box 1.5 high over the same base: every point of the taller box's top
+// is 0.5 from the unit box, and the unit box's farthest points from the taller one lie around
+// the middle of its top face. The reported worst points are where the maxima are.
+TEST(Distance, WorstPointsAreWhereTheMaximaAre) {
+  const TriMesh a = make_box({0, 0, 0}, {1, 1, 1}), b = make_box({0, 0, 0}, {1, 1, 1.5});
+  const SurfaceDistance d = surface_distance(a, b, 20000);
+  EXPECT_NEAR(d.b_to_a, 0.5, 1e-9);
+  EXPECT_GT(d.a_to_b, 0.45);
+  EXPECT_NEAR(distance_to_mesh(b, {d.worst_a})[0], d.a_to_b, 1e-12);
+  EXPECT_NEAR(distance_to_mesh(a, {d.worst_b})[0], d.b_to_a, 1e-12);
+  EXPECT_NEAR(d.worst_a[2], 1.0, 1e-12);
+  EXPECT_NEAR(d.worst_b[2], 1.5, 1e-12);
+}
+
 // ---- what PIC writes -------------------------------------------------------------------------
 
 ::testing::AssertionResult IsValidSolid(const TriMesh& m) {

@@ -36,6 +36,8 @@ void run(const CompareArgs& args) {
       .add("b_to_a", d.b_to_a / unit)
       .add("mean_a_to_b", d.mean_a_to_b / unit)
       .add("mean_b_to_a", d.mean_b_to_a / unit)
+      .raw("worst_a", vec_json(d.worst_a))
+      .raw("worst_b", vec_json(d.worst_b))
       .add("unit", unit)
       .add("volume_a", va)
       .add("volume_b", vb)

@@ -76,6 +76,7 @@ struct SurfaceDistance {
   double hausdorff = 0;            ///< max of the two one-sided distances
   double a_to_b = 0, b_to_a = 0;   ///< one-sided maxima
   double mean_a_to_b = 0, mean_b_to_a = 0;
+  Vec3 worst_a{}, worst_b{};       ///< where the one-sided maxima are: a point of A, of B
 };
 /// Two-sided (Hausdorff) distance sampled at all vertices plus `samples` points per side.
 SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples = 100000);

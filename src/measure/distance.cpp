@@ -195,18 +195,22 @@ std::vector<double> distance_to_mesh(const TriMesh& mesh, const std::vector<Vec3
 
 SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples) {
   SurfaceDistance r;
-  auto side = [&](const TriMesh& from, const TriMesh& to, double& worst, double& mean) {
-    const auto d = distance_to_mesh(to, sample_surface(from, samples, 12345));
+  auto side = [&](const TriMesh& from, const TriMesh& to, double& worst, double& mean, Vec3& where) {
+    const std::vector<Vec3> pts = sample_surface(from, samples, 12345);
+    const auto d = distance_to_mesh(to, pts);
     worst = 0;
     mean = 0;
-    for (double x : d) {
-      worst = std::max(worst, x);
-      mean += x;
+    for (size_t i = 0; i < d.size(); ++i) {
+      if (d[i] > worst) {
+        worst = d[i];
+        where = pts[i];
+      }
+      mean += d[i];
     }
     mean = d.empty() ? 0 : mean / double(d.size());
   };
-  side(a, b, r.a_to_b, r.mean_a_to_b);
-  side(b, a, r.b_to_a, r.mean_b_to_a);
+  side(a, b, r.a_to_b, r.mean_a_to_b, r.worst_a);
+  side(b, a, r.b_to_a, r.mean_b_to_a, r.worst_b);
   r.hausdorff = std::max(r.a_to_b, r.b_to_a);
   return r;
 }
