@@ -153,6 +153,42 @@ TEST(Eval, LeavesApartAreSampledTogether) {
   EXPECT_EQ(test::euler_characteristic(r.mesh), 2 - 2 * 9);
 }
 
+// Three parallel bars turned 30 degrees about z and 20 about x: their axis boxes overlap, but
+// a plane along their own faces separates each pair, so they are one soup (no Boolean).
+// A fourth bar crossing the middle one leaves the three one group: one Boolean.
+TEST(Eval, TurnedBarsApartAreSampledTogether) {
+  const double a = std::numbers::pi / 6, b = std::numbers::pi / 9;
+  // R = Rx(b) Rz(a), then each bar moved 4 along its own turned y axis.
+  const double r[3][3] = {{std::cos(a), -std::sin(a), 0},
+                          {std::cos(b) * std::sin(a), std::cos(b) * std::cos(a), -std::sin(b)},
+                          {std::sin(b) * std::sin(a), std::sin(b) * std::cos(a), std::cos(b)}};
+  const auto bar = [&](double y) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "multmatrix([";
+    for (int i = 0; i < 3; ++i)
+      s << "[" << r[i][0] << ", " << r[i][1] << ", " << r[i][2] << ", " << r[i][1] * y << "], ";
+    s << "[0, 0, 0, 1]]) { cube(size = [20, 2, 2], center = true); }\n";
+    return s.str();
+  };
+  const std::string three = bar(-4) + bar(0) + bar(4);
+  EvalOptions o;
+  o.depth = 8;
+  EvalStats st;
+  Result res;
+  res.mesh = unsplit_contour(eval_csg("union() {\n" + three + "}\n", o, &st, "bars"));
+  res.volume = volume(res.mesh);
+  EXPECT_EQ(st.booleans, 0u);
+  expect_volume(res, 3 * 80, 2e-3);
+  EXPECT_EQ(test::component_count(res.mesh), 3u);
+
+  const std::string crossed = three + "cube(size = [2, 2, 30], center = true);\n";
+  res.mesh = unsplit_contour(eval_csg("union() {\n" + crossed + "}\n", o, &st, "bars"));
+  EXPECT_EQ(st.booleans, 1u);
+  EXPECT_EQ(test::component_count(res.mesh), 3u);  // the middle bar and the fourth are one
+  EXPECT_TRUE(test::IsClosedManifold(res.mesh));
+}
+
 TEST(Eval, HullOfTwoSpheres) {
   // The $fn = 16 sphere polytope: 8 rings of 16 points at polar angles 180 (i + 0.5) / 8; its
   // volume is the stack of frusta between rings (the caps are flat). The hull with its copy

@@ -13,6 +13,7 @@
 
 #include "pic/pic.h"
 #include "sample/sampler.h"
+#include "geometry/vec3.h"
 #include "scad/lower.h"
 
 namespace pic {
@@ -53,6 +54,63 @@ bool union_leaves(const Solid& s, std::vector<const TriMesh*>& out) {
       return true;
     default: return false;
   }
+}
+
+/// A leaf's extent, for telling whether two leaves are apart: its box, and its own face
+/// directions when it has few (a box, a prism, a bar turned obliquely). Two leaves are apart
+/// when their vertices' ranges along one of these directions do not overlap: a plane
+/// separates them. Axis boxes alone take turned bars for overlapping (every pair of the
+/// turned Menger sponge's parallel bars).
+struct LeafExtent {
+  const TriMesh* mesh = nullptr;
+  std::array<Vec3, 2> box;
+  std::vector<Vec3> dirs;  ///< distinct face normals up to sign; none past kMaxDirs
+};
+constexpr size_t kMaxDirs = 16;
+
+LeafExtent extent_of(const TriMesh& m) {
+  using namespace detail;
+  LeafExtent e{&m, box_of(m.positions), {}};
+  for (const auto& t : m.triangles) {
+    const Vec3& p = m.positions[t[0]];
+    const Vec3 n = cross3(sub3(m.positions[t[1]], p), sub3(m.positions[t[2]], p));
+    const double len = norm3(n);
+    if (!(len > 0)) continue;
+    const Vec3 u = scale3(n, 1 / len);
+    const auto same = [&](const Vec3& d) { return std::abs(dot3(d, u)) > 1 - 1e-9; };
+    if (std::any_of(e.dirs.begin(), e.dirs.end(), same)) continue;
+    if (e.dirs.size() == kMaxDirs) {
+      e.dirs.clear();
+      break;
+    }
+    e.dirs.push_back(u);
+  }
+  return e;
+}
+
+/// Whether the ranges of the two meshes' vertices along `d` are apart.
+bool apart_along(const TriMesh& a, const TriMesh& b, const Vec3& d) {
+  const auto range = [&](const TriMesh& m) {
+    double lo = 1e300, hi = -1e300;
+    for (const Vec3& p : m.positions) {
+      const double x = detail::dot3(p, d);
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    return std::pair{lo, hi};
+  };
+  const auto [alo, ahi] = range(a);
+  const auto [blo, bhi] = range(b);
+  return ahi < blo || bhi < alo;
+}
+
+bool leaves_apart(const LeafExtent& a, const LeafExtent& b) {
+  if (boxes_apart(a.box, b.box)) return true;
+  for (const Vec3& d : a.dirs)
+    if (apart_along(*a.mesh, *b.mesh, d)) return true;
+  for (const Vec3& d : b.dirs)
+    if (apart_along(*a.mesh, *b.mesh, d)) return true;
+  return false;
 }
 
 class Evaluator {
@@ -146,16 +204,16 @@ class Evaluator {
     std::vector<const TriMesh*> leaves;
     for (size_t i = b; i < e; ++i)
       if (!union_leaves(kids[i], leaves)) return pairwise();
-    std::vector<std::array<Vec3, 2>> boxes;
+    std::vector<LeafExtent> extents;
     for (const TriMesh* m : leaves) {
       if (m->triangles.empty() || !(volume(*m) > 0)) return pairwise();
-      boxes.push_back(box_of(m->positions));
+      extents.push_back(extent_of(*m));
     }
-    // Greedily: each leaf joins the first group whose every box is apart from its own.
+    // Greedily: each leaf joins the first group whose every leaf is apart from it.
     std::vector<std::vector<size_t>> groups;
     for (size_t i = 0; i < leaves.size(); ++i) {
       const auto apart = [&](const std::vector<size_t>& g) {
-        return std::all_of(g.begin(), g.end(), [&](size_t j) { return boxes_apart(boxes[j], boxes[i]); });
+        return std::all_of(g.begin(), g.end(), [&](size_t j) { return leaves_apart(extents[j], extents[i]); });
       };
       const auto g = std::find_if(groups.begin(), groups.end(), apart);
       if (g == groups.end()) groups.push_back({i});
