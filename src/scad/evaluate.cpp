@@ -11,9 +11,9 @@
 #include <optional>
 #include <sstream>
 
+#include "geometry/vec3.h"
 #include "pic/pic.h"
 #include "sample/sampler.h"
-#include "geometry/vec3.h"
 #include "scad/lower.h"
 
 namespace pic {
