@@ -90,7 +90,7 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
     if (t0 <= t1) x += 0.5 * (t0 + t1) * d;
   } else if (!in_box(x, lo, hi) && rank == 1) {
     // A plane: the centroid of its section with the box (where it crosses the box edges).
-    Eigen::Vector3d n;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();  // rank 1: one column below is taken
     for (int k = 0; k < 3; ++k)
       if (inv[k] != 0) n = u.col(k);
     const double off = n.dot(x);

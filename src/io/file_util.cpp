@@ -20,8 +20,14 @@ std::string lower_extension(const std::filesystem::path& path) {
 std::filesystem::path temp_path_for(const std::filesystem::path& path) {
   static std::atomic<int> counter{0};
   auto tmp = path;
-  tmp.replace_filename("." + path.stem().string() + ".tmp" + std::to_string(::getpid()) + "-" +
-                       std::to_string(counter++) + path.extension().string());
+  std::string name = ".";
+  name += path.stem().string();
+  name += ".tmp";
+  name += std::to_string(::getpid());
+  name += '-';
+  name += std::to_string(counter++);
+  name += path.extension().string();
+  tmp.replace_filename(name);
   return tmp;
 }
 
