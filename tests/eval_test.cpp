@@ -388,5 +388,20 @@ TEST(EvalCli, ScadThroughOpenscad) {
   EXPECT_FALSE(fs::exists(dir / "part.csg"));  // the export goes to a temporary directory
 }
 
+TEST(EvalCli, ScadEvaluatesTheRenderTreeNotThePreview) {
+  if (std::system("command -v openscad > /dev/null 2>&1") != 0) GTEST_SKIP() << "openscad is not installed";
+  test::TempDir dir("pic_eval");
+  {
+    std::ofstream f(dir / "part.scad");
+    // OpenSCAD renders one cube; its preview shows a second one.
+    f << "cube(1);\nif ($preview) translate([5, 0, 0]) cube(1);\nif (!$preview) translate([0, 5, 0]) cube(2);\n";
+  }
+  EvalOptions o;
+  o.depth = 7;
+  const TriMesh m = unsplit_contour(eval_scad(dir / "part.scad", o));
+  EXPECT_NEAR(volume(m), 1 + 8, 1e-6);
+  for (const Vec3& p : m.positions) EXPECT_LT(p[0], 2.5);  // nothing where the preview cube is
+}
+
 }  // namespace
 }  // namespace pic

@@ -1,6 +1,7 @@
 // The CSG clean-up: see csg_cleanup.h.
 #include "csg/cleanup.h"
 
+#include "csg/refine.h"
 #include "signs/settle.h"
 
 namespace pic::detail {
@@ -118,10 +119,11 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
 /// for none keeps seeds 30 and 82 cut). The points set are pinned: enforce_one_component then
 /// undoes them only when nothing else will do.
 void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::function<bool(uint32_t)>& stamped,
-                      PinnedPoints& pinned) {
+                      PinnedPoints& pinned, const std::function<void(const Lat&)>& refine) {
   for (const SignHint& h : hints) {
     const HintedFlip f = examine_hint(t, h, stamped);
     if (!f.possible || !f.needed || f.after >= f.before) continue;
+    refine(h.point);
     set_point_sign(t, h.point, h.inside, nullptr);
     pinned.insert(lattice_key(h.point));
   }
@@ -130,20 +132,28 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
 }  // namespace
 
 void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
-              const std::function<bool(const Lat&)>& sign_b, CsgStats& stats) {
+              const std::function<bool(const Lat&)>& sign_b, double error, CsgStats& stats) {
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return stamps[n] == stamp; };
   std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { stamps[n] = stamp; };
+  // A flip at a coarse leaf's corner would move all of that leaf's surface: split it first.
+  const std::function<void(const Lat&)> refine = [&](const Lat& p) {
+    refine_around(a, p, error, [&](uint32_t n) {
+      if (n >= stamps.size()) stamps.resize(a.nodes.size(), 0);
+      stamps[n] = stamp;
+    });
+  };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
   // for coarse neighbours that finer sign changes contradict (issue 10's slit).
   withdraw_crack_repairs(a, 0, stamped);
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
-  apply_sign_hints(a, hints, stamped, pinned);
+  apply_sign_hints(a, hints, stamped, pinned, refine);
   SettlePlan plan;
   plan.active = &stamped;
   plan.touched = &stamp_it;
   plan.spare_coarse = true;
+  plan.refine = refine;
   // Specks the Boolean made (where the two operands' surfaces pass within a fraction of a
   // cell of each other); one operand's own small components stay.
   plan.keep_speck = [&](const Speck& sp) { return speck_is_inherited(sp, op, sign_b); };

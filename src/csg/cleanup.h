@@ -28,8 +28,10 @@ struct SignHint {
 /// Clean-up of the leaves whose `stamps` entry is `stamp` after `a op b` was combined into `a`: crack
 /// repairs withdrawn and redone, sign hints applied, islands and leaves of more than one
 /// component removed, and specks the Boolean made absorbed (`sign_b`: B's sign at a lattice
-/// point, to tell those from B's own small components). Sets stats.repaired.
+/// point, to tell those from B's own small components). A flip at the corner of a leaf
+/// coarser than the finest level first splits that leaf (resampled with QEF threshold
+/// `error`). Sets stats.repaired.
 void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
-              const std::function<bool(const std::array<int64_t, 3>&)>& sign_b, CsgStats& stats);
+              const std::function<bool(const std::array<int64_t, 3>&)>& sign_b, double error, CsgStats& stats);
 
 }  // namespace pic::detail

@@ -146,7 +146,7 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   const auto tclean = Clock::now();
   {
     Operand ob(b, sb, pb, stamp);
-    clean_up(a, sa, stamp, op, hints, [&](const Lat& p) { return ob.sign(p); }, stats);
+    clean_up(a, sa, stamp, op, hints, [&](const Lat& p) { return ob.sign(p); }, options.error, stats);
   }
   stats.cleanup_seconds = since(tclean);
   stats.csg_seconds = since(tc);

@@ -111,9 +111,12 @@ std::vector<uint8_t> around_coarse_leaves(const Octree& t, const Stamps& stamps,
 /// resampled cell had its sign change but no plane, and its vertex sat 9 cells off the facet).
 void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x) {
   const std::vector<uint8_t> around = around_coarse_leaves(t, stamps, stamp);
-  const std::function<bool(uint32_t)> active = [&](uint32_t n) {
-    return stamps[n] == stamp || (!around.empty() && around[n] != 0);
-  };
+  contour_of(t, [&](uint32_t n) { return stamps[n] == stamp || (!around.empty() && around[n] != 0); }, x);
+}
+
+}  // namespace
+
+void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, PartialContour& x) {
   // The polygons first, then their triangles in parallel into a vector sized once: a
   // triangle is 272 bytes, and growing the vector one at a time copied them over and over.
   std::vector<std::array<Vec3, 4>> quads;
@@ -140,8 +143,6 @@ void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, Part
   });
   x.bvh.build(x.tris);
 }
-
-}  // namespace
 
 /// Stamps the cells where the operands' surfaces may meet (tag, then stamp_under_surface for
 /// the subtrees of B it deferred) and builds both operands' partial contours.

@@ -6,6 +6,10 @@
 
 namespace pic::detail {
 
+/// The dual polygons of the walk over `active` nodes (dual_walk) as triangles, indexed for box
+/// queries: a tree's contour around part of it.
+void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, PartialContour& x);
+
 /// Stamps the cells where the operands' surfaces may meet (pairs where neither is uniform;
 /// under a gray leaf of A only B's cells that A's partial contour comes near) and builds both
 /// operands' partial contours. Sets stats.cells_stamped and the contour times.

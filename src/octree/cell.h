@@ -36,6 +36,13 @@ struct Cell {
     }
     return k;
   }
+  /// Whether lattice point p lies in the closed cell.
+  bool holds(const std::array<int64_t, 3>& p) const {
+    const int64_t s = span();
+    for (int a = 0; a < 3; ++a)
+      if (p[a] < lat[a] || p[a] > lat[a] + s) return false;
+    return true;
+  }
   double size() const { return 1.0 / double(int64_t{1} << level); }
   Vec3 min_unit() const {
     constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);

@@ -251,12 +251,14 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
                  const Wind8* wind) {
   const uint8_t written = p.invert ? uint8_t(~signs) : signs;
   const bool uniform = signs == 0 || signs == kAll;
-  if (idx.empty() && uniform) {
+  const bool at_cap = cell.level >= p.max_depth;
+  const bool focused = !at_cap && p.has_focus && cell.holds(p.focus);
+  if (focused) {
+    // Split whatever the cell holds (below).
+  } else if (idx.empty() && uniform) {
     out.set_uniform(slot, (written & 1) != 0);
     return;
-  }
-  const bool at_cap = cell.level >= p.max_depth;
-  if (uniform) {
+  } else if (uniform) {
     // No vertex here: only whether surface enters the cell matters, not its QEF. A surface
     // that only touches one of the cell's edges (a prism's edge lying on an octree line,
     // the solid on the far side) has no area in the box, yet the edge's perturbed segment

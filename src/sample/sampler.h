@@ -92,6 +92,10 @@ struct SampleParams {
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
   uint32_t memo_id = 0;    // nonzero: one triangle set, whose edge crossing counts may be memoized
+  /// With `has_focus`: every cell whose closed box holds lattice point `focus` splits down to
+  /// max_depth, so that the leaves around that point are finest cells.
+  bool has_focus = false;
+  std::array<int64_t, 3> focus{0, 0, 0};
 };
 
 /// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped,

@@ -58,7 +58,9 @@ std::string csg_text(const std::filesystem::path& path, EvalOptions& o, double& 
   const char* dir = ::mkdtemp(tmpl);
   if (!dir) throw IoError("cannot create a temporary directory");
   const std::filesystem::path tmp_dir = dir, csg = tmp_dir / "model.csg", log = tmp_dir / "openscad.log";
-  const std::string cmd = "openscad -o " + shell_quote(csg.string()) + " " +
+  // OpenSCAD exports the preview tree by default ($preview true); `openscad -o x.stl` renders
+  // with $preview false, and that is the solid a user means.
+  const std::string cmd = "openscad -D '$preview=false' -o " + shell_quote(csg.string()) + " " +
                           shell_quote(std::filesystem::absolute(path).string()) + " >" +
                           shell_quote(log.string()) + " 2>&1";
   const int rc = std::system(cmd.c_str());

@@ -652,7 +652,7 @@ bool emptied_coarse_leaf(const Octree& t, const Around& a, uint8_t flipped) {
 
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
                                   const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned,
-                                  bool spare_coarse) {
+                                  bool spare_coarse, const std::function<void(const Lat&)>* refine) {
   TopologyFix fix;
   for (int pass = 0; pass < 6; ++pass) {
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
@@ -699,7 +699,9 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         t.nodes[l.node].flags |= kFlagCapped;
         continue;
       }
-      set_point_sign(t, l.cell.corner(best), !((s >> best) & 1), touched);
+      const Lat p = l.cell.corner(best);
+      if (refine) (*refine)(p);
+      set_point_sign(t, p, !((s >> best) & 1), touched);
       ++fix.flipped;
     }
   }

@@ -58,9 +58,13 @@ struct TopologyFix {
 /// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
 /// With `spare_coarse` (CSG), a flip that leaves a coarser gray leaf without a sign change
 /// costs more: another flip usually does, and the coarse leaf keeps its surface.
+/// With `refine`, called before each flip with the point, the leaves coarser than the finest
+/// level that hold the point are split first (refine_around), so no flip moves the surface by
+/// more than a finest cell.
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
                                   const std::function<void(uint32_t)>* touched = nullptr,
-                                  const PinnedPoints* pinned = nullptr, bool spare_coarse = false);
+                                  const PinnedPoints* pinned = nullptr, bool spare_coarse = false,
+                                  const std::function<void(const std::array<int64_t, 3>&)>* refine = nullptr);
 
 /// What remove_islands carries from one round of a settling loop to the next. Every check reads
 /// only the stored signs of the leaves around it, so a later round need look again only near

@@ -16,7 +16,8 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
   };
   for (int round = 0; round < 4; ++round) {
     const size_t islands = remove_islands(t, plan.active, &touched, &pinned, &rounds);
-    const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse);
+    const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse,
+                                                  plan.refine ? &plan.refine : nullptr);
     if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
   }
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };

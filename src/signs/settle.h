@@ -21,6 +21,9 @@ struct SettlePlan {
   bool one_component_everywhere = false;
   bool spare_coarse = false;  ///< see enforce_one_component
   std::function<bool(const Speck&)> keep_speck;  ///< specks to keep (null: remove them all)
+  /// Splits the coarser leaves holding a point before the one-component pass flips it (null:
+  /// flip in place); see enforce_one_component.
+  std::function<void(const std::array<int64_t, 3>&)> refine;
   SpeckSearch specks;
 };
 
