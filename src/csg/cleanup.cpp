@@ -2,6 +2,7 @@
 #include "csg/cleanup.h"
 
 #include "csg/refine.h"
+#include "signs/refine.h"
 #include "signs/settle.h"
 
 namespace pic::detail {
@@ -134,14 +135,13 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
 void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
               const std::function<bool(const Lat&)>& sign_b, double error, CsgStats& stats) {
   std::function<bool(uint32_t)> stamped = [&](uint32_t n) { return stamps[n] == stamp; };
-  std::function<void(uint32_t)> stamp_it = [&](uint32_t n) { stamps[n] = stamp; };
-  // A flip at a coarse leaf's corner would move all of that leaf's surface: split it first.
-  const std::function<void(const Lat&)> refine = [&](const Lat& p) {
-    refine_around(a, p, error, [&](uint32_t n) {
-      if (n >= stamps.size()) stamps.resize(a.nodes.size(), 0);
-      stamps[n] = stamp;
-    });
+  std::function<void(uint32_t)> stamp_it = [&](uint32_t n) {
+    if (n >= stamps.size()) stamps.resize(a.nodes.size(), 0);
+    stamps[n] = stamp;
   };
+  // A flip at a coarse leaf's corner would move all of that leaf's surface: split it first.
+  const ResampleLeaf from_contour = [&](const LeafRef& l, const Lat& q) { return resample_from_contour(a, l, q, error); };
+  const std::function<void(const Lat&)> refine = [&](const Lat& p) { refine_around(a, p, from_contour, stamp_it); };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
   // for coarse neighbours that finer sign changes contradict (issue 10's slit).
   withdraw_crack_repairs(a, 0, stamped);

@@ -26,6 +26,7 @@ struct Fragment {
   std::vector<std::array<float, 3>> vertices;
   std::vector<std::pair<uint32_t, Node>> pending;  // A's slot -> node
   std::vector<SignHint> hints;                      // see sign_hint()
+  std::vector<Cell> contacts;  // finest cells whose result signs make two components
 
   static bool is_local(uint32_t index) { return (index & kLocal) != 0; }
   /// `n` with its fragment-local index moved to where the fragment's arrays land (bases
@@ -43,8 +44,47 @@ struct Fragment {
     vertices.insert(vertices.end(), f.vertices.begin(), f.vertices.end());
     for (const auto& [slot, n] : f.pending) pending.push_back({slot, relocate(n, nb, vb)});
     hints.insert(hints.end(), f.hints.begin(), f.hints.end());
+    contacts.insert(contacts.end(), f.contacts.begin(), f.contacts.end());
     return relocate(root, nb, vb);
   }
+};
+
+/// The cells, at every level above the cap, whose closed box holds a given lattice point: the
+/// recursion splits them down to the finest level, so that the leaves around the point are
+/// finest cells (a sign the clean-up changes there then moves the surface by a finest cell,
+/// not by a coarse leaf's size). A key may stand for two cells (then both split: harmless).
+class FocusCells {
+ public:
+  FocusCells(const std::vector<Lat>& points, int max_depth) {
+    for (const Lat& p : points) add(p, max_depth);
+  }
+  bool holds(const Cell& cell) const { return keys_.count(key(cell.level, cell.lat)) != 0; }
+  bool empty() const { return keys_.empty(); }
+
+ private:
+  static uint64_t key(int level, const Lat& lat) {
+    const int shift = kMaxLevel - level;
+    return uint64_t(level) << 59 ^ uint64_t(lat[0] >> shift) << 38 ^ uint64_t(lat[1] >> shift) << 19 ^
+           uint64_t(lat[2] >> shift);
+  }
+  void add(const Lat& p, int max_depth) {
+    constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+    for (int level = 0; level < max_depth; ++level) {
+      const int64_t span = int64_t{1} << (kMaxLevel - level);
+      // Along each axis the cell holding p, and the one below when p lies on their plane.
+      std::array<std::array<int64_t, 2>, 3> lo;
+      std::array<int, 3> n{};
+      for (int a = 0; a < 3; ++a) {
+        const int64_t base = std::min(p[a], kLimit - 1) / span * span;
+        lo[a][n[a]++] = base;
+        if (p[a] == base && base > 0) lo[a][n[a]++] = base - span;
+      }
+      for (int i = 0; i < n[0]; ++i)
+        for (int j = 0; j < n[1]; ++j)
+          for (int k = 0; k < n[2]; ++k) keys_.insert(key(level, {lo[0][i], lo[1][j], lo[2][k]}));
+    }
+  }
+  std::unordered_set<uint64_t> keys_;
 };
 
 /// What the recursion counts; each task counts its own, summed when the tasks merge.
@@ -64,6 +104,7 @@ class FragmentWriter {
   explicit FragmentWriter(Fragment& out) : out_(out) {}
 
   void hint(const SignHint& h) { out_.hints.push_back(h); }
+  void contact(const Cell& c) { out_.contacts.push_back(c); }
   void set(uint32_t slot, const Node& n) {
     if (Fragment::is_local(slot)) out_.nodes[slot & ~Fragment::kLocal] = n;
     else out_.pending.push_back({slot, n});
@@ -151,15 +192,35 @@ class FragmentWriter {
 class Combiner {
  public:
   Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
-           int parallel_splits, bool parallel, CombineCounts& stats)
+           int parallel_splits, bool parallel, const FocusCells* focus, CombineCounts& stats)
       : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
-        parallel_splits_(parallel_splits), parallel_(parallel), stats_(stats) {}
+        parallel_splits_(parallel_splits), parallel_(parallel), focus_(focus), stats_(stats) {}
 
   /// The result's root node (its index may be fragment-local).
   Node run() {
     Side sa = side_of(a_, 0, Cell{});
     Side sb = side_of(b_, 0, Cell{});
     return combine(Cell{}, sa, sb);
+  }
+
+  /// The result over one cell: both operands followed down to it (virtual cells inside
+  /// their gray leaves), then combined there.
+  Node run_at(const Cell& target) {
+    Side sa = side_of(a_, 0, Cell{});
+    Side sb = side_of(b_, 0, Cell{});
+    Cell cell;
+    while (cell.level < target.level) {
+      const int64_t h = cell.span() / 2;
+      int c = 0;
+      for (int k = 0; k < 3; ++k)
+        if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
+      const SignGrid ga = sa.kind == Side::Gray ? sign_grid(a_, sa, cell) : SignGrid{};
+      const SignGrid gb = sb.kind == Side::Gray ? sign_grid(b_, sb, cell) : SignGrid{};
+      sa = child_side(a_, sa, cell, c, ga);
+      sb = child_side(b_, sb, cell, c, gb);
+      cell = cell.child(c);
+    }
+    return combine(cell, sa, sb);
   }
 
  private:
@@ -172,6 +233,7 @@ class Combiner {
     p.max_depth = max_depth_;
     p.error = error_;
     p.invert = invert;
+    p.tips_at_corners = true;
     Builder sub;
     sub.nodes.resize(1);
     size_t capped = 0;
@@ -199,6 +261,7 @@ class Combiner {
 
   Node combine(const Cell& cell, const Side& a, const Side& b) {
     ++stats_.cells_visited;
+    if (focus_ && cell.level < max_depth_ && focus_->holds(cell)) return subdivide(cell, a, b, std::nullopt, true);
     if (a.kind == Side::Uniform) {
       if (b.kind == Side::Uniform) return uniform(apply(op_, a.inside, b.inside));
       // white | X = X, black & X = X, black - X = not X; the rest are uniform.
@@ -223,7 +286,8 @@ class Combiner {
   }
 
   /// `pg`: the grids if gray_cell computed them already (both sides gray).
-  Node subdivide(const Cell& cell, const Side& a, const Side& b, PairGrids pg = std::nullopt) {
+  /// `keep`: no collapse of uniform children (a focus cell must stay split).
+  Node subdivide(const Cell& cell, const Side& a, const Side& b, PairGrids pg = std::nullopt, bool keep = false) {
     // Children of A's internal node are written in place; otherwise new slots.
     uint32_t first;
     if (a.kind == Side::Internal) {
@@ -250,7 +314,7 @@ class Combiner {
       all_uniform = all_uniform && (kids[c].kind == CellKind::White || kids[c].kind == CellKind::Black) &&
                     kids[c].kind == kids[0].kind;
     }
-    if (all_uniform) return uniform(kids[0].kind == CellKind::Black);  // collapse
+    if (all_uniform && !keep) return uniform(kids[0].kind == CellKind::Black);  // collapse
     return Node{first, CellKind::Internal, 0, 0, 0};
   }
 
@@ -272,7 +336,8 @@ class Combiner {
     std::array<CombineCounts, 8> sub_stats;
     auto task = [&](int c) {
       Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
-      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, sub_stats[c]);
+      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, focus_,
+                   sub_stats[c]);
       // Both sides internal here: no sign grid is read.
       kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c, {}), child_side(cb, b, cell, c, {}));
     };
@@ -306,9 +371,11 @@ class Combiner {
     if (at_cap) {
       if (sr == 0 || sr == 0xff) return uniform(sr != 0);
       const CellQefs q = cell_qefs(a_, a, b_, b, cell);
-      if (!one_component(sr))
+      if (!one_component(sr)) {
+        out_.contact(cell);
         if (const std::optional<SignHint> h = sign_hint(op_, a_, b_, cell, sr)) out_.hint(*h);
-      return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr).position, kFlagCapped);
+      }
+      return out_.gray(cell, sr, cell_vertex(q.sum, cell, sr, true).position, kFlagCapped);
     }
     return subdivide(cell, a, b, pg);
   }
@@ -343,7 +410,7 @@ class Combiner {
     const Vec3 seed{(va[0] + vb[0]) / 2, (va[1] + vb[1]) / 2, (va[2] + vb[2]) / 2};
     const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
     Qef::Solution sol = q.sum.solve_in_box(seed, lo, hi);
-    if (!inside_cell(sol.position, cell)) sol = cell_vertex(q.sum, cell, sr);
+    if (!inside_cell(sol.position, cell)) sol = cell_vertex(q.sum, cell, sr, true);
     if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
         feature_is_local(a_, b_, cell, sol.position, error_, scratch_))
       return out_.gray(cell, sr, sol.position, 0);
@@ -359,25 +426,34 @@ class Combiner {
   uint32_t stamp_;
   int parallel_splits_;
   bool parallel_;
+  const FocusCells* focus_;  // cells to split down to the finest level whatever they hold
   CombineCounts& stats_;
   std::vector<uint32_t> scratch_;
 };
 
 }  // namespace
 
-/// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
-/// A's, and A's own slots are written only once all tasks are done.
-std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, const Stamps& sb, const PartialContour& pa,
-                                      const PartialContour& pb, CsgOp op, const CsgOptions& options, int depth,
-                                      uint32_t stamp, CsgStats& stats) {
-  Fragment f;
-  Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
-  CombineCounts counts;
-  Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelSplits, options.parallel, counts);
-  const Node root = comb.run();
-  stats.cells_visited = counts.cells_visited;
-  stats.gray_pairs = counts.gray_pairs;
-  stats.forced_subdivisions = counts.forced_subdivisions;
+namespace {
+
+/// How to take back a fragment landed in A: the sizes before, and the slots it overwrote.
+struct Landing {
+  size_t nodes = 0, vertices = 0, stamps = 0;
+  std::vector<std::tuple<uint32_t, Node, uint32_t>> slots;  // slot, node before, stamp before
+
+  void undo(Octree& a, Stamps& sa) const {
+    for (auto it = slots.rbegin(); it != slots.rend(); ++it) {
+      a.nodes[std::get<0>(*it)] = std::get<1>(*it);
+      sa[std::get<0>(*it)] = std::get<2>(*it);
+    }
+    a.nodes.resize(nodes);
+    a.vertices.resize(vertices);
+    sa.resize(stamps);
+  }
+};
+
+/// Writes the fragment into A: the new nodes land after A's, then A's own slots.
+Landing land(Octree& a, Stamps& sa, const Fragment& f, const Node& root, uint32_t stamp) {
+  Landing l{a.nodes.size(), a.vertices.size(), sa.size(), {}};
   const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
   for (const Node& n : f.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
   a.vertices.insert(a.vertices.end(), f.vertices.begin(), f.vertices.end());
@@ -394,10 +470,109 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   // a small sphere's pole piercing a lattice plane beside a coarse leaf — became a sculpting
   // stroke's pinched vertex). Cleaning these parts too costs sculpting about 2-3 ms a stroke.
   for (const auto& [slot, n] : f.pending) {
+    l.slots.emplace_back(slot, a.nodes[slot], sa[slot]);
     a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
     sa[slot] = stamp;
   }
+  l.slots.emplace_back(0, a.nodes[0], sa[0]);
   a.nodes[0] = Fragment::relocate(root, node_base, vertex_base);
+  return l;
+}
+
+/// The corners of the contact cells, each once.
+std::vector<Lat> contact_corners(const std::vector<Cell>& contacts) {
+  std::vector<Lat> out;
+  for (const Cell& c : contacts)
+    for (int k = 0; k < 8; ++k) out.push_back(c.corner(k));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The gray leaves coarser than the finest level that hold one of the points (a uniform one
+/// is split toward a point when its sign changes: set_point_sign), each once.
+std::vector<LeafRef> coarse_gray_leaves_at(const Octree& a, const std::vector<Lat>& points, int depth) {
+  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
+  std::vector<LeafRef> out;
+  for (const Lat& p : points)
+    for (int o = 0; o < 8; ++o) {
+      Lat q;
+      bool in_root = true;
+      for (int x = 0; x < 3; ++x) {
+        q[x] = p[x] - (((o >> x) & 1) ? 0 : 1);
+        in_root = in_root && q[x] >= 0 && q[x] < kLimit;
+      }
+      if (!in_root) continue;
+      const LeafRef l = leaf_at(a, q);
+      if (l.cell.level >= depth || a.nodes[l.node].kind != CellKind::Gray) continue;
+      bool seen = false;
+      for (const LeafRef& x : out) seen = seen || x.node == l.node;
+      if (!seen) out.push_back(l);
+    }
+  return out;
+}
+
+}  // namespace
+
+/// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
+/// A's, and A's own slots are written only once all tasks are done. Where the result has
+/// contacts (finest cells of two components, which the clean-up must settle by changing a
+/// sign) next to coarser leaves, the combine runs again with the cells around them split down
+/// to the finest level, from the operands' own surfaces.
+std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, const Stamps& sb, const PartialContour& pa,
+                                      const PartialContour& pb, CsgOp op, const CsgOptions& options, int depth,
+                                      uint32_t stamp, CsgStats& stats,
+                                      const std::function<void(const std::vector<Lat>&)>& prepare_focus) {
+  const auto run = [&](const FocusCells* focus, Fragment& f) {
+    Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
+    CombineCounts counts;
+    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelSplits, options.parallel, focus, counts);
+    const Node root = comb.run();
+    stats.cells_visited += counts.cells_visited;
+    stats.gray_pairs += counts.gray_pairs;
+    stats.forced_subdivisions += counts.forced_subdivisions;
+    return root;
+  };
+  stats.cells_visited = stats.gray_pairs = stats.forced_subdivisions = 0;
+  Fragment f;
+  const Node root = run(nullptr, f);
+  const Landing landed = land(a, sa, f, root, stamp);
+  if (f.contacts.empty()) return std::move(f.hints);
+  const std::vector<Lat> corners = contact_corners(f.contacts);
+  const std::vector<LeafRef> coarse = coarse_gray_leaves_at(a, corners, depth);
+  if (coarse.empty()) return std::move(f.hints);
+  // Those leaves' cells combined again from A as it was, split down to the finest level
+  // around the contacts; the rest of the result stays as it is.
+  landed.undo(a, sa);
+  prepare_focus(corners);
+  const FocusCells focus(corners, depth);
+  Fragment again;
+  std::vector<Node> roots;
+  {
+    Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
+    CombineCounts counts;
+    Combiner comb(again, oa, ob, op, options.error, depth, stamp, 0, false, &focus, counts);
+    for (const LeafRef& l : coarse) roots.push_back(comb.run_at(l.cell));
+    stats.cells_visited += counts.cells_visited;
+    stats.gray_pairs += counts.gray_pairs;
+    stats.forced_subdivisions += counts.forced_subdivisions;
+  }
+  land(a, sa, f, root, stamp);
+  // The recombined cells' roots go where the coarse leaves were (the same slots: landing is
+  // deterministic). Their nodes land after the result's.
+  const auto node_base = static_cast<uint32_t>(a.nodes.size()), vertex_base = static_cast<uint32_t>(a.vertices.size());
+  for (const Node& n : again.nodes) a.nodes.push_back(Fragment::relocate(n, node_base, vertex_base));
+  a.vertices.insert(a.vertices.end(), again.vertices.begin(), again.vertices.end());
+  sa.resize(a.nodes.size(), stamp);
+  for (const auto& [slot, n] : again.pending) {
+    a.nodes[slot] = Fragment::relocate(n, node_base, vertex_base);
+    sa[slot] = stamp;
+  }
+  for (size_t i = 0; i < coarse.size(); ++i) {
+    a.nodes[coarse[i].node] = Fragment::relocate(roots[i], node_base, vertex_base);
+    sa[coarse[i].node] = stamp;
+  }
+  f.hints.insert(f.hints.end(), again.hints.begin(), again.hints.end());
   return std::move(f.hints);
 }
 

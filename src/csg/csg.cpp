@@ -141,7 +141,19 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
 
   const auto tc = Clock::now();
   const size_t before = a.nodes.size();
-  const std::vector<SignHint> hints = combine_stamped(a, sa, b, sb, pa, pb, op, options, depth, stamp, stats);
+  // Around contacts, both operands' cells holding them take part, with their contours.
+  const auto prepare_focus = [&](const std::vector<Lat>& points) {
+    if (stamp_holding(a, sa, stamp, points) > 0) {
+      pa = {};
+      partial_contour(a, sa, stamp, pa);
+    }
+    if (stamp_holding(b, sb, stamp, points) > 0) {
+      pb = {};
+      partial_contour(b, sb, stamp, pb);
+    }
+  };
+  const std::vector<SignHint> hints =
+      combine_stamped(a, sa, b, sb, pa, pb, op, options, depth, stamp, stats, prepare_focus);
   a.max_depth = depth;
   const auto tclean = Clock::now();
   {

@@ -244,7 +244,7 @@ CellQefs cell_qefs(const Operand& xa, const Side& a, const Operand& xb, const Si
 /// a virtual cell.
 Vec3 operand_vertex(const Operand& x, const Side& s, const Qef& q, const Cell& cell) {
   if (s.real) return vertex_unit(cell, x.t.vertices[x.t.nodes[s.node].index]);
-  return cell_vertex(q, cell, s.signs).position;
+  return cell_vertex(q, cell, s.signs, true).position;
 }
 
 }  // namespace pic::detail

@@ -109,12 +109,26 @@ std::vector<uint8_t> around_coarse_leaves(const Octree& t, const Stamps& stamps,
 /// is resampled into when such a polygon is all the surface it holds (a sphere's flat facet
 /// in a coarse leaf beside an unstamped one: with only the stamped leaves' polygons, a
 /// resampled cell had its sign change but no plane, and its vertex sat 9 cells off the facet).
+}  // namespace
+
 void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x) {
   const std::vector<uint8_t> around = around_coarse_leaves(t, stamps, stamp);
   contour_of(t, [&](uint32_t n) { return stamps[n] == stamp || (!around.empty() && around[n] != 0); }, x);
 }
 
-}  // namespace
+size_t stamp_holding(const Octree& t, Stamps& stamps, uint32_t stamp, const std::vector<Lat>& points) {
+  size_t fresh = 0;
+  std::function<void(uint32_t, const Cell&, const Lat&)> walk = [&](uint32_t node, const Cell& cell, const Lat& p) {
+    if (!cell.holds(p)) return;
+    fresh += stamps[node] != stamp;
+    stamps[node] = stamp;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c), p);
+  };
+  for (const Lat& p : points) walk(0, Cell{}, p);
+  return fresh;
+}
 
 void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, PartialContour& x) {
   // The polygons first, then their triangles in parallel into a vector sized once: a

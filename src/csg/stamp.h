@@ -10,6 +10,14 @@ namespace pic::detail {
 /// queries: a tree's contour around part of it.
 void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, PartialContour& x);
 
+/// An operand's partial contour: the dual polygons around its stamped cells and around the
+/// edges of its stamped coarse leaves.
+void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x);
+
+/// Stamps every node whose closed cell holds one of the lattice points; returns how many were
+/// not stamped yet.
+size_t stamp_holding(const Octree& t, Stamps& stamps, uint32_t stamp, const std::vector<Lat>& points);
+
 /// Stamps the cells where the operands' surfaces may meet (pairs where neither is uniform;
 /// under a gray leaf of A only B's cells that A's partial contour comes near) and builds both
 /// operands' partial contours. Sets stats.cells_stamped and the contour times.

@@ -1,7 +1,14 @@
 // The representative vertex of a gray cell (paper section 4, Figure 2).
 #include "octree/cell_vertex.h"
 
+#include <bit>
+
 namespace pic::detail {
+
+namespace {
+/// How much more than the QEF's minimum a tip corner's error may be, in cell sizes squared.
+constexpr double kTipTolerance = 1e-12;
+}  // namespace
 
 bool inside_cell(const Vec3& x, const Cell& cell) {
   const Vec3 m = cell.min_unit();
@@ -12,7 +19,7 @@ bool inside_cell(const Vec3& x, const Cell& cell) {
   return true;
 }
 
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
   if (q.empty()) {
@@ -34,6 +41,15 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs) {
   }
   const Vec3 hi{m[0] + s, m[1] + s, m[2] + s};
   Qef::Solution sol = q.solve_in_box({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, m, hi);
+  if (const int in = std::popcount(signs); tip_at_corner && sol.rank < 3 && (in == 1 || in == 7)) {
+    // A tip: one corner apart from the other seven. Where the planes leave the vertex free
+    // (a face or a crease) and pass through that corner, the surface meets there (two parts
+    // touching at a lattice point): the vertex belongs at the corner, not at the point of the
+    // feature nearest the cell's centre, which may be half a cell away from any surface.
+    const int c = std::countr_zero(unsigned(in == 1 ? signs : uint8_t(~signs)));
+    const Vec3 p{m[0] + (c & 1) * s, m[1] + ((c >> 1) & 1) * s, m[2] + ((c >> 2) & 1) * s};
+    if (const double e = q.error(p); e <= sol.error + kTipTolerance * s * s) return {p, e, sol.rank};
+  }
   if (inside_cell(sol.position, cell)) return sol;
   // Reseed from the corner closest to the surface (smallest QEF value).
   int best = 0;

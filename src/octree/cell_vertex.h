@@ -10,8 +10,11 @@ namespace pic::detail {
 
 /// The vertex of a gray cell: QEF minimum seeded at the centre, then at the corner with the
 /// smallest error when the first solution leaves the cell (paper Figure 2). With no planes at
-/// all, the mass point of the sign-changing edges' midpoints.
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs);
+/// all, the mass point of the sign-changing edges' midpoints. With `tip_at_corner`, a cell whose
+/// one corner differs from the other seven takes that corner as its vertex when the planes pass
+/// through it and leave the vertex free: two parts touching at a lattice point, as a Boolean
+/// meets them.
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner = false);
 bool inside_cell(const Vec3& x, const Cell& cell);
 
 }  // namespace pic::detail

@@ -19,6 +19,7 @@
 namespace pic {
 
 using namespace detail;
+using Lat = std::array<int64_t, 3>;
 
 double detail::plane_spread(const TriMesh& mesh) {
   Vec3 n{0, 0, 0}, origin{0, 0, 0};
@@ -137,6 +138,28 @@ SampleParams params_of(const SampleOptions& options) {
   return p;
 }
 
+/// A leaf of a sampled tree sampled again from the input, split down to the finest level
+/// around lattice point p (refine_around); `winding`: the source when it carries winding numbers.
+Builder resample_from_input(const SurfaceSource& src, const WindingSource* winding, const Octree& t,
+                            const LeafRef& leaf, const Lat& p, double error) {
+  std::vector<uint32_t> all(src.tris().size()), idx;
+  for (uint32_t k = 0; k < all.size(); ++k) all[k] = k;
+  filter_tris(src.tris(), all, leaf.cell, idx);
+  SampleParams params;
+  params.max_depth = t.max_depth;
+  params.error = error;
+  params.has_focus = true;
+  params.focus = p;
+  Wind8 wind{};
+  if (winding)
+    for (int c = 0; c < 8; ++c) wind[c] = winding->ray_winding(lattice_to_grid(leaf.cell.corner(c)));
+  Builder sub;
+  sub.nodes.resize(1);
+  size_t capped = 0;
+  sample_cell(src, params, leaf.cell, signs_of(t.nodes[leaf.node]), idx, sub, 0, capped, winding ? &wind : nullptr);
+  return sub;
+}
+
 /// Runs the sampler from the root and assembles the tree.
 Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
                    const Wind8* root_wind, size_t& capped) {
@@ -176,7 +199,10 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
     const double s = c.size();
     region.boxes.push_back({{lo[0] - s, lo[1] - s, lo[2] - s}, {lo[0] + 2 * s, lo[1] + 2 * s, lo[2] + 2 * s}});
   }
-  settle_sampled(tree, region);
+  const ResampleLeaf from_input = [&](const LeafRef& l, const Lat& p) {
+    return resample_from_input(src, &src, tree, l, p, options.error);
+  };
+  settle_sampled(tree, region, &from_input);
   if (tree.vertices.empty())
     throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
   return tree;
@@ -222,9 +248,18 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     if (clean.defects.boundary_edges > 0 || clean.defects.nonmanifold_edges > 0) check_closed(clean.mesh);
     const std::vector<ITri> tris = grid_triangles(clean.mesh.triangles, grid);
     // Root corners are outside: the mesh lies strictly inside the cube.
-    tree = sample_tree(MeshSource(tris), options, cube, 0, nullptr, capped);
-    // Leaves at the depth cap may hold two components; make each hold one (see topology.h).
-    if (capped > 0 && enforce_one_component(tree, nullptr).flipped > 0) repair_cracks(tree, nullptr);
+    const MeshSource src(tris);
+    tree = sample_tree(src, options, cube, 0, nullptr, capped);
+    // Leaves at the depth cap may hold two components; make each hold one, splitting coarser
+    // leaves at the corners that change sign first.
+    const ResampleLeaf from_input = [&](const LeafRef& l, const Lat& p) {
+      return resample_from_input(src, nullptr, tree, l, p, options.error);
+    };
+    const std::function<void(const Lat&)> refine = [&](const Lat& p) {
+      refine_around(tree, p, from_input, [](uint32_t) {});
+    };
+    if (capped > 0 && enforce_one_component(tree, nullptr, nullptr, nullptr, false, &refine).flipped > 0)
+      repair_cracks(tree, nullptr);
   } else {
     tree = sample_winding(clean, grid, options, cube, st, capped);
   }
@@ -269,7 +304,10 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
   if (spacing > 0) opt.depth = std::clamp(int(std::ceil(std::log2(2 / spacing))), 1, options.depth);
   size_t capped = 0;
   Octree tree = sample_tree(src, opt, cube, signs, nullptr, capped);
-  settle_sampled(tree, SettleRegion{});
+  const ResampleLeaf from_input = [&](const LeafRef& l, const Lat& p) {
+    return resample_from_input(src, nullptr, tree, l, p, opt.error);
+  };
+  settle_sampled(tree, SettleRegion{}, &from_input);
   if (tree.vertices.empty())
     throw InvalidInput("point cloud encloses no solid: its winding number never reaches 1/2 (normals pointing inward?)");
   if (stats) {

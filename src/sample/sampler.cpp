@@ -275,7 +275,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     Qef q;
     cell_qef(src.tris(), idx, cell, q);
     src.add_fill_planes(cell, signs, wind, idx, q);
-    const Qef::Solution sol = cell_vertex(q, cell, signs);
+    const Qef::Solution sol = cell_vertex(q, cell, signs, p.tips_at_corners);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
                     !has_double_crossing(src.tris(), idx, cell, signs, p.memo_id);
     if (ok || at_cap) {

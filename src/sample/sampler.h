@@ -96,6 +96,7 @@ struct SampleParams {
   /// max_depth, so that the leaves around that point are finest cells.
   bool has_focus = false;
   std::array<int64_t, 3> focus{0, 0, 0};
+  bool tips_at_corners = false;  ///< cell_vertex's tip_at_corner (Booleans' touching parts)
 };
 
 /// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped,

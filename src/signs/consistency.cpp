@@ -808,10 +808,12 @@ bool grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, co
         continue;
       }
       // A point is on the boundary of every leaf around it; with coarse_rim it need not be
-      // a corner of a leaf one level coarser (its sign then is the finer side's alone). Not
-      // of coarser ones: the speck's leaves become uniform, and a big leaf's surface is no speck.
+      // a corner of a leaf one level coarser (its sign then is the finer side's alone). No
+      // leaf may be coarser than that: the speck's leaves become uniform, and a big leaf's
+      // surface is no speck (two parts' corners meeting at the point, seen from the big
+      // leaves of one of them).
       const bool corner = cell.corner_index(q) >= 0;
-      ok = n.kind == CellKind::Gray && (corner || (coarse_rim && cell.level >= t.max_depth - 1));
+      ok = n.kind == CellKind::Gray && cell.level >= t.max_depth - 1 && (corner || coarse_rim);
       if (!ok) break;
       coarse = coarse || !corner;
       touched = touched || !active || (*active)(node);

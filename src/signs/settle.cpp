@@ -54,11 +54,14 @@ std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
 
 }  // namespace
 
-void settle_sampled(Octree& tree, const SettleRegion& region) {
+void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample) {
   std::vector<uint8_t> in;
   if (!region.everywhere) in = nodes_in(tree, region);
   const std::function<bool(uint32_t)> active = [&](uint32_t n) { return in[n] != 0; };
-  const std::function<void(uint32_t)> touched = [&](uint32_t n) { in[n] = 1; };
+  const std::function<void(uint32_t)> touched = [&](uint32_t n) {
+    if (n >= in.size()) in.resize(tree.nodes.size(), 0);
+    in[n] = 1;
+  };
   SettlePlan plan;
   plan.active = region.everywhere ? nullptr : &active;
   plan.touched = region.everywhere ? nullptr : &touched;
@@ -66,6 +69,9 @@ void settle_sampled(Octree& tree, const SettleRegion& region) {
   // Where |w| hovers at 1/2 (an open part's end inside another part) the level set leaves
   // specks a cell across, closed shells or voids of a few triangles: resolution noise.
   plan.specks = {tree.max_depth - 1, true};
+  const std::function<void(uint32_t)> ignore = [](uint32_t) {};
+  if (resample)
+    plan.refine = [&](const std::array<int64_t, 3>& p) { refine_around(tree, p, *resample, region.everywhere ? ignore : touched); };
   PinnedPoints pinned;
   settle(tree, plan, pinned);
 }

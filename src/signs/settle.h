@@ -9,6 +9,7 @@
 
 #include "geometry/box_tree.h"
 #include "signs/consistency.h"
+#include "signs/refine.h"
 
 namespace pic::detail {
 
@@ -42,6 +43,7 @@ struct SettleRegion {
 /// Settles a sampled tree whose signs may change inside uniform leaves (a winding number's
 /// level set can cross a cell without touching its corners): finer neighbours can then show
 /// islands and cracks on their faces. Visits the region, plus every leaf a flip touched.
-void settle_sampled(Octree& tree, const SettleRegion& region);
+/// With `resample`, a flip at the corner of a coarser leaf splits it first (refine_around).
+void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample = nullptr);
 
 }  // namespace pic::detail
