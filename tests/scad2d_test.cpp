@@ -509,6 +509,25 @@ TEST(ScadImport, SvgShapesUnitsAndTransforms) {
   EXPECT_THROW(outline_of("import(file = \"" + (dir / "bad.svg").string() + "\");"), InvalidInput);
 }
 
+// SVG paths with cubic and quadratic Beziers (smooth and relative forms too), elliptical arcs
+// (turned, large, scaled up to reach), circles and ellipses, against OpenSCAD 2021.01's area of
+// the same import (its SVG export, by the shoelace formula). Its import cuts a Bezier into 20
+// pieces and a circle into 40 and an arc by the angle it turns, whatever $fn, $fa and $fs say:
+// three settings, one answer.
+TEST(ScadImport, SvgCurvesAndArcsAsOpenScadFlattensThem) {
+  const std::pair<const char*, double> drawings[] = {
+      {"svg_curves_beziers.svg", 4087.39067723},
+      {"svg_curves_relative.svg", 5352.617729325},
+      {"svg_curves_arcs.svg", 2180.680598478499},
+  };
+  for (const auto& [name, openscad_area] : drawings)
+    for (const char* settings : {"$fn = 0, $fa = 12, $fs = 2", "$fn = 12, $fa = 12, $fs = 2", "$fn = 0, $fa = 2, $fs = 0.2"}) {
+      const std::string file = std::string(PIC_SCAD_DATA_DIR) + "/" + name;
+      const Outline o = outline_of("import(file = \"" + file + "\", " + settings + ");");
+      EXPECT_LT(relative(area(o), openscad_area), 1e-5) << name << " with " << settings;
+    }
+}
+
 // The 2D rounded rectangle: a 10 x 4 rectangle plus a 16-gon of radius 1 (vertices at 0, 22.5,
 // ... degrees: 2 wide and 2 high) is the rectangle, a 1-wide strip along each side and the
 // 16-gon's area at the corners; moved once by the translation.

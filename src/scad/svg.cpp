@@ -25,9 +25,12 @@ Map compose(const Map& m, const Map& n) {  // m * n
 }
 P2 map_point(const Map& m, const P2& p) { return {m[0] * p[0] + m[2] * p[1] + m[4], m[1] * p[0] + m[3] * p[1] + m[5]}; }
 
-// Straight pieces per curve and arc, and per circle or ellipse (OpenSCAD 2021's exports).
+// Straight pieces per Bezier curve, and per circle or ellipse; an arc's count grows with the
+// angle it turns: 4, and one more per 18 degrees (OpenSCAD 2021's imports, whatever $fn, $fa
+// and $fs say).
 constexpr int kCurvePieces = 20;
 constexpr int kCirclePieces = 40;
+int arc_pieces(double radians) { return int(std::floor(4 + std::abs(radians) * 10 / std::numbers::pi)); }
 
 // Numbers in SVG syntax: "1.5e-3", "-2", ".5.5" (two numbers), separated by spaces or commas.
 class Numbers {
@@ -144,10 +147,11 @@ std::vector<Ring> parse_path(const std::string& d) {
     double dt = angle((x1 - cx1) / rx, (y1 - cy1) / ry, (-x1 - cx1) / rx, (-y1 - cy1) / ry);
     if (!sweep && dt > 0) dt -= 2 * std::numbers::pi;
     if (sweep && dt < 0) dt += 2 * std::numbers::pi;
-    for (int j = 1; j <= kCurvePieces; ++j) {
-      const double t = t1 + dt * j / kCurvePieces;
-      line_to(j == kCurvePieces ? p : P2{cx + rx * std::cos(t) * c - ry * std::sin(t) * s,
-                                          cy + rx * std::cos(t) * s + ry * std::sin(t) * c});
+    const int pieces = arc_pieces(dt);
+    for (int j = 1; j <= pieces; ++j) {
+      const double t = t1 + dt * j / pieces;
+      line_to(j == pieces ? p : P2{cx + rx * std::cos(t) * c - ry * std::sin(t) * s,
+                                    cy + rx * std::cos(t) * s + ry * std::sin(t) * c});
     }
   };
   Numbers n(d);
