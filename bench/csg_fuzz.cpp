@@ -1,4 +1,4 @@
-// Randomized CSG harness (issue 10): random rotated and scaled primitives and the meshes in
+// Randomized CSG harness: random rotated and scaled primitives and the meshes in
 // data/, random operations and chains of them; each PIC result is compared with CGAL's exact
 // Boolean of the operands' own contours (tests/support/exact_csg.h): component counts, the two
 // one-sided distances in finest cells, volumes. Prints one line per case and the worst cases
@@ -131,7 +131,7 @@ CaseResult run_case(uint64_t seed, int fixed_depth, const std::string& out_dir) 
   return res;
 }
 
-/// Two meshes (a real pair, e.g. the Thingi10K difference of issue 10) sampled in the cube
+/// Two meshes (a real pair, e.g. the Thingi10K difference pair) sampled in the cube
 /// around both. The exact reference does not check its inputs for self-intersections here:
 /// CGAL then corefines what it can, and the distances far from a crossing still hold.
 CaseResult run_pair(const std::string& pa, CsgOp op, const std::string& pb, int depth, const std::string& out_dir) {

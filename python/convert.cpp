@@ -107,7 +107,6 @@ std::optional<pic::Cube> to_cube(py::handle obj) {
 
 py::tuple from_cube(const pic::Cube& c) { return py::make_tuple(c.origin[0], c.origin[1], c.origin[2], c.size); }
 
-#ifdef PIC_HAS_RENDER
 py::array_t<uint8_t> from_image(const pic::Image& img) {
   py::array_t<uint8_t> a({py::ssize_t{img.height}, py::ssize_t{img.width}, py::ssize_t{3}});
   if (!img.rgb.empty()) std::memcpy(a.mutable_data(), img.rgb.data(), img.rgb.size());
@@ -127,6 +126,5 @@ pic::Image to_image(py::handle obj) {
   img.rgb.assign(d.data(), d.data() + d.size());
   return img;
 }
-#endif
 
 }  // namespace pic_python

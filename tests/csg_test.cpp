@@ -387,9 +387,7 @@ TEST(Csg, CadToolMatchesTheExactSolid) {
   for (const Vec3& p : m.positions) worst = std::max(worst, std::abs(sdf(p)));
   std::printf("  [measure] CAD tool: %.3g of the root cube from the exact solid\n", worst);
   EXPECT_LT(worst, 2e-4);
-  // Stamps grow per operation and are never reset.
-  EXPECT_LT(stats[0].stamp, stats[1].stamp);
-  EXPECT_LT(stats[1].stamp, stats[2].stamp);
+  // Each operation stamps its own cells (in arrays of its own: no state carried between calls).
   for (const auto& s : stats) EXPECT_GT(s.cells_stamped, 0u);
 }
 

@@ -96,7 +96,7 @@ TEST(Eval, FlatLeafIsEmpty) { expect_volume(eval_file("flat_leaf.csg"), 1000, 1e
 
 // A sphere's flat facets sample into coarse leaves, which a Boolean nearby subdivides and
 // resamples from the sphere's partial contour. Two ways that went wrong, both at depth 10 and
-// in these models' own cubes (found by bench/scad_fuzz.py, seed 187), both measured against
+// in these models' own cubes (found by bench/scad_fuzz.py), both measured against
 // OpenSCAD's render of the same model:
 // - facet_minus_inner_sphere: a resampled cell at a coarse leaf's corner held only polygons of
 //   unstamped neighbours, which the partial contour kept for parity walks alone: its sign

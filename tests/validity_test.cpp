@@ -1,4 +1,4 @@
-// Valid solids out (issue 10): the exact self-intersection count on hand-made cases, and every
+// Valid solids out: the exact self-intersection count on hand-made cases, and every
 // mesh PIC writes — contours of the bundled models, CSG results, a sculpting run — with no
 // self-intersecting triangle pair and no non-manifold vertex or edge.
 #include <gtest/gtest.h>
@@ -350,7 +350,7 @@ TEST(Validity, CoarseSidesAreSplitAtTheirFace) {
   expect_construction_keeps_the_surface(t, input, 0.6, "suzanne depth 12");
 }
 
-// The Thingi10K difference pair of issue 10 (1706459 − 1514499, both sampled in one cube). The
+// The Thingi10K difference pair (1706459 − 1514499, both sampled in one cube). The
 // meshes are not in this repository: the test runs where PIC_THINGI_DIR (or the workplace's
 // shared data folder) holds them, and is skipped elsewhere.
 TEST(Validity, ThingiDifferencePair) {

@@ -4,12 +4,8 @@
 #include <memory>
 
 #include "cli.h"
-#ifdef PIC_HAS_RENDER
 #include "pic/render.h"
-#endif
-#ifdef PIC_HAS_VIEWER
 #include "pic/viewer.h"
-#endif
 
 namespace pic::cli {
 
@@ -21,8 +17,7 @@ struct RenderArgs {
   double half_extent = 0;
 };
 
-void run_render([[maybe_unused]] const RenderArgs& a) {
-#ifdef PIC_HAS_RENDER
+void run_render(const RenderArgs& a) {
   RenderOptions ro;
   const auto wh = parse_numbers(a.size, 2, "--size W,H");
   if (wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384) throw InvalidInput("--size must be 1..16384");
@@ -50,9 +45,6 @@ void run_render([[maybe_unused]] const RenderArgs& a) {
     mesh = read_mesh(a.in);
     write_png(render(mesh, nullptr, ro), a.out);
   }
-#else
-  throw std::runtime_error("this build has no renderer");
-#endif
 }
 
 struct ViewArgs {
@@ -60,15 +52,11 @@ struct ViewArgs {
   int depth = 12;
 };
 
-void run_view([[maybe_unused]] const ViewArgs& a) {
-#ifdef PIC_HAS_VIEWER
+void run_view(const ViewArgs& a) {
   TriMesh mesh;
   const Octree tree = load_any(a.in, a.depth, &mesh);
   const size_t bytes = is_pic_path(a.in) ? std::filesystem::file_size(a.in) : 0;
   write_text(a.out, view_html(mesh, &tree, info_json(tree, bytes)));
-#else
-  throw std::runtime_error("this build has no viewer");
-#endif
 }
 }  // namespace
 

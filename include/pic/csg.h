@@ -34,7 +34,7 @@ struct CsgStats {
   size_t gray_pairs = 0;         ///< gray/gray evaluations (GraycellCSG)
   size_t forced_subdivisions = 0;
   size_t repaired = 0;           ///< uniform leaves turned gray to keep the surface closed
-  uint32_t stamp = 0;            ///< this operation's timestamp
+  uint32_t stamp = 0;            ///< this operation's number in its chain (1 for a single one)
   bool resampled_b = false;      ///< B was re-expressed in A's cube
 };
 

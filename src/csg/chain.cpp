@@ -1,5 +1,6 @@
 // Chains of Booleans over PIC objects and meshes (pic csg, Python's csg_meshes).
 #include "pic/csg.h"
+#include "octree/cell.h"
 
 #include <algorithm>
 
@@ -41,9 +42,11 @@ Octree csg_chain(std::vector<CsgOperand> operands, const std::vector<CsgOp>& ops
     const Octree b = take(k + 1);
     say(to_string(ops[k]) + " " + operands[k + 1].name);
     CsgStats st;
-    acc = csg(acc, b, ops[k], options.csg, &st);
+    csg_inplace(acc, b, ops[k], options.csg, &st);  // no copy of the result per step
+    st.stamp = uint32_t(k + 1);
     if (options.on_step) options.on_step(k + 1, st);
   }
+  if (acc.nodes.size() > detail::reachable_nodes(acc)) detail::compact(acc);
   return acc;
 }
 

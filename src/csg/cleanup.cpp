@@ -1,4 +1,4 @@
-// The CSG clean-up: see csg_cleanup.h.
+// The CSG clean-up: see cleanup.h.
 #include "csg/cleanup.h"
 
 #include "csg/refine.h"
@@ -15,8 +15,8 @@ using Lat = std::array<int64_t, 3>;
 /// over the sign changes its finer neighbours show on its faces. The island and face passes
 /// take every gray leaf for a cell whose faces must look like one cell's, so they "fixed" those
 /// neighbours' signs to the repair's uniform ones: where an operand's repair leaf was copied
-/// into the result, that carved a slit as deep as the leaf into a flat face of the operand
-/// (issue 10, the Thingi10K pair). repair_cracks after the passes gives the leaves back their
+/// into the result, that carved a slit as deep as the leaf into a flat face of the operand.
+/// repair_cracks after the passes gives the leaves back their
 /// vertices where they still border a sign change.
 void withdraw_crack_repairs(Octree& t, uint32_t node, const std::function<bool(uint32_t)>& active) {
   if (!active(node)) return;
@@ -56,8 +56,8 @@ struct HintedFlip {
 /// Whether setting corner k of a coarser leaf to `inside` would strand a finer point on one of
 /// its edges or faces through that corner: a point of the other sign on an edge or face whose
 /// corners all have this sign is an island, which the island pass then flips too, carrying
-/// the hint along the whole edge or face (seed 56: 3 points along a 4-cell leaf's edge, the
-/// surface 1.41 cells out). Faces wider than kMaxCheckedFace finest cells are not searched.
+/// the hint along the whole edge or face (3 points along a 4-cell leaf's edge, the surface
+/// 1.41 cells out). Faces wider than kMaxCheckedFace finest cells are not searched.
 bool strands_finer_points(const Octree& t, const LeafRef& big, int k, bool inside) {
   constexpr int64_t kMaxCheckedFace = 32;
   const int64_t step = int64_t{1} << (kMaxLevel - t.max_depth);
@@ -117,7 +117,7 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
 /// Sets the hinted signs (sign_hint) where every leaf around the point is stamped and has it
 /// as a corner and the flip leaves fewer leaves of more than one component around it. Some
 /// flips leave one for the one-component pass (the next point along an oblique slab; asking
-/// for none keeps seeds 30 and 82 cut). The points set are pinned: enforce_one_component then
+/// for none leaves such slabs cut). The points set are pinned: enforce_one_component then
 /// undoes them only when nothing else will do.
 void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::function<bool(uint32_t)>& stamped,
                       PinnedPoints& pinned, const std::function<void(const Lat&)>& refine) {
@@ -143,7 +143,7 @@ void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::ve
   const ResampleLeaf from_contour = [&](const LeafRef& l, const Lat& q) { return resample_from_contour(a, l, q, error); };
   const std::function<void(const Lat&)> refine = [&](const Lat& p) { refine_around(a, p, from_contour, stamp_it); };
   // Crack repairs of the operands are redone on the result: as gray leaves they would pass
-  // for coarse neighbours that finer sign changes contradict (issue 10's slit).
+  // for coarse neighbours that finer sign changes contradict (a slit in a flat face).
   withdraw_crack_repairs(a, 0, stamped);
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.

@@ -14,7 +14,6 @@
 // path from the leaf's most reliable corner through its partial contour), and the result's
 // sign is op(sign_A, sign_B). Vertex positions only decide accuracy.
 #include <algorithm>
-#include <atomic>
 #include <functional>
 #include <optional>
 
@@ -27,34 +26,6 @@ namespace pic {
 namespace detail {
 namespace {
 
-std::atomic<uint32_t> g_timestamp{0};
-
-
-/// Drops unreachable nodes and vertices (left behind by in-place replacement).
-void compact(Octree& t) {
-  Octree c;
-  c.cube = t.cube;
-  c.max_depth = t.max_depth;
-  c.nodes.clear();
-  c.nodes.reserve(t.nodes.size());
-  c.nodes.push_back(Node{});
-  std::function<void(uint32_t, uint32_t)> copy = [&](uint32_t from, uint32_t to) {
-    Node n = t.nodes[from];
-    if (n.kind == CellKind::Gray) {
-      c.vertices.push_back(t.vertices[n.index]);
-      n.index = static_cast<uint32_t>(c.vertices.size() - 1);
-    } else if (n.kind == CellKind::Internal) {
-      const auto first = static_cast<uint32_t>(c.nodes.size());
-      c.nodes.resize(first + 8);
-      for (int k = 0; k < 8; ++k) copy(n.index + k, first + k);
-      n.index = first;
-    }
-    c.nodes[to] = n;
-  };
-  copy(0, 0);
-  t.nodes = std::move(c.nodes);
-  t.vertices = std::move(c.vertices);
-}
 
 /// One frame: B re-expressed in A's cube when they differ (its contour resampled). When B's
 /// surface does not fit in A's cube, both are resampled into the cube around both cubes (A then
@@ -94,17 +65,6 @@ std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptio
 
 }  // namespace
 
-size_t reachable_nodes(const Octree& t) {
-  size_t n = 0;
-  std::function<void(uint32_t)> walk = [&](uint32_t i) {
-    ++n;
-    if (t.nodes[i].kind == CellKind::Internal)
-      for (int c = 0; c < 8; ++c) walk(t.nodes[i].index + c);
-  };
-  walk(0);
-  return n;
-}
-
 }  // namespace detail
 
 std::string to_string(CsgOp op) {
@@ -131,7 +91,8 @@ void csg_inplace(Octree& a, const Octree& b_in, CsgOp op, const CsgOptions& opti
   const Octree& b = resampled ? *resampled : b_in;
   const int depth = std::max(a.max_depth, b.max_depth);
 
-  const uint32_t stamp = ++g_timestamp;
+  // Stamps live in this operation's own per-node arrays (sa, sb): one value marks its cells.
+  constexpr uint32_t stamp = 1;
   stats.stamp = stamp;
   // The cells this operation works on, per node of each operand: kept here, not in the
   // trees, so that csg(a, b) only reads b.

@@ -72,8 +72,8 @@ int corner_to_join(const HalfwaySigns& h, uint8_t sr, bool inside) {
 /// A finest leaf whose corner signs make more than one component (corners of one sign meeting
 /// only diagonally): the clean-up must flip a corner, and its default (flip the minority sign)
 /// erases a solid or a gap about a cell thick lying obliquely to the lattice, whose lattice
-/// points meet only diagonally (harness seed 30: a box face and a torus meeting at a shallow
-/// angle, a slab 1-2 cells thick cut to pieces; seed 82). The operands know better: the
+/// points meet only diagonally (a box face and a torus meeting at a shallow angle: a slab 1-2
+/// cells thick cut to pieces). The operands know better: the
 /// result's sign half-way between two such corners says whether the solid (or the gap) joins
 /// them. When it joins all the corners of one sign, the hint flips a corner of the other sign
 /// to it. Nothing when it joins neither (a feature thinner than a cell).

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <chrono>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
@@ -14,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "geometry/bvh.h"
+#include "geometry/stopwatch.h"
 #include "geometry/key_bits.h"
 #include "contour/dual_walk.h"
 #include "csg/cleanup.h"
@@ -23,8 +23,6 @@
 namespace pic::detail {
 
 using Lat = std::array<int64_t, 3>;
-using Clock = std::chrono::steady_clock;
-inline double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 
 inline bool apply(CsgOp op, bool a, bool b) {

@@ -82,8 +82,8 @@ void mark_touching_edges(const Octree& t, uint32_t node, const Cell& cell, const
 /// inside such a leaf come from crossing parity with the contour triangles in its cell, and a
 /// dual polygon of finer neighbours (none of them stamped) can cut through a corner of that
 /// cell. Without those triangles the parity is wrong over part of the cell (a box's coarse
-/// leaf took a cone's tip for outside the box: a stray shell 4 cells from the exact result,
-/// harness seed 81). Only cells at the leaf's edges matter: a polygon's vertices lie in their
+/// leaf took a cone's tip for outside the box: a stray shell 4 cells from the exact result).
+/// Only cells at the leaf's edges matter: a polygon's vertices lie in their
 /// cells, and cells that touch only the inside of one face all lie beyond that face's plane,
 /// and so do their polygons. A flag per node (none when no such leaf is stamped): a hash set
 /// of the nodes along the leaves' edges was slower.

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <functional>
 
 #include "octree/cell.h"
 
@@ -22,6 +23,43 @@ Node append_subtree(std::vector<Node>& nodes, std::vector<std::array<float, 3>>&
   }
   vertices.insert(vertices.end(), sub.vertices.begin(), sub.vertices.end());
   return root;
+}
+
+/// Drops unreachable nodes and vertices (left behind by in-place replacement).
+void compact(Octree& t) {
+  Octree c;
+  c.cube = t.cube;
+  c.max_depth = t.max_depth;
+  c.nodes.clear();
+  c.nodes.reserve(t.nodes.size());
+  c.nodes.push_back(Node{});
+  std::function<void(uint32_t, uint32_t)> copy = [&](uint32_t from, uint32_t to) {
+    Node n = t.nodes[from];
+    if (n.kind == CellKind::Gray) {
+      c.vertices.push_back(t.vertices[n.index]);
+      n.index = static_cast<uint32_t>(c.vertices.size() - 1);
+    } else if (n.kind == CellKind::Internal) {
+      const auto first = static_cast<uint32_t>(c.nodes.size());
+      c.nodes.resize(first + 8);
+      for (int k = 0; k < 8; ++k) copy(n.index + k, first + k);
+      n.index = first;
+    }
+    c.nodes[to] = n;
+  };
+  copy(0, 0);
+  t.nodes = std::move(c.nodes);
+  t.vertices = std::move(c.vertices);
+}
+
+size_t reachable_nodes(const Octree& t) {
+  size_t n = 0;
+  std::function<void(uint32_t)> walk = [&](uint32_t i) {
+    ++n;
+    if (t.nodes[i].kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) walk(t.nodes[i].index + c);
+  };
+  walk(0);
+  return n;
 }
 
 void Builder::splice(uint32_t slot, const Builder& sub) {

@@ -78,6 +78,11 @@ struct Builder {
 /// (for the caller to place).
 Node append_subtree(std::vector<Node>& nodes, std::vector<std::array<float, 3>>& vertices, const Builder& sub);
 
+/// Nodes reachable from the root (a tree edited in place keeps replaced subtrees in its arrays).
+size_t reachable_nodes(const Octree& t);
+/// Drops unreachable nodes and vertices (left behind by in-place replacement).
+void compact(Octree& t);
+
 /// World position of a cell-local vertex.
 inline Vec3 vertex_unit(const Cell& cell, const std::array<float, 3>& local) {
   const Vec3 m = cell.min_unit();

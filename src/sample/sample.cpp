@@ -7,6 +7,7 @@
 #include "mesh/clean.h"
 #include "signs/invariants.h"
 #include "signs/settle.h"
+#include "geometry/stopwatch.h"
 #include "geometry/vec3.h"
 
 #include <algorithm>
@@ -227,7 +228,7 @@ std::optional<InsideMode> parse_inside_mode(const std::string& s) {
 }
 
 Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   check_options(options);
   check_mesh(mesh);
   const Cube cube = checked_cube(options, mesh.positions);
@@ -270,7 +271,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     st.depth = options.depth;
     st.max_depth = options.depth;
     st.error = options.error;
-    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    st.seconds = since(t0);
     *stats = st;
   }
   PIC_CHECK_OCTREE(tree, "sampling a mesh");
@@ -278,7 +279,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
 }
 
 Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   check_options(options);
   if (cloud.positions.empty()) throw InvalidInput("point cloud has no points");
   if (cloud.normals.size() != cloud.positions.size())
@@ -320,7 +321,7 @@ Octree sample(const PointCloud& cloud, const SampleOptions& options, SampleStats
     stats->capped = capped;
     stats->classifier = "points";
     stats->depth = opt.depth;
-    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats->seconds = since(t0);
   }
   PIC_CHECK_OCTREE(tree, "sampling a point cloud");
   return tree;

@@ -5,12 +5,12 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <fstream>
 #include <mutex>
 #include <optional>
 #include <sstream>
 
+#include "geometry/stopwatch.h"
 #include "geometry/vec3.h"
 #include "pic/pic.h"
 #include "sample/sampler.h"
@@ -20,8 +20,8 @@ namespace pic {
 namespace {
 
 using namespace detail::scad;
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using detail::Clock;
+using detail::since;
 
 // Hull input: the vertices of the leaves, when the subtree is only unions (and hulls) of them.
 bool hull_points(const Solid& s, std::vector<Vec3>& out) {

@@ -6,16 +6,16 @@
 #include <sstream>
 
 #include "pic/scad.h"
+#include "geometry/stopwatch.h"
 #include "io/file_util.h"
 #include "scad/lower.h"
 
-#include <chrono>
 
 namespace pic {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using detail::Clock;
+using detail::since;
 
 bool on_path(const std::string& prog) {
   const char* p = std::getenv("PATH");

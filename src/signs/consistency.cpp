@@ -643,7 +643,7 @@ namespace {
 /// Whether a flip leaves a coarser gray leaf without a sign change: its surface is gone and
 /// only a crack repair's vertex is left, whose faces the island pass then clears of the finer
 /// side's sign changes too. At the thin end of a wedge that erodes the wedge by a cell or two
-/// (harness seeds 263, 265: 1.5 and 1.9 finest cells where the exact solid is a cell thick).
+/// (1.5 to 2 finest cells gone where the exact solid is a cell thick).
 bool emptied_coarse_leaf(const Octree& t, const Around& a, uint8_t flipped) {
   return a.cell.level < t.max_depth && t.nodes[a.node].kind == CellKind::Gray && (flipped == 0 || flipped == 0xff);
 }
@@ -715,8 +715,8 @@ namespace {
 constexpr size_t kMaxSpeckPoints = 4;
 
 /// How thin, in finest cells, a speck that reaches a coarser leaf must be to be removed: two
-/// surfaces passing within a fraction of a cell of each other (harness seed 300: a void a
-/// quarter cell thick) are; a piece a cell thick is a feature.
+/// surfaces passing within a fraction of a cell of each other (a void a quarter cell thick)
+/// are; a piece a cell thick is a feature.
 constexpr double kMaxSpeckThickness = 0.5;
 
 /// The extent of points across their flattest direction (the smallest principal axis).
@@ -833,8 +833,8 @@ bool grow_speck(const Octree& t, const std::function<bool(uint32_t)>* active, co
     }
   }
   if (!ok || !touched) return false;
-  // Beside a coarser leaf the region may be a small real piece (harness seed 43: 4 cells
-  // across, a component of the exact result too); only a flat one is the Boolean's noise.
+  // Beside a coarser leaf the region may be a small real piece (4 cells across, a component
+  // of the exact result too); only a flat one is the Boolean's noise.
   if (coarse && thickness(vertices) * double(int64_t{1} << t.max_depth) >= kMaxSpeckThickness) return false;
   std::sort(sp.leaves.begin(), sp.leaves.end());
   sp.leaves.erase(std::unique(sp.leaves.begin(), sp.leaves.end()), sp.leaves.end());

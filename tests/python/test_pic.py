@@ -1,4 +1,4 @@
-"""Tests of the `pic` Python module (issue 12), run by ctest as `python_tests`.
+"""Tests of the `pic` Python module, run by ctest as `python_tests`.
 
 Environment (set by tests/CMakeLists.txt): PYTHONPATH=build/python, PIC_DATA_DIR (data/),
 PIC_CLI (build/pic, for the round trips against the C++ results), PIC_EXAMPLES_DIR,

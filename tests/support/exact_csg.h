@@ -1,4 +1,4 @@
-// The exact reference for PIC's CSG (issue 10): CGAL's corefinement Boolean of the operands'
+// The exact reference for PIC's CSG: CGAL's corefinement Boolean of the operands'
 // own contours, and the comparison of PIC's result with it. Test-only (CGAL is a test
 // dependency); shared by tests/csg_regression_test.cpp and the randomized harness
 // bench/csg_fuzz.cpp.

@@ -1,4 +1,4 @@
-// The Thingi10K difference pair of issue 10 (1706459 and 1514499, already placed in one
+// The Thingi10K difference pair (1706459 and 1514499, already placed in one
 // frame). Its meshes are not in this repository: tests find them where PIC_THINGI_DIR (or the
 // workplace's shared data folder) points, and skip elsewhere.
 #pragma once
