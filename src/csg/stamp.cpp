@@ -120,9 +120,9 @@ size_t stamp_holding(const Octree& t, Stamps& stamps, uint32_t stamp, const std:
   size_t fresh = 0;
   std::function<void(uint32_t, const Cell&, const Lat&)> walk = [&](uint32_t node, const Cell& cell, const Lat& p) {
     if (!cell.holds(p)) return;
-    fresh += stamps[node] != stamp;
-    stamps[node] = stamp;
     const Node& n = t.nodes[node];
+    fresh += stamps[node] != stamp && n.kind == CellKind::Gray;
+    stamps[node] = stamp;
     if (n.kind == CellKind::Internal)
       for (int c = 0; c < 8; ++c) walk(n.index + c, cell.child(c), p);
   };

@@ -14,8 +14,8 @@ void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, Pa
 /// edges of its stamped coarse leaves.
 void partial_contour(const Octree& t, const Stamps& stamps, uint32_t stamp, PartialContour& x);
 
-/// Stamps every node whose closed cell holds one of the lattice points; returns how many were
-/// not stamped yet.
+/// Stamps every node whose closed cell holds one of the lattice points; returns how many gray
+/// leaves were not stamped yet (only those add polygons to the partial contour).
 size_t stamp_holding(const Octree& t, Stamps& stamps, uint32_t stamp, const std::vector<Lat>& points);
 
 /// Stamps the cells where the operands' surfaces may meet (pairs where neither is uniform;
