@@ -14,7 +14,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
-PHASES = ["geometry", "mesh", "octree", "io", "measure", "contour", "signs", "sample", "csg", "scad", "render"]
+PHASES = ["geometry", "mesh", "octree", "signs", "io", "measure", "contour", "sample", "csg", "scad", "render"]
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 

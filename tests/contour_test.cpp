@@ -10,7 +10,7 @@
 
 #include "pic/pic.h"
 #include "pic/primitives.h"
-#include "contour/dual_walk.h"
+#include "octree/dual_walk.h"
 #include "contour/triangulate.h"
 #include "support/mesh_checks.h"
 #include "support/shapes.h"

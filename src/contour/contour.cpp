@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "contour/dual_walk.h"
+#include "octree/dual_walk.h"
 #include "contour/triangulate.h"
 #include "octree/cell.h"
 #include "pic/contour.h"

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "contour/dual_walk.h"
+#include "octree/dual_walk.h"
 
 namespace pic::detail {
 

@@ -15,7 +15,7 @@
 #include "geometry/bvh.h"
 #include "geometry/stopwatch.h"
 #include "geometry/key_bits.h"
-#include "contour/dual_walk.h"
+#include "octree/dual_walk.h"
 #include "csg/cleanup.h"
 #include "sample/sampler.h"
 #include "signs/consistency.h"

@@ -1,7 +1,6 @@
 #include "signs/consistency.h"
 
-#include "contour/dual_walk.h"
-#include "octree/cell_vertex.h"
+#include "octree/dual_walk.h"
 #include "geometry/key_bits.h"
 #include "geometry/union_find.h"
 
@@ -24,24 +23,6 @@ namespace {
 
 using Lat = std::array<int64_t, 3>;
 
-/// The node covering cell `target`, or the leaf above it; `path` gets the nodes from the
-/// root down to it.
-LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path = nullptr) {
-  uint32_t node = 0;
-  Cell cell;
-  while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
-    if (path) path->push_back(node);
-    const int64_t h = cell.span() / 2;
-    int c = 0;
-    for (int k = 0; k < 3; ++k)
-      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
-    node = t.nodes[node].index + c;
-    cell = cell.child(c);
-  }
-  if (path) path->push_back(node);
-  return {node, cell};
-}
-
 /// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
 /// in depth-first order.
 void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
@@ -56,39 +37,6 @@ void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const Lat
     return;
   }
   for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
-}
-
-/// The finest lattice cell touching p in octant o (bit k set: on p's high side along k);
-/// false when it falls outside the root.
-bool octant_cell(const Lat& p, int o, Lat& q) {
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
-  for (int k = 0; k < 3; ++k) {
-    q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
-    if (q[k] < 0 || q[k] >= kLimit) return false;
-  }
-  return true;
-}
-
-/// Leaves having lattice point p as a corner, with the corner index in each; `path` gets
-/// every node on the way down to them.
-struct Around {
-  uint32_t node;
-  int corner;
-  Cell cell;
-};
-std::vector<Around> leaves_around(const Octree& t, const Lat& p, std::vector<uint32_t>* path = nullptr) {
-  std::vector<Around> out;
-  for (int o = 0; o < 8; ++o) {
-    Lat q;
-    if (!octant_cell(p, o, q)) continue;
-    const LeafRef l = leaf_at(t, q, path);
-    const int c = l.cell.corner_index(p);
-    if (c < 0) continue;
-    bool seen = false;
-    for (const auto& a : out) seen = seen || a.node == l.node;
-    if (!seen) out.push_back({l.node, c, l.cell});
-  }
-  return out;
 }
 
 /// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
@@ -109,50 +57,7 @@ void for_each_gray_leaf(const Octree& t, const std::function<bool(uint32_t)>* ac
 
 }  // namespace
 
-uint8_t signs_of(const Node& n) {
-  if (n.kind == CellKind::Gray) return n.signs;
-  return n.kind == CellKind::Black ? 0xff : 0;
-}
-
 bool multi_component(uint8_t s) { return s != 0 && s != 0xff && !one_component(s); }
-
-uint8_t with_corner(uint8_t s, int c, bool inside) { return uint8_t(s & ~(1 << c)) | uint8_t(int(inside) << c); }
-
-void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell) {
-  Node& n = t.nodes[node];
-  if (n.kind == CellKind::Gray) {
-    n.signs ^= uint8_t(1 << c);
-    return;
-  }
-  const uint8_t s = uint8_t(signs_of(n) ^ (1 << c));
-  n = add_gray(t.vertices, cell, s, cell_vertex(Qef{}, cell, s).position);
-}
-
-LeafRef leaf_at(const Octree& t, const Lat& q, std::vector<uint32_t>* path) {
-  return node_at(t, Cell{kMaxLevel, q}, path);
-}
-
-std::optional<bool> point_sign(const Octree& t, const Lat& p) {
-  for (int o = 0; o < 8; ++o) {
-    Lat q;
-    if (!octant_cell(p, o, q)) continue;
-    const LeafRef l = leaf_at(t, q);
-    if (const int c = l.cell.corner_index(p); c >= 0) return bool((signs_of(t.nodes[l.node]) >> c) & 1);
-  }
-  return std::nullopt;
-}
-
-/// Gives lattice point p the sign `inside` in every leaf that has it as a corner, and reports
-/// the nodes on the way to them. Set, not toggled: around a crack (a uniform leaf beside a
-/// sign change) the leaves disagree, and a toggle would keep them disagreeing — the gray
-/// leaves' sign flips one way and the uniform leaf's the other, and the contour has a hole.
-void set_point_sign(Octree& t, const Lat& p, bool inside, const std::function<void(uint32_t)>* touched) {
-  std::vector<uint32_t> path;
-  for (const auto& a : leaves_around(t, p, touched ? &path : nullptr))
-    if (bool((signs_of(t.nodes[a.node]) >> a.corner) & 1) != inside) flip_corner(t, a.node, a.corner, a.cell);
-  if (touched)
-    for (uint32_t x : path) (*touched)(x);
-}
 
 namespace {
 

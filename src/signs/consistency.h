@@ -13,20 +13,10 @@
 #include <vector>
 
 #include "octree/cell.h"
+#include "octree/point_signs.h"
 
 namespace pic::detail {
 
-/// A leaf (or node) and its cell.
-struct LeafRef {
-  uint32_t node;
-  Cell cell;
-};
-/// The leaf containing the finest lattice cell whose min corner is `q`; `path` gets the nodes
-/// from the root down to it.
-LeafRef leaf_at(const Octree& t, const std::array<int64_t, 3>& q, std::vector<uint32_t>* path = nullptr);
-/// The sign of lattice point q where a leaf has it as a corner; nothing where none has (q lies
-/// inside a coarser leaf's face, edge or body).
-std::optional<bool> point_sign(const Octree& t, const std::array<int64_t, 3>& q);
 
 /// Lattice points (key: x | y << 21 | z << 42) that remove_islands set in this operation, which
 /// enforce_one_component should not flip back when anything else will do.
@@ -35,19 +25,8 @@ inline uint64_t lattice_key(const std::array<int64_t, 3>& p) {
   return uint64_t(p[0]) | uint64_t(p[1]) << 21 | uint64_t(p[2]) << 42;
 }
 
-/// A leaf's corner signs as a mask (uniform leaves: all corners alike).
-uint8_t signs_of(const Node& n);
 /// Whether corner signs make more than one surface component in a cell.
 bool multi_component(uint8_t signs);
-/// `signs` with corner c set to `inside`.
-uint8_t with_corner(uint8_t signs, int c, bool inside);
-/// Gives lattice point p the sign `inside` in every leaf that has it as a corner (a uniform
-/// leaf of the other sign turns gray); `touched` is told of the nodes on the way to them.
-void set_point_sign(Octree& t, const std::array<int64_t, 3>& p, bool inside,
-                    const std::function<void(uint32_t)>* touched);
-/// Flips corner c of a leaf (its cell `cell`). A uniform leaf becomes gray with its vertex
-/// right next to that corner (the only place its surface can be).
-void flip_corner(Octree& t, uint32_t node, int c, const Cell& cell);
 
 struct TopologyFix {
   size_t flipped = 0;    // lattice points whose sign changed

@@ -1,4 +1,4 @@
-#include "contour/dual_walk.h"
+#include "octree/dual_walk.h"
 #include "geometry/predicates.h"
 #include "geometry/vec3.h"
 
