@@ -1,0 +1,45 @@
+// Walks over leaves that the sign passes share.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "octree/point_signs.h"
+
+namespace pic::detail {
+
+/// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
+/// in depth-first order.
+inline void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const std::array<int64_t, 3>& lo,
+                            const std::array<int64_t, 3>& hi, int max_level, std::vector<LeafRef>& out) {
+  if (cell.level > max_level) return;
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  const Node& n = t.nodes[node];
+  if (n.kind != CellKind::Internal) {
+    out.push_back({node, cell});
+    return;
+  }
+  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
+}
+
+/// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
+/// one when null), depth first.
+template <class F>
+void for_each_gray_leaf(const Octree& t, const std::function<bool(uint32_t)>* active, F&& f) {
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    if (active && !(*active)(node)) return;
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray) {
+      f(node, cell);
+    }
+  };
+  walk(walk, 0, Cell{});
+}
+
+}  // namespace pic::detail
