@@ -6,6 +6,9 @@
 //   BM_Contour/threads:T         dual contouring of the fandisk PIC object on T threads (triangles/s)
 //   BM_CsgCadStep/K              step K of the CAD tool (paper Table 3): 0 = cube ∪ cylinder z,
 //                                1 = − cylinder x, 2 = − cylinder y (operands pre-sampled)
+//   BM_UnionOf100Spheres/K       100 pre-sampled spheres (radius 0.05, depth 9, on a 5x5x4 grid,
+//                                each overlapping its neighbours) united: 0 = left to right
+//                                (csg_chain), 1 = the library's CSG tree (balanced, in parallel)
 //   BM_RoundToFloat32/K          rounding a contour to floats for STL/GLB, exactly checked
 //                                (0 = spot, 1 = a box minus a faceted sphere; triangles/s)
 //   BM_WindingQuery/near         inside/outside by the winding number of the open bunny (69k
@@ -31,6 +34,7 @@
 #include <chrono>
 #include <functional>
 #include <map>
+#include <memory>
 #include <cmath>
 #include <random>
 #include <string>
@@ -181,6 +185,37 @@ BENCHMARK(BM_CsgCadStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 // Writing STL or GLB: the contour rounded to floats, with the exact search for triangle pairs
 // the rounding made cross. 0 = spot's contour (curved), 1 = a box minus a 48-segment sphere
 // (OpenSCAD's example004: flat faces and facets, many coplanar neighbours).
+void BM_UnionOf100Spheres(benchmark::State& state) {
+  static const std::vector<pic::Octree> balls = [] {
+    pic::SampleOptions o;
+    o.depth = 9;
+    o.cube = pic::Cube{{0, 0, 0}, 1};
+    std::vector<pic::Octree> out;
+    for (int i = 0; i < 100; ++i)
+      out.push_back(pic::sample(pic::make_sphere({0.2 + 0.08 * (i % 5), 0.2 + 0.08 * (i / 5 % 5), 0.3 + 0.08 * (i / 25)},
+                                                 0.05, 32),
+                                o));
+    return out;
+  }();
+  size_t pics = 0;
+  for (auto _ : state) {
+    pic::Octree r;
+    if (state.range(0) == 0) {
+      std::vector<pic::CsgOperand> ops(balls.size());
+      for (size_t i = 0; i < balls.size(); ++i) ops[i].tree = balls[i];
+      r = pic::csg_chain(std::move(ops), std::vector<pic::CsgOp>(balls.size() - 1, pic::CsgOp::Union));
+    } else {
+      std::vector<pic::CsgTree> leaves;
+      for (const pic::Octree& b : balls) leaves.push_back(pic::csg_leaf(std::make_shared<const pic::Octree>(b)));
+      r = pic::evaluate(pic::csg_union(std::move(leaves)));
+    }
+    pics = r.vertices.size();
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["PICs"] = double(pics);
+}
+BENCHMARK(BM_UnionOf100Spheres)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_RoundToFloat32(benchmark::State& state) {
   static const std::array<pic::TriMesh, 2> meshes = [] {
     const pic::Octree spot = pic::sample(pic::read_mesh(kData + "/spot.obj"), pic::SampleOptions{});

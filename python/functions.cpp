@@ -97,6 +97,33 @@ pic::CsgOperand to_operand(py::handle x, size_t k) {
   return out;
 }
 
+/// A leaf of a CSG tree: a PIC object (copied, so the tree owns what it evaluates) or a mesh.
+pic::CsgTree to_tree_leaf(py::handle x, size_t k) {
+  pic::CsgOperand op = to_operand(x, k);
+  return op.tree ? pic::csg_leaf(std::move(*op.tree)) : pic::csg_leaf(std::move(op.mesh));
+}
+std::vector<pic::CsgTree> to_tree_leaves(py::iterable xs) {
+  std::vector<pic::CsgTree> out;
+  for (py::handle x : xs) out.push_back(to_tree_leaf(x, out.size()));
+  return out;
+}
+
+/// Evaluates an n-ary Boolean (pic::evaluate of a CsgTree) without the GIL.
+std::unique_ptr<PyOctree> evaluate_tree(const pic::CsgTree& tree, int depth, double error, bool parallel) {
+  pic::CsgChainOptions o;
+  o.sampling.depth = depth;
+  o.sampling.error = error;
+  o.sampling.parallel = parallel;
+  o.csg.error = error;
+  o.csg.parallel = parallel;
+  pic::Octree result;
+  {
+    py::gil_scoped_release nogil;
+    result = pic::evaluate(tree, o);
+  }
+  return wrap(std::move(result));
+}
+
 std::unique_ptr<PyOctree> csg_meshes(py::args args, int depth, double error, bool parallel, py::object cube) {
   if (args.size() < 3 || args.size() % 2 == 0)
     throw py::value_error("csg_meshes(a, op, b [, op, c ...]): operands and operations alternate");
@@ -208,6 +235,29 @@ Operands are meshes (pic.Mesh, a (vertices, faces) tuple, anything with .vertice
 mesh file paths, or Octrees. Mesh operands are sampled at `depth` into one cube around all of
 them (or `cube`), so no cube needs choosing by hand (pic::csg_chain, as `pic csg` does).
 The result's stats['steps'] hold each Boolean's statistics.)doc");
+  m.def(
+      "union",
+      [](py::iterable xs, int depth, double error, bool parallel) {
+        return evaluate_tree(pic::csg_union(to_tree_leaves(xs)), depth, error, parallel);
+      },
+      py::arg("solids"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8, py::arg("parallel") = true,
+      R"doc(The union of PIC objects and meshes (pic::evaluate of a CsgTree): combined in a balanced
+order, halves in parallel, no result copied per step; three combine as (a | b) | c. Meshes are
+sampled into one cube around them all at `depth`.)doc");
+  m.def(
+      "intersection",
+      [](py::iterable xs, int depth, double error, bool parallel) {
+        return evaluate_tree(pic::csg_intersection(to_tree_leaves(xs)), depth, error, parallel);
+      },
+      py::arg("solids"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8, py::arg("parallel") = true,
+      "The intersection of PIC objects and meshes, as union() combines them.");
+  m.def(
+      "difference",
+      [](py::handle a, py::iterable xs, int depth, double error, bool parallel) {
+        return evaluate_tree(pic::csg_difference(to_tree_leaf(a, 0), to_tree_leaves(xs)), depth, error, parallel);
+      },
+      py::arg("a"), py::arg("solids"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
+      py::arg("parallel") = true, "a minus the union of the others: difference(a, [b, c]) = a - (b | c).");
   m.def(
       "bounding_cube",
       [](py::object vertices, double margin) {

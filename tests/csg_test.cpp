@@ -608,5 +608,45 @@ TEST(Csg, LeavesItsOperandsUntouched) {
   EXPECT_TRUE(serialize(b) == bytes_b);
 }
 
+TEST(CsgTree, UnionOfThreeIsTheLeftToRightUnion) {
+  const int depth = 8;
+  const Octree a = sample_in_unit(make_sphere({0.4, 0.5, 0.5}, 0.2, 48), depth);
+  const Octree b = sample_in_unit(make_box({0.45, 0.3, 0.3}, {0.8, 0.7, 0.6}), depth);
+  const Octree c = sample_in_unit(make_cylinder({0.55, 0.5, 0.5}, 0.1, 0.8, 0, 48), depth);
+  const Octree chained = csg(csg(a, b, CsgOp::Union), c, CsgOp::Union);
+  const Octree tree = evaluate(csg_union({csg_leaf(a), csg_leaf(b), csg_leaf(c)}));
+  EXPECT_EQ(serialize(tree), serialize(chained));
+  // A difference takes the union of the rest; an intersection of two is their Boolean.
+  const Octree diff = evaluate(csg_difference(csg_leaf(b), {csg_leaf(a), csg_leaf(c)}));
+  EXPECT_EQ(serialize(diff), serialize(csg(b, csg(a, c, CsgOp::Union), CsgOp::Subtract)));
+  const Octree both = evaluate(csg_intersection({csg_leaf(a), csg_leaf(b)}));
+  EXPECT_EQ(serialize(both), serialize(csg(a, b, CsgOp::Intersect)));
+}
+
+TEST(CsgTree, ManyPartsInABalancedOrderAndMeshLeaves) {
+  // Nine overlapping balls in a row: the balanced union against the left-to-right one (the
+  // same solid; the order of the Booleans may place a few vertices differently).
+  const int depth = 8;
+  std::vector<Octree> balls;
+  std::vector<CsgTree> leaves;
+  for (int i = 0; i < 9; ++i) {
+    balls.push_back(sample_in_unit(make_sphere({0.2 + 0.075 * i, 0.5, 0.5}, 0.06, 32), depth));
+    leaves.push_back(csg_leaf(balls.back()));
+  }
+  Octree chained = balls[0];
+  for (int i = 1; i < 9; ++i) csg_inplace(chained, balls[i], CsgOp::Union);
+  const TriMesh m = unsplit_contour(evaluate(csg_union(std::move(leaves))));
+  EXPECT_TRUE(IsClosedManifold(m));
+  EXPECT_NEAR(volume(m), volume(unsplit_contour(chained)), 1e-6);
+  EXPECT_EQ(test::component_count(m), 1u);
+  // Mesh leaves are sampled into one cube around them all.
+  const TriMesh box = make_box({0, 0, 0}, {2, 2, 2}), hole = make_box({0.5, 0.5, -1}, {1.5, 1.5, 3});
+  CsgChainOptions o;
+  o.sampling.depth = 7;
+  const TriMesh d = unsplit_contour(evaluate(csg_difference(csg_leaf(box), {csg_leaf(hole)}), o));
+  EXPECT_NEAR(volume(d), 8 - 2, 1e-6);
+  EXPECT_TRUE(unsplit_contour(evaluate(csg_union({}))).triangles.empty());
+}
+
 }  // namespace
 }  // namespace pic

@@ -6,6 +6,7 @@
 #include <string>
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "pic/octree.h"
@@ -72,5 +73,32 @@ struct CsgChainOptions {
 /// \throws InvalidInput when ops.size() + 1 != operands.size() or as sample() and csg().
 Octree csg_chain(std::vector<CsgOperand> operands, const std::vector<CsgOp>& ops,
                  const CsgChainOptions& options = {});
+
+/// A CSG tree over PIC objects and meshes, evaluated on demand: a leaf holds an octree (shared,
+/// never copied by building the tree) or a mesh; an inner node is an n-ary union or
+/// intersection, or a difference (its first child minus the union of the others). Build it
+/// with csg_leaf, csg_union, csg_intersection and csg_difference.
+struct CsgTree {
+  enum class Kind { Octree, Mesh, Union, Intersection, Difference };
+  Kind kind = Kind::Union;
+  std::shared_ptr<const Octree> tree;   ///< Kind::Octree
+  std::shared_ptr<const TriMesh> mesh;  ///< Kind::Mesh
+  std::vector<CsgTree> children;        ///< inner nodes
+};
+CsgTree csg_leaf(Octree tree);
+CsgTree csg_leaf(std::shared_ptr<const Octree> tree);
+CsgTree csg_leaf(TriMesh mesh);
+CsgTree csg_union(std::vector<CsgTree> children);
+CsgTree csg_intersection(std::vector<CsgTree> children);
+CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away);
+
+/// Evaluates the tree on octrees. Mesh leaves are sampled into one cube around all of them
+/// (options.sampling.cube when set); octree leaves in another cube are resampled as csg()
+/// does. An n-ary union or intersection combines its children in a balanced order — the first
+/// half with the second, each half the same way, halves evaluated in parallel (with
+/// options.csg.parallel) — and no step copies a result: each Boolean is written into its left
+/// operand. Three children combine as (a op b) op c. An empty union is the empty solid.
+/// 	hrows InvalidInput as sample() and csg() do, or for a difference without children.
+Octree evaluate(const CsgTree& tree, const CsgChainOptions& options = {});
 
 }  // namespace pic

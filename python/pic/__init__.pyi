@@ -1,6 +1,6 @@
 """PIC: solids as points with implicit connectivity (type stubs for the `pic` module)."""
 import os
-from typing import Any, NamedTuple, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Iterable, NamedTuple, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -126,6 +126,20 @@ def csg_meshes(*args: Any, depth: int = 12, error: float = 1e-8, parallel: bool 
 
 def bounding_cube(vertices: ArrayLike, margin: float = 1 / 16) -> Cube:
     """The automatic root cube around points (bounding cube plus margin of the extent)."""
+
+def union(solids: Iterable[Any], *, depth: int = 12, error: float = 1e-8, parallel: bool = True) -> Octree:
+    """The union of PIC objects and meshes, combined in a balanced order (halves in parallel);
+    three combine as (a | b) | c."""
+    ...
+
+def intersection(solids: Iterable[Any], *, depth: int = 12, error: float = 1e-8, parallel: bool = True) -> Octree:
+    """The intersection of PIC objects and meshes, combined as union() combines them."""
+    ...
+
+def difference(a: Any, solids: Iterable[Any], *, depth: int = 12, error: float = 1e-8,
+               parallel: bool = True) -> Octree:
+    """a minus the union of the others."""
+    ...
 
 def csg(a: Octree, b: Octree, op: str, error: float = 1e-8, parallel: bool = True) -> Octree:
     """Boolean on the octrees as a new object (pic::csg). op: 'union', 'intersect'

@@ -492,17 +492,11 @@ std::vector<Lat> contact_corners(const std::vector<Cell>& contacts) {
 /// The gray leaves coarser than the finest level that hold one of the points (a uniform one
 /// is split toward a point when its sign changes: set_point_sign), each once.
 std::vector<LeafRef> coarse_gray_leaves_at(const Octree& a, const std::vector<Lat>& points, int depth) {
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   std::vector<LeafRef> out;
   for (const Lat& p : points)
     for (int o = 0; o < 8; ++o) {
       Lat q;
-      bool in_root = true;
-      for (int x = 0; x < 3; ++x) {
-        q[x] = p[x] - (((o >> x) & 1) ? 0 : 1);
-        in_root = in_root && q[x] >= 0 && q[x] < kLimit;
-      }
-      if (!in_root) continue;
+      if (!octant_cell(p, o, q)) continue;
       const LeafRef l = leaf_at(a, q);
       if (l.cell.level >= depth || a.nodes[l.node].kind != CellKind::Gray) continue;
       bool seen = false;

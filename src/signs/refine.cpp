@@ -11,16 +11,12 @@ namespace {
 
 /// The sign a leaf outside `cell` gives lattice point q as one of its corners, if one does.
 std::optional<bool> sign_outside(const Octree& t, const Cell& cell, const Lat& q) {
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   for (int o = 0; o < 8; ++o) {
     Lat f;
-    bool in_root = true, in_cell = true;
-    for (int k = 0; k < 3; ++k) {
-      f[k] = q[k] - (((o >> k) & 1) ? 0 : 1);
-      in_root = in_root && f[k] >= 0 && f[k] < kLimit;
-      in_cell = in_cell && f[k] >= cell.lat[k] && f[k] < cell.lat[k] + cell.span();
-    }
-    if (!in_root || in_cell) continue;
+    if (!octant_cell(q, o, f)) continue;
+    bool in_cell = true;
+    for (int k = 0; k < 3; ++k) in_cell = in_cell && f[k] >= cell.lat[k] && f[k] < cell.lat[k] + cell.span();
+    if (in_cell) continue;
     const LeafRef l = leaf_at(t, f);
     if (const int c = l.cell.corner_index(q); c >= 0) return ((signs_of(t.nodes[l.node]) >> c) & 1) != 0;
   }
@@ -48,16 +44,10 @@ void agree_on_boundary(Octree& t, uint32_t root, const Cell& cell) {
 }  // namespace
 
 size_t refine_around(Octree& t, const Lat& p, const ResampleLeaf& resample, const std::function<void(uint32_t)>& grown) {
-  constexpr int64_t kLimit = int64_t{1} << kMaxLevel;
   size_t replaced = 0;
   for (int o = 0; o < 8; ++o) {
-    Lat q;  // the finest lattice cell beside p in octant o
-    bool in_root = true;
-    for (int k = 0; k < 3; ++k) {
-      q[k] = p[k] - (((o >> k) & 1) ? 0 : 1);
-      in_root = in_root && q[k] >= 0 && q[k] < kLimit;
-    }
-    if (!in_root) continue;
+    Lat q;
+    if (!octant_cell(p, o, q)) continue;
     const LeafRef l = leaf_at(t, q);
     if (l.cell.level >= t.max_depth) continue;
     const auto first = static_cast<uint32_t>(t.nodes.size());

@@ -1,0 +1,125 @@
+// A CSG tree over octrees and meshes, evaluated bottom-up: see pic/csg.h (CsgTree, evaluate).
+#include "pic/csg.h"
+#include "octree/cell.h"
+
+#include <tbb/parallel_invoke.h>
+
+namespace pic {
+
+CsgTree csg_leaf(std::shared_ptr<const Octree> tree) {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Octree;
+  t.tree = std::move(tree);
+  return t;
+}
+CsgTree csg_leaf(Octree tree) { return csg_leaf(std::make_shared<const Octree>(std::move(tree))); }
+CsgTree csg_leaf(TriMesh mesh) {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Mesh;
+  t.mesh = std::make_shared<const TriMesh>(std::move(mesh));
+  return t;
+}
+CsgTree csg_union(std::vector<CsgTree> children) {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Union;
+  t.children = std::move(children);
+  return t;
+}
+CsgTree csg_intersection(std::vector<CsgTree> children) {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Intersection;
+  t.children = std::move(children);
+  return t;
+}
+CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away) {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Difference;
+  t.children.push_back(std::move(from));
+  for (CsgTree& c : take_away) t.children.push_back(std::move(c));
+  return t;
+}
+
+namespace {
+
+void collect_mesh_points(const CsgTree& t, std::vector<Vec3>& out) {
+  if (t.kind == CsgTree::Kind::Mesh) out.insert(out.end(), t.mesh->positions.begin(), t.mesh->positions.end());
+  for (const CsgTree& c : t.children) collect_mesh_points(c, out);
+}
+
+/// The first octree leaf's cube, for a tree without meshes whose result must still have one.
+const Octree* first_octree(const CsgTree& t) {
+  if (t.kind == CsgTree::Kind::Octree) return t.tree.get();
+  for (const CsgTree& c : t.children)
+    if (const Octree* o = first_octree(c)) return o;
+  return nullptr;
+}
+
+class TreeEvaluator {
+ public:
+  TreeEvaluator(const CsgChainOptions& options, const SampleOptions& sampling, const Octree* empty_like)
+      : options_(options), sampling_(sampling), empty_like_(empty_like) {}
+
+  Octree eval(const CsgTree& t) const {
+    switch (t.kind) {
+      case CsgTree::Kind::Octree: return *t.tree;
+      case CsgTree::Kind::Mesh: return sample(*t.mesh, sampling_);
+      case CsgTree::Kind::Union: return balanced(t.children, 0, t.children.size(), CsgOp::Union);
+      case CsgTree::Kind::Intersection: return balanced(t.children, 0, t.children.size(), CsgOp::Intersect);
+      case CsgTree::Kind::Difference: {
+        if (t.children.empty()) throw InvalidInput("a difference needs the solid to take from");
+        if (t.children.size() == 1) return eval(t.children[0]);
+        Octree a, b;
+        both([&] { a = eval(t.children[0]); }, [&] { b = balanced(t.children, 1, t.children.size(), CsgOp::Union); });
+        csg_inplace(a, b, CsgOp::Subtract, options_.csg);
+        return a;
+      }
+    }
+    return empty();
+  }
+
+ private:
+  const CsgChainOptions& options_;
+  SampleOptions sampling_;
+  const Octree* empty_like_;
+
+  /// The empty solid in the tree's cube.
+  Octree empty() const {
+    Octree t;
+    if (sampling_.cube) t.cube = *sampling_.cube;
+    else if (empty_like_) t.cube = empty_like_->cube;
+    t.max_depth = empty_like_ ? empty_like_->max_depth : sampling_.depth;
+    return t;
+  }
+  template <class A, class B>
+  void both(const A& a, const B& b) const {
+    if (options_.csg.parallel) tbb::parallel_invoke(a, b);
+    else a(), b();
+  }
+  /// kids[b, e) combined: the first ceil(n/2) with the rest, each half the same way.
+  Octree balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) const {
+    if (b >= e) return empty();
+    if (e - b == 1) return eval(kids[b]);
+    const size_t mid = b + (e - b + 1) / 2;
+    Octree x, y;
+    both([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
+    csg_inplace(x, y, op, options_.csg);
+    return x;
+  }
+};
+
+}  // namespace
+
+Octree evaluate(const CsgTree& tree, const CsgChainOptions& options) {
+  SampleOptions sampling = options.sampling;
+  if (!sampling.cube) {
+    TriMesh all;
+    collect_mesh_points(tree, all.positions);
+    if (!all.positions.empty()) sampling.cube = bounding_cube(all, sampling.margin);
+  }
+  const TreeEvaluator ev(options, sampling, first_octree(tree));
+  Octree r = ev.eval(tree);
+  if (r.nodes.size() > detail::reachable_nodes(r)) detail::compact(r);
+  return r;
+}
+
+}  // namespace pic
