@@ -59,7 +59,6 @@ class FocusCells {
     for (const Lat& p : points) add(p, max_depth);
   }
   bool holds(const Cell& cell) const { return keys_.count(key(cell.level, cell.lat)) != 0; }
-  bool empty() const { return keys_.empty(); }
 
  private:
   static uint64_t key(int level, const Lat& lat) {
@@ -210,10 +209,7 @@ class Combiner {
     Side sb = side_of(b_, 0, Cell{});
     Cell cell;
     while (cell.level < target.level) {
-      const int64_t h = cell.span() / 2;
-      int c = 0;
-      for (int k = 0; k < 3; ++k)
-        if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
+      const int c = cell.child_toward(target.lat);
       const SignGrid ga = sa.kind == Side::Gray ? sign_grid(a_, sa, cell) : SignGrid{};
       const SignGrid gb = sb.kind == Side::Gray ? sign_grid(b_, sb, cell) : SignGrid{};
       sa = child_side(a_, sa, cell, c, ga);
@@ -489,8 +485,9 @@ std::vector<Lat> contact_corners(const std::vector<Cell>& contacts) {
   return out;
 }
 
-/// The gray leaves coarser than the finest level that hold one of the points (a uniform one
-/// is split toward a point when its sign changes: set_point_sign), each once.
+/// The gray leaves coarser than the finest level that hold one of the points, each once (a
+/// uniform one flipped at a corner becomes gray with its vertex right next to that corner:
+/// its surface stays at the point).
 std::vector<LeafRef> coarse_gray_leaves_at(const Octree& a, const std::vector<Lat>& points, int depth) {
   std::vector<LeafRef> out;
   for (const Lat& p : points)

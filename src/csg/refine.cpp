@@ -3,30 +3,15 @@
 
 #include "csg/operand.h"
 #include "csg/stamp.h"
+#include "signs/leaf_walks.h"
 
 namespace pic::detail {
-namespace {
-
-/// Every node whose closed cell meets the closed lattice box [lo, hi] (a list: the box is
-/// small against the tree).
-void nodes_meeting(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
-                   std::vector<uint32_t>& out) {
-  const int64_t s = cell.span();
-  for (int k = 0; k < 3; ++k)
-    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
-  out.push_back(node);
-  const Node& n = t.nodes[node];
-  if (n.kind == CellKind::Internal)
-    for (int c = 0; c < 8; ++c) nodes_meeting(t, n.index + c, cell.child(c), lo, hi, out);
-}
-
-}  // namespace
 
 Builder resample_from_contour(const Octree& t, const LeafRef& leaf, const Lat& p, double error) {
   // The dual polygons of every leaf meeting the cell hold all of the surface inside it (a
   // polygon's vertices lie in their own cells).
-  std::vector<uint32_t> near;
-  nodes_meeting(t, 0, Cell{}, leaf.cell.lat, leaf.cell.corner(7), near);
+  std::vector<uint32_t> near;  // a list: the box is small against the tree
+  for_each_node_meeting(t, 0, Cell{}, leaf.cell.lat, leaf.cell.corner(7), [&](uint32_t n) { near.push_back(n); });
   std::sort(near.begin(), near.end());
   PartialContour contour;
   contour_of(t, [&](uint32_t n) { return std::binary_search(near.begin(), near.end(), n); }, contour);

@@ -36,6 +36,14 @@ struct Cell {
     }
     return k;
   }
+  /// The child whose half-open cell holds lattice point p (p inside this cell).
+  int child_toward(const std::array<int64_t, 3>& p) const {
+    const int64_t h = span() / 2;
+    int c = 0;
+    for (int a = 0; a < 3; ++a)
+      if (p[a] >= lat[a] + h) c |= 1 << a;
+    return c;
+  }
   /// Whether lattice point p lies in the closed cell.
   bool holds(const std::array<int64_t, 3>& p) const {
     const int64_t s = span();

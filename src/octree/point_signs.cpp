@@ -14,10 +14,7 @@ LeafRef node_at(const Octree& t, const Cell& target, std::vector<uint32_t>* path
   Cell cell;
   while (cell.level < target.level && t.nodes[node].kind == CellKind::Internal) {
     if (path) path->push_back(node);
-    const int64_t h = cell.span() / 2;
-    int c = 0;
-    for (int k = 0; k < 3; ++k)
-      if (target.lat[k] >= cell.lat[k] + h) c |= 1 << k;
+    const int c = cell.child_toward(target.lat);
     node = t.nodes[node].index + c;
     cell = cell.child(c);
   }

@@ -77,10 +77,7 @@ struct IslandSearch {
   /// The node covering `target` (or the leaf above it), searched from `from`.
   LeafRef node_below(LeafRef from, const Cell& target) const {
     while (from.cell.level < target.level && t.nodes[from.node].kind == CellKind::Internal) {
-      const int64_t h = from.cell.span() / 2;
-      int c = 0;
-      for (int k = 0; k < 3; ++k)
-        if (target.lat[k] >= from.cell.lat[k] + h) c |= 1 << k;
+      const int c = from.cell.child_toward(target.lat);
       from = {t.nodes[from.node].index + c, from.cell.child(c)};
     }
     return from;
@@ -377,15 +374,8 @@ void finer_corners_on_coarse_leaf(const Octree& t, const IslandSearch& search, c
 namespace {
 
 /// Marks every node whose closed cell meets the closed lattice box [lo, hi].
-void mark_meeting(const Octree& t, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
-                  std::vector<uint8_t>& out) {
-  const int64_t s = cell.span();
-  for (int k = 0; k < 3; ++k)
-    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
-  out[node] = 1;
-  const Node& n = t.nodes[node];
-  if (n.kind == CellKind::Internal)
-    for (int c = 0; c < 8; ++c) mark_meeting(t, n.index + c, cell.child(c), lo, hi, out);
+void mark_meeting(const Octree& t, const Lat& lo, const Lat& hi, std::vector<uint8_t>& out) {
+  for_each_node_meeting(t, 0, Cell{}, lo, hi, [&](uint32_t n) { out[n] = 1; });
 }
 
 /// Marks the nodes whose closed cell meets that of a leaf among `touched` (which holds every
@@ -404,7 +394,7 @@ void mark_near_touched(const Octree& t, const std::vector<uint32_t>& touched, st
     for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
   };
   if (!touched.empty()) walk(walk, 0, Cell{});
-  for (const LeafRef& l : leaves) mark_meeting(t, 0, Cell{}, l.cell.lat, l.cell.corner(7), out);
+  for (const LeafRef& l : leaves) mark_meeting(t, l.cell.lat, l.cell.corner(7), out);
 }
 
 }  // namespace
@@ -430,7 +420,7 @@ size_t remove_islands(Octree& t, const std::function<bool(uint32_t)>* active,
     set_point_sign(t, p, inside, touched);
     if (pinned) pinned->insert(lattice_key(p));
     ++flipped;
-    for (const Around& a : leaves_around(t, p)) mark_meeting(t, 0, Cell{}, a.cell.lat, a.cell.corner(7), moved);
+    for (const Around& a : leaves_around(t, p)) mark_meeting(t, a.cell.lat, a.cell.corner(7), moved);
   };
   // Each pass first asks, in parallel and reading only, which of its leaves would flip a point
   // as the tree stands; then it runs in order over those and over the ones a flip since has

@@ -26,6 +26,20 @@ inline void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, co
   for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
 }
 
+/// Calls f(node) for every node whose closed cell meets the closed lattice box [lo, hi], below
+/// `node` (cell `cell`), depth first.
+template <class F>
+void for_each_node_meeting(const Octree& t, uint32_t node, const Cell& cell, const std::array<int64_t, 3>& lo,
+                           const std::array<int64_t, 3>& hi, F&& f) {
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+  f(node);
+  const Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal)
+    for (int c = 0; c < 8; ++c) for_each_node_meeting(t, n.index + c, cell.child(c), lo, hi, f);
+}
+
 /// Calls f(node, cell) for every gray leaf in the subtrees for which `active` holds (every
 /// one when null), depth first.
 template <class F>
