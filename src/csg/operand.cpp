@@ -48,8 +48,8 @@ Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGr
     const int gx = (c & 1) + (k & 1), gy = ((c >> 1) & 1) + ((k >> 1) & 1), gz = ((c >> 2) & 1) + ((k >> 2) & 1);
     v.signs |= uint8_t(grid[gx + 3 * gy + 9 * gz]) << k;
   }
-  filter_tris(x.tris, s.idx, cc, v.idx);
-  if ((v.signs == 0 || v.signs == 0xff) && !meets_cell(x.tris, v.idx, cc)) {
+  filter_box(x.tris, s.idx, cc.box(), v.idx);
+  if ((v.signs == 0 || v.signs == 0xff) && !meets_box(x.tris, v.idx, cc.box())) {
     Side u;
     u.inside = v.signs != 0;
     return u;

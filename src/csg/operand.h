@@ -17,7 +17,7 @@
 #include "geometry/key_bits.h"
 #include "octree/dual_walk.h"
 #include "csg/cleanup.h"
-#include "sample/sampler.h"
+#include "octree/subdivide.h"
 #include "signs/consistency.h"
 
 namespace pic::detail {

@@ -84,7 +84,7 @@ struct IBox {
 /// Whether `t` crosses any of the 12 edges of the box (crosses() on each).
 bool crosses_box_edge(const ITri& t, const IBox& box);
 
-/// edges_may_touch_box for the 8 children of one box (split_tris asks it for several): the
+/// edges_may_touch_box for the 8 children of one box (split_box asks it for several): the
 /// triangle's projections on the 9 axes are taken once about the box's centre and shifted to
 /// each child's, with the margin widened by the shift.
 class ChildEdgeTest {

@@ -327,4 +327,24 @@ std::vector<std::array<uint32_t, 3>> cap_loops(const std::vector<std::array<uint
 
 namespace pic {
 MeshDefects find_defects(const TriMesh& mesh) { return detail::clean_mesh(mesh).defects; }
+double detail::plane_spread(const TriMesh& mesh) {
+  Vec3 n{0, 0, 0}, origin{0, 0, 0};
+  double best = 0;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const Vec3 x{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double area2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    if (area2 > best) best = area2, n = x, origin = a;
+  }
+  if (best == 0) return -1;
+  const double len = std::sqrt(best);
+  double lo = 0, hi = 0;
+  for (const Vec3& p : mesh.positions) {
+    const double d = ((p[0] - origin[0]) * n[0] + (p[1] - origin[1]) * n[1] + (p[2] - origin[2]) * n[2]) / len;
+    lo = std::min(lo, d), hi = std::max(hi, d);
+  }
+  return hi - lo;
+}
+
 }  // namespace pic

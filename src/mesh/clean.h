@@ -38,4 +38,8 @@ std::vector<std::vector<uint32_t>> boundary_loops(const std::vector<std::array<u
 std::vector<std::array<uint32_t, 3>> cap_loops(const std::vector<std::array<uint32_t, 2>>& chain,
                                                size_t* count = nullptr);
 
+/// How far the mesh's vertices spread across the plane of its largest triangle (-1 when every
+/// triangle is degenerate). Below a finest cell the mesh is flat: no solid the octree holds.
+double plane_spread(const TriMesh& mesh);
+
 }  // namespace pic::detail

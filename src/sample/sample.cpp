@@ -1,7 +1,7 @@
 // Sampling (paper section 4): the public entry points. A clean closed mesh runs the sampler
 // kernel (sampler.h) over crossing parity; any other mesh over its winding number, a point
 // cloud over the points' winding number (sources.h); both then settle their signs (signs/).
-#include "sample/sampler.h"
+#include "octree/subdivide.h"
 
 #include "sample/sources.h"
 #include "mesh/clean.h"
@@ -21,26 +21,6 @@ namespace pic {
 
 using namespace detail;
 using Lat = std::array<int64_t, 3>;
-
-double detail::plane_spread(const TriMesh& mesh) {
-  Vec3 n{0, 0, 0}, origin{0, 0, 0};
-  double best = 0;
-  for (const auto& t : mesh.triangles) {
-    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const Vec3 x{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    const double area2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-    if (area2 > best) best = area2, n = x, origin = a;
-  }
-  if (best == 0) return -1;
-  const double len = std::sqrt(best);
-  double lo = 0, hi = 0;
-  for (const Vec3& p : mesh.positions) {
-    const double d = ((p[0] - origin[0]) * n[0] + (p[1] - origin[1]) * n[1] + (p[2] - origin[2]) * n[2]) / len;
-    lo = std::min(lo, d), hi = std::max(hi, d);
-  }
-  return hi - lo;
-}
 
 Cube bounding_cube(const TriMesh& mesh, double margin) {
   if (mesh.positions.empty()) throw InvalidInput("mesh has no vertices");
@@ -130,9 +110,9 @@ std::vector<I3> to_grid_inside(const Cube& cube, const std::vector<Vec3>& points
   return grid;
 }
 
-SampleParams params_of(const SampleOptions& options) {
+SampleParams params_of(const SampleOptions& options, EdgeCountMemo& memo) {
   SampleParams p;
-  p.memo_id = new_memo_id();
+  p.edge_memo = &memo;
   p.max_depth = options.depth;
   p.error = options.error;
   p.parallel_levels = options.parallel ? 2 : 0;
@@ -145,7 +125,7 @@ Builder resample_from_input(const SurfaceSource& src, const WindingSource* windi
                             const LeafRef& leaf, const Lat& p, double error) {
   std::vector<uint32_t> all(src.tris().size()), idx;
   for (uint32_t k = 0; k < all.size(); ++k) all[k] = k;
-  filter_tris(src.tris(), all, leaf.cell, idx);
+  filter_box(src.tris(), all, leaf.cell.box(), idx);
   SampleParams params;
   params.max_depth = t.max_depth;
   params.error = error;
@@ -168,7 +148,8 @@ Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const
   for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
   Builder b;
   b.nodes.resize(1);
-  sample_cell(src, params_of(options), Cell{}, root_signs, idx, b, 0, capped, root_wind);
+  EdgeCountMemo memo;
+  sample_cell(src, params_of(options, memo), Cell{}, root_signs, idx, b, 0, capped, root_wind);
   Octree tree;
   tree.cube = cube;
   tree.max_depth = options.depth;

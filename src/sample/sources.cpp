@@ -85,47 +85,6 @@ std::optional<Vec3> level_on_edge(const Cell& cell, int c0, int axis, bool s0, G
   return to_unit(along(lattice_to_grid(cell.corner(c0)), axis, lo + (hi - lo) / 2));
 }
 
-struct CacheEntry {
-  I3 p;
-  uint32_t id = 0;  // 0: empty
-  bool inside = false;
-};
-constexpr int kCacheBits = 15;
-
-CacheEntry& cache_slot(const I3& p) {
-  thread_local std::vector<CacheEntry> slots(size_t{1} << kCacheBits);
-  return slots[memo_slot(p, 0, kCacheBits)];
-}
-
-/// A crossing found on a cell edge across a hole, with the level set's normal there: up to 4
-/// cells of a level share each edge, and each would search it again.
-struct CrossingEntry {
-  I3 a;
-  i64 len = 0;
-  int axis = 0;
-  uint32_t id = 0;  // 0: empty
-  Vec3 x, n;
-};
-
-CrossingEntry& crossing_slot(const I3& a, int axis, i64 len) {
-  constexpr int kBits = 13;
-  thread_local std::vector<CrossingEntry> slots(size_t{1} << kBits);
-  return slots[edge_memo_slot(a, axis, len, kBits)];
-}
-
-/// The caps' winding number at a cell corner: the ends of the edges searched across a hole,
-/// shared by the corner's edges in each cell around it.
-struct CapValueEntry {
-  I3 p;
-  uint32_t id = 0;  // 0: empty
-  double w = 0;
-};
-
-CapValueEntry& cap_value_slot(const I3& p) {
-  constexpr int kBits = 12;
-  thread_local std::vector<CapValueEntry> slots(size_t{1} << kBits);
-  return slots[memo_slot(p, 0, kBits)];
-}
 
 /// Integer winding number at b from w at a, along the axes in turn (x, then y, then z) through
 /// the triangles `near` (all those the path can cross). Crossing a triangle along +axis changes
@@ -146,14 +105,12 @@ int32_t winding_along_axes(const std::vector<ITri>& tris, const std::vector<uint
 
 }  // namespace
 
-DecisionCache::DecisionCache() : id_(new_memo_id()) {}
-
 int DecisionCache::find(const I3& p) const {
-  const CacheEntry& e = cache_slot(p);
-  return e.id == id_ && e.p == p ? int(e.inside) : -1;
+  const Entry& e = memo_.slot(memo_slot(p, 0, Memo::kBits));
+  return e.filled && e.p == p ? int(e.inside) : -1;
 }
 
-void DecisionCache::store(const I3& p, bool inside) const { cache_slot(p) = {p, id_, inside}; }
+void DecisionCache::store(const I3& p, bool inside) const { memo_.slot(memo_slot(p, 0, Memo::kBits)) = {p, true, inside}; }
 
 // ---- triangle soups -----------------------------------------------------------------------
 
@@ -418,8 +375,8 @@ void WindingSource::child_grid_signs(const Cell& cell, const std::vector<uint32_
 
 double WindingSource::cap_winding(const I3& p, bool memoize) const {
   if (!memoize) return caps_.evaluate(to_unit(p), &p).w;
-  CapValueEntry& e = cap_value_slot(p);
-  if (e.id != cache_.id() || e.p != p) e = {p, cache_.id(), caps_.evaluate(to_unit(p), &p).w};
+  CapValue& e = cap_values_.slot(memo_slot(p, 0, CapValueMemo::kBits));
+  if (!e.filled || e.p != p) e = {p, true, caps_.evaluate(to_unit(p), &p).w};
   return e.w;
 }
 
@@ -445,8 +402,8 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     int surface = 0;
     for (uint32_t k : idx) surface += (all_[k].use & kUseQef) && crosses(all_[k], a, axis, len);
     if (surface & 1) continue;  // the input's own surface changes the sign here
-    CrossingEntry& memo = crossing_slot(a, axis, len);
-    if (memo.id == cache_.id() && memo.a == a && memo.axis == axis && memo.len == len) {
+    HoleCrossing& memo = crossings_.slot(edge_memo_slot(a, axis, len, HoleCrossingMemo::kBits));
+    if (memo.filled && memo.a == a && memo.axis == axis && memo.len == len) {
       if (memo.n != Vec3{0, 0, 0}) q.add_plane(memo.n, dot3(memo.n, memo.x), 0.5);
       continue;
     }
@@ -469,7 +426,7 @@ void WindingSource::add_fill_planes(const Cell& cell, uint8_t signs, const Wind8
     });
     // Across a hole the level set's normal is the gradient of w: the field of the boundary.
     const Vec3 n = unit_vec(boundary_field(boundary_, x));
-    memo = {a, len, axis, cache_.id(), x, n};
+    memo = {a, len, axis, true, x, n};
     if (n == Vec3{0, 0, 0}) continue;
     q.add_plane(n, dot3(n, x), 0.5);
   }
@@ -519,7 +476,7 @@ bool WindingSource::surface_matters(const Cell& cell, uint8_t, const Wind8* wind
                                     const std::vector<uint32_t>& idx) const {
   // Past this many triangles the test costs more than subdividing (coarse cells split anyway).
   constexpr size_t kMaxTested = 64;
-  if (!wind || idx.size() > kMaxTested) return meets_cell(all_, idx, cell);
+  if (!wind || idx.size() > kMaxTested) return meets_box(all_, idx, cell.box());
   const IBox box = cell.box();
   const i64 delta = std::max<i64>(1, (box.hi[0] - box.lo[0]) / 1024);
   bool met = false;

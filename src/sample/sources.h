@@ -18,7 +18,8 @@
 
 #include "geometry/box_tree.h"
 #include "geometry/bvh.h"
-#include "sample/sampler.h"
+#include "geometry/memo.h"
+#include "octree/subdivide.h"
 #include "geometry/vec3.h"
 #include "geometry/winding.h"
 
@@ -29,16 +30,38 @@ namespace pic::detail {
 /// a decision near a hole costs hundreds of solid angles. Direct mapped, no locks.
 class DecisionCache {
  public:
-  DecisionCache();
   /// The cached decision at p (-1: none).
   int find(const I3& p) const;
   void store(const I3& p, bool inside) const;
-  /// Tells this source's entries in per-thread memos from those of other sources.
-  uint32_t id() const { return id_; }
 
  private:
-  uint32_t id_;  // tells this source's entries from an earlier source's in the same thread
+  struct Entry {
+    I3 p;
+    bool filled = false;
+    bool inside = false;
+  };
+  using Memo = ThreadMemo<Entry, 15>;
+  mutable Memo memo_;  // a memo of the source's pure decisions: asking fills it, answers never depend on it
 };
+
+/// A crossing found on a cell edge across a hole, with the level set's normal there: up to 4
+/// cells of a level share each edge, and each would search it again.
+struct HoleCrossing {
+  I3 a;
+  i64 len = 0;
+  int axis = 0;
+  bool filled = false;
+  Vec3 x, n;
+};
+using HoleCrossingMemo = ThreadMemo<HoleCrossing, 13>;
+/// The caps' winding number at a cell corner: the ends of the edges searched across a hole,
+/// shared by the corner's edges in each cell around it.
+struct CapValue {
+  I3 p;
+  bool filled = false;
+  double w = 0;
+};
+using CapValueMemo = ThreadMemo<CapValue, 12>;
 
 /// A connected cap's extent: an oriented box around its vertices (so around its convex hull),
 /// axes along their principal directions (a flat cap gets a thin box).
@@ -102,7 +125,9 @@ class WindingSource : public SurfaceSource {
   std::vector<ITri> all_;
   size_t mesh_count_;
   bool dropped_any_ = false;  // drop_interior_triangles took some out of the surface
-  mutable TriangleBvh bvh_;  // built on the first ray
+  // Built once, on the first ray (only rays read it; most inputs never need one), behind the
+  // once-flag: concurrent first rays wait for the one build.
+  mutable TriangleBvh bvh_;
   mutable std::once_flag bvh_built_;
   DipoleTree caps_;
   std::vector<CapExtent> cap_extents_;
@@ -110,6 +135,10 @@ class WindingSource : public SurfaceSource {
   BoxTree cap_boxes_;     // the caps' reach, one box per cap
   std::vector<std::array<Vec3, 2>> boundary_;  // unit space
   DecisionCache cache_;
+  // Memos of pure functions of a grid point or edge (asking fills them; answers never depend on them).
+  mutable HoleCrossingMemo crossings_;
+  mutable CapValueMemo cap_values_;
+  // Cells the sampling passed over, collected for the caller (skipped_cells).
   mutable std::mutex skipped_mutex_;
   mutable std::vector<Cell> skipped_;
 };

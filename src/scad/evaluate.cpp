@@ -13,7 +13,7 @@
 #include "geometry/stopwatch.h"
 #include "geometry/vec3.h"
 #include "pic/pic.h"
-#include "sample/sampler.h"
+#include "mesh/clean.h"
 #include "scad/lower.h"
 
 namespace pic {

@@ -7,25 +7,15 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/clip.h"
 #include "geometry/lattice.h"
+#include "geometry/memo.h"
 #include "octree/cell.h"
 #include "geometry/qef.h"
 #include "octree/cell_vertex.h"
 
 namespace pic::detail {
 
-/// Which axis-parallel grid lines a triangle's bounding box lets it cross: lines at
-/// base + b step (b < count) on each axis, for segments from base to base + step along it.
-struct LineMask {
-  std::array<unsigned, 3> on{};  // bit b of on[d]: coordinate base[d] + b step within [lo, hi)
-  std::array<bool, 3> spans{};   // segments along axis d overlap the box
-  /// A segment along `axis` at grid steps ci (axis i) and cj (axis j), i < j the other two.
-  bool may_cross(int axis, int i, int ci, int j, int cj) const {
-    return spans[axis] && ((on[i] >> ci) & 1) && ((on[j] >> cj) & 1);
-  }
-};
-/// The line mask of `t` for `count` grid lines per axis from `base`, `step` apart.
-LineMask line_mask(const ITri& t, const I3& base, i64 step, int count);
 
 /// The 19 segments that carry signs from a cell's corners to the rest of its child grid: grid
 /// point `to` is reached from `from` along `axis`; the segment's other two coordinates are
@@ -86,12 +76,24 @@ class MeshSource : public SurfaceSource {
                         std::array<bool, 27>& grid, Wind27* wind) const override;
 };
 
+/// A cell edge's crossing count (up to 4 cells of a level share an edge, and the count is the
+/// edge's own: every cell's list holds each triangle crossing its edges).
+struct EdgeCount {
+  I3 a;
+  i64 len = 0;
+  int axis = 0;
+  bool filled = false;
+  int count = 0;
+};
+using EdgeCountMemo = ThreadMemo<EdgeCount, 13>;
+
 struct SampleParams {
   int max_depth = 12;
   double error = 1e-8;
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
-  uint32_t memo_id = 0;    // nonzero: one triangle set, whose edge crossing counts may be memoized
+  /// Set: one triangle set through the whole call, whose edge crossing counts may be memoized.
+  EdgeCountMemo* edge_memo = nullptr;
   /// With `has_focus`: every cell whose closed box holds lattice point `focus` splits down to
   /// max_depth, so that the leaves around that point are finest cells.
   bool has_focus = false;
@@ -99,41 +101,18 @@ struct SampleParams {
   bool tips_at_corners = false;  ///< cell_vertex's tip_at_corner (Booleans' touching parts)
 };
 
-/// A slot index of `bits` bits for a grid point (and an extra word) in a direct-mapped,
-/// per-thread memo.
-size_t memo_slot(const I3& p, uint64_t extra, int bits);
-/// The same for a cell edge: from `a`, `len` along `axis`.
-inline size_t edge_memo_slot(const I3& a, int axis, i64 len, int bits) {
-  return memo_slot(a, (uint64_t(len) * 0xD6E8FEB86659FD93ull) ^ uint64_t(axis), bits);
-}
-/// A fresh nonzero id for a memo (SampleParams::memo_id, a decision cache).
-uint32_t new_memo_id();
 
 /// QEF of the triangles meeting `cell` (weights: clipped area / cell face area + a floor, so
 /// planes that touch the cell only along its boundary still count — box corners on octree
 /// planes need them), and, at the floor weight, those that touch the cell only in a low face
 /// but cross one of its edges (a slanted face or a crease through an octree line).
-void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-              Qef& q);
-/// The same over an arbitrary box; `face_area` normalizes the weights (unit-space area).
-void box_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const IBox& box,
-             double face_area, Qef& q);
+inline void cell_qef(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                     Qef& q) {
+  box_qef(tris, idx, cell.box(), cell.size() * cell.size(), q);
+}
 
-/// Whether any triangle of `idx` meets the cell under the perturbation convention (a triangle
-/// lying in one of the cell's low faces belongs to the neighbour below).
-bool meets_cell(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell);
 
-/// How far the mesh's vertices spread across the plane of its largest triangle (-1 when every
-/// triangle is degenerate). Below a finest cell the mesh is flat: no solid the octree holds.
-double plane_spread(const TriMesh& mesh);
 
-/// Triangles of `idx` overlapping the closed boxes of the 8 children of `cell` (conservative;
-/// the same lists as filter_tris per child, in one pass).
-void split_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-                std::array<std::vector<uint32_t>, 8>& out);
-/// Triangles of `idx` overlapping the closed box of `cell` (conservative).
-void filter_tris(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
-                 std::vector<uint32_t>& out);
 
 
 /// Samples `cell` (corner `signs`, candidate triangles `idx`) into `out` at `slot`. `wind`:
