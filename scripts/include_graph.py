@@ -2,8 +2,9 @@
 """The include graph of src/, folder by folder (docs/layout.md shows it).
 
     scripts/include_graph.py            print the graph as a markdown table
-    scripts/include_graph.py --check    exit 1 if a file-level include cycle exists or a
-                                        folder includes one of a later phase than its own
+    scripts/include_graph.py --check    exit 1 if a file-level include cycle exists, a folder
+                                        includes one of a later phase than its own, or one
+                                        of the APART pairs meets
 
 The phases, lowest first: a folder may include its own files, the public headers
 (include/pic/) and folders before it in PHASES.
@@ -15,6 +16,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
 PHASES = ["geometry", "mesh", "octree", "signs", "io", "measure", "contour", "sample", "csg", "scad", "render"]
+# Pairs of folders that never include one another although the phase order allows it: Booleans
+# work on octrees and their contours, never on the sampler's input sources.
+APART = [("csg", "sample")]
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -67,6 +71,8 @@ def main():
             for b in bs:
                 if a not in PHASES or b not in PHASES or PHASES.index(b) > PHASES.index(a):
                     bad.append(f"src/{a}/ includes src/{b}/ (a later phase)")
+                if (a, b) in APART:
+                    bad.append(f"src/{a}/ includes src/{b}/ (kept apart)")
         for b in bad:
             print("include graph:", b)
         print(f"include graph: {len(graph)} files, {sum(map(len, graph.values()))} includes, "

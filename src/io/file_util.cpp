@@ -2,9 +2,9 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <cctype>
 #include <fstream>
+#include <random>
 #include <string>
 
 #include "pic/pic.h"
@@ -18,14 +18,15 @@ std::string lower_extension(const std::filesystem::path& path) {
 }
 
 std::filesystem::path temp_path_for(const std::filesystem::path& path) {
-  static std::atomic<int> counter{0};
+  // Unique per process (pid) and per call (random): two writers of one path never share a
+  // temporary file.
   auto tmp = path;
   std::string name = ".";
   name += path.stem().string();
   name += ".tmp";
   name += std::to_string(::getpid());
   name += '-';
-  name += std::to_string(counter++);
+  name += std::to_string(std::random_device{}());
   name += path.extension().string();
   tmp.replace_filename(name);
   return tmp;

@@ -1,5 +1,5 @@
 // Sampling (paper section 4): the public entry points. A clean closed mesh runs the sampler
-// kernel (sampler.h) over crossing parity; any other mesh over its winding number, a point
+// kernel (octree/subdivide.h) over crossing parity; any other mesh over its winding number, a point
 // cloud over the points' winding number (sources.h); both then settle their signs (signs/).
 #include "octree/subdivide.h"
 
