@@ -158,7 +158,8 @@ TEST(Format, RoundTripOfUniformAndHandBuiltTrees) {
   black.nodes[0].kind = CellKind::Black;
   EXPECT_EQ(deserialize(serialize(black)).nodes[0].kind, CellKind::Black);
 
-  // Depth 20, a single chain of gray cells down to the deepest level (4-bit coordinates).
+  // Depth 20, a single chain of cells down to the deepest level (4-bit coordinates), the
+  // deepest gray with the root's corner inside, its siblings white (one sign per point).
   Octree deep;
   deep.max_depth = kMaxLevel;
   uint32_t node = 0;
@@ -166,10 +167,10 @@ TEST(Format, RoundTripOfUniformAndHandBuiltTrees) {
     const auto first = static_cast<uint32_t>(deep.nodes.size());
     deep.nodes.resize(deep.nodes.size() + 8);
     deep.nodes[node] = Node{first, CellKind::Internal, 0, 0, 0};
-    for (int c = 1; c < 8; ++c) deep.nodes[first + c] = Node{0, c == 7 ? CellKind::Black : CellKind::White, 0, 0, 0};
+    for (int c = 1; c < 8; ++c) deep.nodes[first + c] = Node{0, CellKind::White, 0, 0, 0};
     node = first;
   }
-  deep.nodes[node] = Node{0, CellKind::Gray, 0x81, kFlagCapped, 0};
+  deep.nodes[node] = Node{0, CellKind::Gray, 0x01, kFlagCapped, 0};
   deep.vertices.push_back({0.5f, 0.25f, 0.75f});
   const Octree d = deserialize(serialize(deep));
   expect_same_tree(deep, d, 1e-7);
@@ -279,6 +280,62 @@ TEST(Format, ForgedFilesWithValidChecksumNeverCrash) {
   }
   std::printf("  [measure] forged files: %zu rejected, %zu accepted\n", rejected, accepted);
   EXPECT_GT(rejected, 0u);
+}
+
+// A forged payload with a valid checksum is refused, or else it is a tree the construction
+// could have made: its contour (what `pic mesh` writes) is closed and 2-manifold.
+TEST(Format, ForgedFilesAreRefusedOrContourValid) {
+  for (const auto& [tree, trials] : {std::pair{&small_tree(), 400}, std::pair{&sphere_tree(), 60}}) {
+    const auto bytes = serialize(*tree);
+    std::mt19937_64 rng(7);
+    size_t rejected = 0, accepted = 0;
+    for (int trial = 0; trial < trials; ++trial) {
+      auto bad = bytes;
+      const size_t i = kHeaderBytes + rng() % (bad.size() - 4 - kHeaderBytes);
+      bad[i] ^= uint8_t(1u << (rng() % 8));
+      fix_crc(bad);
+      Octree t;
+      try {
+        t = deserialize(bad);
+      } catch (const IoError&) {
+        ++rejected;
+        continue;
+      }
+      ++accepted;
+      EXPECT_TRUE(IsClosedManifold(contour(t))) << "trial " << trial << ": byte " << i;
+    }
+    std::printf("  [measure] forged payloads: %zu refused, %zu accepted and valid\n", rejected, accepted);
+    EXPECT_GT(rejected, 0u);
+  }
+}
+
+// One corner sign of a gray leaf changed (the rest of the file intact): where the lattice
+// point then has two signs, which the contour cannot close around, the file is refused; the
+// others (a point no other leaf has as a corner or inside) contour closed.
+TEST(Format, ALeafWithAChangedCornerSignIsRefusedOrValid) {
+  const Octree& good = sphere_tree();
+  std::vector<uint32_t> grays;
+  for (uint32_t i = 0; i < good.nodes.size(); ++i)
+    if (good.nodes[i].kind == CellKind::Gray) grays.push_back(i);
+  ASSERT_FALSE(grays.empty());
+  std::mt19937_64 rng(3);
+  size_t refused = 0, valid = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    Octree t = good;
+    Node& n = t.nodes[grays[rng() % grays.size()]];
+    n.signs ^= uint8_t(1u << (rng() % 8));
+    if (n.signs == 0 || n.signs == 0xff) continue;
+    try {
+      t = deserialize(serialize(t));
+    } catch (const IoError&) {
+      ++refused;
+      continue;
+    }
+    ++valid;
+    EXPECT_TRUE(IsClosedManifold(contour(t))) << "trial " << trial;
+  }
+  std::printf("  [measure] changed corner signs: %zu refused, %zu accepted and valid\n", refused, valid);
+  EXPECT_GT(refused, valid);
 }
 
 TEST(Format, ForgedHeaderFieldsAreRejected) {

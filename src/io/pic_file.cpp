@@ -9,6 +9,7 @@
 
 #include "io/file_util.h"
 #include "octree/cell.h"
+#include "signs/invariants.h"
 
 namespace pic {
 namespace {
@@ -195,6 +196,15 @@ Octree deserialize(const std::vector<uint8_t>& in) {
   d.read_node(0, 0);
   if (t.nodes.size() != node_count || t.vertices.size() != gray_count)
     throw IoError("corrupted .pic file: node counts do not match the tree");
+  // A loaded tree is input like any other: the contour is closed and 2-manifold only for the
+  // trees the construction makes (one sign per lattice point, one component per leaf above
+  // the cap), so a file whose checksum is right but whose signs are not is refused here.
+  try {
+    detail::check_octree(t, "loading");
+  } catch (const std::logic_error& e) {
+    const std::string what = e.what();
+    throw IoError("corrupted .pic file: " + what.substr(what.find(": ") + 2));
+  }
   return t;
 }
 
