@@ -11,8 +11,9 @@ namespace {
 struct CsgArgs {
   std::vector<std::string> args;
   std::string out, mesh;
-  bool json = false, no_split = false, no_check = false;
+  bool json = false, no_split = false, no_check = false, raw = false;
   double error = 1e-8;
+  double simplify = 0.1;  // finest cells
   int depth = 12;
 };
 
@@ -55,10 +56,13 @@ void run(const CsgArgs& a) {
   j.add("pics", pics).add("seconds", since(t0)).raw("ops", steps);
   ContourOptions co;
   co.split_sheets = !a.no_split;
+  co.simplify = a.raw ? 0 : a.simplify;
   std::vector<WrittenMesh> written;
   auto write = [&](const std::string& path, bool with_volume) {
     ContourFile f = write_contour(result, path, co);
-    j.add("triangles", f.mesh.triangles.size()).add("split_vertices", f.stats.split_vertices);
+    j.add("triangles", f.mesh.triangles.size())
+        .add("split_vertices", f.stats.split_vertices)
+        .add("simplified_away", f.stats.simplified_away);
     if (with_volume) j.add("volume", volume(f.mesh));
     j.raw("topology", topology_json(f.written.topology));
     written.push_back(f.written);
@@ -91,6 +95,10 @@ void add_csg(CLI::App& app) {
   c->add_flag("--no-split", a->no_split,
               "With --mesh: write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   c->add_option("--error", a->error, "QEF residual threshold for new vertices")->capture_default_str();
+  c->add_option("--simplify", a->simplify,
+                "Mesh output: merge flat regions and straight creases, every face within TOL finest cells")
+      ->capture_default_str();
+  c->add_flag("--raw", a->raw, "Mesh output: the contour as it is, a vertex per gray cell (no --simplify)");
   c->add_flag("--json", a->json, "Print one JSON object on stdout");
   c->add_flag("--no-check", a->no_check, "With --mesh --json: skip the exact self-intersection test (huge meshes)");
   c->callback([a] { run(*a); });

@@ -12,7 +12,8 @@ struct EvalArgs {
   std::string in, out;
   int depth = 12;
   double error = 1e-8;
-  bool smooth = false, json = false, serial = false, no_split = false;
+  bool smooth = false, json = false, serial = false, no_split = false, raw = false;
+  double simplify = 0.1;  // finest cells
 };
 
 bool is_outline_path(const std::string& p) { return extension(p) == ".svg" || extension(p) == ".dxf"; }
@@ -52,11 +53,13 @@ void run(const EvalArgs& a) {
   if (is_mesh_path(a.out)) {
     ContourOptions co;
     co.split_sheets = !a.no_split;
+    co.simplify = a.raw ? 0 : a.simplify;
     const ContourFile f = write_contour(tree, a.out, co);
     written = f.written;
     j.add("contour_seconds", f.seconds)
         .add("triangles", f.mesh.triangles.size())
         .add("split_vertices", f.stats.split_vertices)
+        .add("simplified_away", f.stats.simplified_away)
         .add("volume", volume(f.mesh))
         .raw("topology", topology_json(f.written.topology));
     summary = std::to_string(f.mesh.triangles.size()) + " triangles (" + topology_words(f.written.topology) + ")";
@@ -86,6 +89,10 @@ void add_eval(CLI::App& app) {
   c->add_flag("--json", a->json, "Print one JSON object on stdout");
   c->add_flag("--serial", a->serial, "Do not use threads");
   c->add_flag("--no-split", a->no_split, "Mesh output: write the dual contouring mesh as is");
+  c->add_option("--simplify", a->simplify,
+                "Mesh output: merge flat regions and straight creases, every face within TOL finest cells")
+      ->capture_default_str();
+  c->add_flag("--raw", a->raw, "Mesh output: the contour as it is, a vertex per gray cell (no --simplify)");
   c->callback([a] { run(*a); });
 }
 

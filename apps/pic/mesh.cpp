@@ -11,6 +11,7 @@ namespace {
 struct MeshArgs {
   std::string in, out;
   bool json = false, no_split = false, no_check = false, fast = false, plain = false, fans = false;
+  double simplify = 0;  // finest cells
 };
 
 void run(const MeshArgs& a) {
@@ -19,6 +20,7 @@ void run(const MeshArgs& a) {
   opt.intersection_free = !a.plain;
   opt.split_sheets = !a.no_split;
   opt.fan_all = a.fans;
+  opt.simplify = a.simplify;
   const ContourFile f = write_contour(tree, a.out, opt);
   const TriMesh& mesh = f.mesh;
   const MeshTopology& topo = f.written.topology;
@@ -29,6 +31,7 @@ void run(const MeshArgs& a) {
         .add("triangles", mesh.triangles.size())
         .add("seconds", f.seconds)
         .add("split_vertices", f.stats.split_vertices)
+        .add("simplified_away", f.stats.simplified_away)
         .add("fans", f.stats.fans)
         .add("other_diagonal", f.stats.other_diagonal)
         .add("face_points", f.stats.face_points)
@@ -59,6 +62,9 @@ void add_mesh(CLI::App& app) {
   c->add_flag("--fast", a->fast, "Same as the default (the intersection-free contour is as fast as the plain one)");
   c->add_flag("--plain", a->plain,
               "Dual contouring's plain split everywhere, for comparison: slivers may fold through each other");
+  c->add_option("--simplify", a->simplify,
+                "Merge flat regions and straight creases, every face within TOL finest cells (0: the raw contour)")
+      ->capture_default_str();
   c->add_flag("--fans", a->fans,
               "Every dual polygon a fan around a point of its edge, for comparison (about 2.4 times the triangles)");
   c->callback([a] { run(*a); });

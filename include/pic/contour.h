@@ -22,6 +22,10 @@ struct ContourOptions {
   /// Every polygon a fan (for comparison: about 2.4 times the triangles). Overrides
   /// intersection_free.
   bool fan_all = false;
+  /// Merge the contour's vertices where the surface is flat or runs straight along a crease,
+  /// keeping every original plane within this many finest cells of the result (simplify());
+  /// 0: the raw contour, a vertex per gray leaf.
+  double simplify = 0;
 };
 struct ContourStats {
   size_t fans = 0;            ///< polygons triangulated as a fan around a point on their edge
@@ -29,6 +33,7 @@ struct ContourStats {
   size_t face_points = 0;     ///< polygon sides split at a point of their cells' common face
   size_t face_fans = 0;       ///< polygons with face points, fanned from a point of their own ring
   size_t split_vertices = 0;  ///< vertex copies added by split_sheets
+  size_t simplified_away = 0; ///< triangles removed by simplify
   // Kept for readers of `pic mesh --json`: the construction moves no vertex and leaves no
   // crossing to resolve, so these stay 0.
   size_t moved_vertices = 0;
@@ -56,5 +61,13 @@ inline TriMesh unsplit_contour(const Octree& tree) { return contour(tree, {true,
 /// into its own sheet, where the exact test finds no crossing: a reader that merges equal
 /// positions would otherwise see the pinch again.
 size_t split_nonmanifold(TriMesh& mesh);
+
+/// Collapses edges of a closed 2-manifold mesh (one end moves onto the other) while every plane
+/// of the original triangles around the merged vertices passes within `tolerance` of the kept
+/// vertex (a quadric of squared distances, summed: each is below it): flat regions become a
+/// few large triangles, straight creases keep their line, curved parts stay within tolerance.
+/// Each collapse keeps the mesh closed and 2-manifold (the link condition) and its triangles'
+/// orientation; a result with a crossing is not taken. Returns the triangles removed.
+size_t simplify(TriMesh& mesh, double tolerance);
 
 }  // namespace pic

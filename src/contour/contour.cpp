@@ -70,6 +70,10 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   }
   const size_t split_vertices = options.split_sheets ? split_nonmanifold(out) : 0;
   if (stats) stats->split_vertices = split_vertices;
+  if (options.simplify > 0) {
+    const size_t removed = simplify(out, options.simplify * tree.cube.size / double(int64_t{1} << tree.max_depth));
+    if (stats) stats->simplified_away = removed;
+  }
   return out;
 }
 
