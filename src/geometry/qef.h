@@ -36,8 +36,4 @@ struct Qef {
   Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi) const;
 };
 
-/// Relative eigenvalue cutoff of the pseudo-inverse. Singular values of A^(1/2) below 0.1 of
-/// the largest are dropped, as in Ju et al. 2002 (dual contouring).
-inline constexpr double kRelativeCutoff = 1e-2;
-
 }  // namespace pic::detail

@@ -10,6 +10,7 @@
 #include "geometry/lattice.h"
 #include "octree/cell.h"
 #include "geometry/qef.h"
+#include "geometry/tolerances.h"
 #include "octree/cell_vertex.h"
 
 namespace pic::detail {
@@ -88,7 +89,7 @@ class MeshSource : public SurfaceSource {
 
 struct SampleParams {
   int max_depth = 12;
-  double error = 1e-8;
+  double error = kDefaultQefError;
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
   uint32_t memo_id = 0;    // nonzero: one triangle set, whose edge crossing counts may be memoized

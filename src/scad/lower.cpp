@@ -12,6 +12,7 @@
 #include "scad/region.h"
 #include "scad/svg.h"
 #include "scad/text.h"
+#include "geometry/tolerances.h"
 
 namespace pic::detail::scad {
 namespace {
@@ -157,7 +158,7 @@ class Lowering {
       const Solid s = combine(Solid::Kind::Union, children3(n, kIdentity));
       if (s.kind == Solid::Kind::Empty) return s;
       const TriMesh surface = solid_surface(s, opt_);
-      Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+      Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
       for (const Vec3& p : surface.positions)
         for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
       const auto f = resize_factors(n, {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}, 3);
@@ -379,7 +380,7 @@ class Lowering {
     if (k == "offset") return offset(n, m);
     if (k == "resize") {
       const Region r = region_union(children2(n, kIdentity2));
-      double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+      double lo[2] = {kHuge, kHuge}, hi[2] = {-kHuge, -kHuge};
       for (const Ring& ring : r)
         for (const P2& p : ring)
           for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
@@ -470,7 +471,7 @@ class Lowering {
     const Region region = shape(n, m);
     const bool convex = std::all_of(region.begin(), region.end(), [](const Ring& ring) {
       const double area = signed_area(ring), hull = signed_area(convex_hull_2d(ring));
-      return area > 0 && std::abs(hull - area) <= 1e-9 * hull;
+      return area > 0 && std::abs(hull - area) <= kConvexArea * hull;
     });
     if (convex) {
       out.insert(out.end(), region.begin(), region.end());
