@@ -17,6 +17,7 @@
 #include <functional>
 #include <optional>
 
+#include "pic/contour.h"
 #include "csg/combine.h"
 #include "csg/operand.h"
 #include "csg/stamp.h"

@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

@@ -10,7 +10,8 @@
 #include "geometry/lattice.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/types.h"
 
 namespace pic {
 namespace {

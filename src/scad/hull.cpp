@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "pic/measure.h"
 #include "geometry/predicates.h"
 #include "geometry/tolerances.h"
 #include "geometry/union_find.h"

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include "pic/io.h"
+#include "pic/measure.h"
 #include "pic/primitives.h"
 #include "io/file_util.h"
 #include "scad/dxf.h"

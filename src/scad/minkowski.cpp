@@ -7,6 +7,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "pic/measure.h"
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "geometry/tolerances.h"
