@@ -26,6 +26,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
 namespace pic::detail {
@@ -49,7 +50,7 @@ Face common_face(const VertexCell& ca, const VertexCell& cb) {
   Face f;
   // The axis across the face: where the cells touch (centres half + half apart).
   int axis = 0;
-  double best = -1e300;
+  double best = -kHuge;
   for (int d = 0; d < 3; ++d) {
     const double gap = std::abs(cb.center[d] - ca.center[d]) - (ca.half + cb.half);
     if (gap > best) {
@@ -57,7 +58,7 @@ Face common_face(const VertexCell& ca, const VertexCell& cb) {
       axis = d;
     }
   }
-  if (std::abs(best) > 1e-9 * (ca.half + cb.half)) return f;
+  if (std::abs(best) > kTouchingCellsGap * (ca.half + cb.half)) return f;
   for (int d = 0; d < 3; ++d) {
     if (d == axis) continue;
     f.lo[d] = std::max(ca.center[d] - ca.half, cb.center[d] - cb.half);
@@ -208,7 +209,7 @@ double pierce_near(const std::vector<Vec3>& x, const std::vector<MeshPolygon>& p
 double mean_plane_height(const std::array<Vec3, 4>& p, int count, const Vec3& e0, const Vec3& e1) {
   const int a = axis_of(e0, e1);
   Vec3 c{0, 0, 0}, n{0, 0, 0};
-  double lo = 1e300, hi = -1e300;
+  double lo = kHuge, hi = -kHuge;
   for (int k = 0; k < count; ++k) {
     for (int d = 0; d < 3; ++d) c[d] += p[k][d] / count;
     const Vec3 x = cross3(p[k], p[(k + 1) % count]);
@@ -340,7 +341,7 @@ bool inside_ring(const Vec3* r, int n, const Vec3& e0, const Vec3& e1, const std
     if (c == 0 || (turn != 0 && (c > 0) != (turn > 0))) return false;
     turn = c;
   }
-  const double h0 = e0[ax], h1 = e1[ax], margin = 1e-9 * std::abs(h1 - h0);
+  const double h0 = e0[ax], h1 = e1[ax], margin = kRingHeightMargin * std::abs(h1 - h0);
   // Height z at fraction rho of the way out along ray k: strictly between the lines from e0
   // and from e1 to r_k.
   const auto between = [&](double z, double rho, int k) {

@@ -17,10 +17,12 @@
 #include <functional>
 #include <optional>
 
+#include "pic/contour.h"
 #include "csg/combine.h"
 #include "csg/operand.h"
 #include "csg/stamp.h"
 #include "signs/invariants.h"
+#include "geometry/tolerances.h"
 
 namespace pic {
 namespace detail {
@@ -42,7 +44,7 @@ std::optional<Octree> common_frame(Octree& a, const Octree& b_in, const CsgOptio
       resampled = sample(mb, so);
     } catch (const InvalidInput&) {
       Cube both;
-      double hi = -1e300;
+      double hi = -kHuge;
       for (int k = 0; k < 3; ++k) {
         both.origin[k] = std::min(a.cube.origin[k], b_in.cube.origin[k]);
         hi = std::max({hi, a.cube.origin[k] + a.cube.size - both.origin[k],

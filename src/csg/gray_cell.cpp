@@ -1,6 +1,7 @@
 // GraycellCSG's predicates (paper Figure 3): whether the summed QEF's vertex may stand for the
 // result in a cell, or the cell must be subdivided. See gray_cell.h.
 #include "csg/gray_cell.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
 namespace pic::detail {
@@ -107,13 +108,6 @@ EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axi
 
 }  // namespace
 
-/// Crossings of the two operands this close (unit cube) bound no sliver of the result where
-/// the result does not change across the pair: coplanar faces of the two operands (a cutter
-/// flush with a face) come through their stored float vertices up to a few float steps of the
-/// unit cube apart, and would otherwise count as two crossings and refine the whole shared
-/// face's rim to the depth cap. A sliver this thin is far below a finest cell.
-constexpr double kCoincident = 0x1p-22;
-
 /// Directed distances on each edge and the 1D CSG of the two crossings (paper 5.2.3,
 /// Table 1): two result crossings on one edge force a subdivision, as do two crossings of one
 /// operand on an edge of a virtual cell.
@@ -176,10 +170,10 @@ bool surfaces_coincide(const Operand& xa, const Side& a, const Operand& xb, cons
   if (a.idx.empty() || b.idx.empty()) return false;
   // Within a millionth of the cell, or a few float steps of the unit cube (the operands' float
   // vertices on one exact plane).
-  const double tol = std::max(1e-6 * cell.size(), kCoincident);
+  const double tol = std::max(kCoincidentRelative * cell.size(), kCoincident);
   const auto same_plane = [&](const ITri& s, const ITri& t) {
     const double c = dot3(s.unit_normal, t.unit_normal);
-    if (std::abs(std::abs(c) - 1) > 1e-9) return false;
+    if (std::abs(std::abs(c) - 1) > kParallelCosine) return false;
     return std::abs((c > 0 ? t.plane : -t.plane) - s.plane) <= tol;
   };
   // Every plane of one operand here is a plane of the other (a cutter flush with a face, or

@@ -15,6 +15,7 @@
 #include "geometry/bvh.h"
 #include "geometry/stopwatch.h"
 #include "geometry/key_bits.h"
+#include "geometry/tolerances.h"
 #include "octree/dual_walk.h"
 #include "csg/cleanup.h"
 #include "octree/subdivide.h"
@@ -77,7 +78,7 @@ struct Operand {
     double best_d = -1;
     for (int c = 0; c < 8; ++c) {
       const Vec3 p = to_unit(lattice_to_grid(cell.corner(c)));
-      double d = 1e300;
+      double d = kHuge;
       for (uint32_t k : idx) {
         d = std::min(d, point_triangle_distance2(p, tris[k]));
         if (d <= best_d) break;  // no farther than the best corner so far: cannot replace it

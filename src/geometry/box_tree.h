@@ -10,7 +10,7 @@
 
 #include <tbb/parallel_invoke.h>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

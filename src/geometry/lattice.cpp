@@ -1,4 +1,5 @@
 #include "geometry/lattice.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
 #include <algorithm>
@@ -203,7 +204,7 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi) {
     for (int k = 0; k < 3; ++k) {
       // Axis = unit vector k x f: components (i, j) = (-f[j], f[i]) for (i, j) the other two.
       const int i = (k + 1) % 3, j = (k + 2) % 3;
-      double pmin = 1e300, pmax = -1e300, mag = 0;
+      double pmin = kHuge, pmax = -kHuge, mag = 0;
       for (const auto& w : v) {
         const double p = -f[j] * w[i] + f[i] * w[j];
         pmin = std::min(pmin, p);
@@ -211,7 +212,7 @@ bool edges_may_touch_box(const ITri& t, const I3& lo, const I3& hi) {
         mag = std::max(mag, std::abs(f[j] * w[i]) + std::abs(f[i] * w[j]));
       }
       const double r = half[i] * std::abs(f[j]) + half[j] * std::abs(f[i]);
-      const double slack = 1e-12 * (mag + r) + 1;
+      const double slack = kProductRounding * (mag + r) + 1;
       if (pmin > r + slack || pmax < -r - slack) return false;
     }
   }
@@ -232,7 +233,7 @@ ChildEdgeTest::ChildEdgeTest(const ITri& t, const IBox& parent) {
     for (int k = 0; k < 3; ++k) {
       const int i = (k + 1) % 3, j = (k + 2) % 3, x = 3 * e + k;
       double mag = 0;
-      pmin_[x] = 1e300, pmax_[x] = -1e300;
+      pmin_[x] = kHuge, pmax_[x] = -kHuge;
       for (const auto& w : v) {
         const double p = -f[j] * w[i] + f[i] * w[j];
         pmin_[x] = std::min(pmin_[x], p);
@@ -244,7 +245,7 @@ ChildEdgeTest::ChildEdgeTest(const ITri& t, const IBox& parent) {
       b_[x] = f[i] * q;
       const double r = q * (std::abs(f[j]) + std::abs(f[i]));
       // About the child's centre the vertices' terms grow by at most r: edges_may_touch_box's margin.
-      reach_[x] = r + (1e-12 * (mag + 2 * r) + 1);
+      reach_[x] = r + (kProductRounding * (mag + 2 * r) + 1);
     }
   }
 }
@@ -351,10 +352,9 @@ bool triangles_meet_in_box(const ITri& a, const ITri& b, const IBox& box) {
     db[k] = dot3(nb, sub3(pa[k], pb[0])) / lb;  // a's vertices vs plane b
     da[k] = dot3(na, sub3(pb[k], pa[0])) / la;  // b's vertices vs plane a
   }
-  constexpr double kEps = 1e-13;  // root-cube units: snap near-zero distances to the plane
   for (auto* d : {&da, &db})
     for (double& x : *d)
-      if (std::abs(x) < kEps) x = 0;
+      if (std::abs(x) < kPlaneSnap) x = 0;  // snap near-zero distances to the plane
   auto same_side = [](const std::array<double, 3>& d) {
     return (d[0] > 0 && d[1] > 0 && d[2] > 0) || (d[0] < 0 && d[1] < 0 && d[2] < 0);
   };

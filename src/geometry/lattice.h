@@ -15,7 +15,8 @@
 #include <optional>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/octree.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

@@ -1,4 +1,5 @@
 #include "geometry/qef.h"
+#include "geometry/tolerances.h"
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -47,7 +48,6 @@ bool in_box(const Eigen::Vector3d& x, const Vec3& lo, const Vec3& hi) {
 }  // namespace
 
 Qef::Solution Qef::solve(const Vec3& seed) const {
-  constexpr double kHuge = 1e300;
   return solve_in_box(seed, {-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge});
 }
 
@@ -76,9 +76,9 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
     Eigen::Vector3d d;
     for (int k = 0; k < 3; ++k)
       if (inv[k] == 0) d = u.col(k);
-    double t0 = -1e300, t1 = 1e300;
+    double t0 = -kHuge, t1 = kHuge;
     for (int k = 0; k < 3; ++k) {
-      if (std::abs(d[k]) < 1e-300) {
+      if (std::abs(d[k]) < kTinyDivisor) {
         if (x[k] < lo[k] || x[k] > hi[k]) t0 = 1, t1 = 0;
         continue;
       }

@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 
@@ -35,9 +35,5 @@ struct Qef {
   /// the middle of the line's chord through the box, or the centroid of the plane's section.
   Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi) const;
 };
-
-/// Relative eigenvalue cutoff of the pseudo-inverse. Singular values of A^(1/2) below 0.1 of
-/// the largest are dropped, as in Ju et al. 2002 (dual contouring).
-inline constexpr double kRelativeCutoff = 1e-2;
 
 }  // namespace pic::detail

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

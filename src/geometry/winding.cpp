@@ -7,6 +7,7 @@
 #include <numbers>
 #include <optional>
 
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
 namespace pic::detail {
@@ -128,7 +129,7 @@ uint32_t DipoleTree::build_range(uint32_t begin, uint32_t end, const std::functi
   // Centre weighted by |area| (plain average when all areas vanish).
   double wsum = 0;
   Vec3 c{0, 0, 0}, plain{0, 0, 0};
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
   for (uint32_t i = begin; i < end; ++i) {
     const Element& e = elems_[i];
     c = add3(c, scale3(e.centre, e.abs_area));
@@ -242,7 +243,7 @@ std::optional<bool> DipoleTree::inside_far(const Vec3& p, double offset) const {
       stack[n++] = k + 1;
     }
   }
-  if (std::abs(std::abs(offset - w) - 0.5) > bound + 1e-9) return std::abs(offset - w) >= 0.5;
+  if (std::abs(std::abs(offset - w) - 0.5) > bound + kWindingRounding) return std::abs(offset - w) >= 0.5;
   return std::nullopt;
 }
 
@@ -294,7 +295,7 @@ bool DipoleTree::inside(const Vec3& p, const I3* gp, double offset, double toler
     const double w = w_far + w_points + turns;
     const double margin = std::abs(std::abs(offset - w) - 0.5);
     // Rounding of the exact sums, and of the running bound, is far below 1e-9.
-    if (heap.empty() || margin > bound + 1e-9 || bound < tolerance) return std::abs(offset - w) >= 0.5;
+    if (heap.empty() || margin > bound + kWindingRounding || bound < tolerance) return std::abs(offset - w) >= 0.5;
     if (!is_heap) std::make_heap(heap.begin(), heap.end()), is_heap = true;
     // Open the largest bounds until their sum has halved before looking again (each look
     // costs an atan2).
@@ -323,7 +324,7 @@ Vec3 boundary_field(const std::vector<std::array<Vec3, 2>>& edges, const Vec3& p
     const Vec3 ra = sub3(a, p), rb = sub3(b, p);
     const double la = norm3(ra), lb = norm3(rb);
     const double den = la * lb * (la * lb + dot3(ra, rb));
-    if (!(den > 1e-300)) continue;  // p on the segment's line
+    if (!(den > kTinyDivisor)) continue;  // p on the segment's line
     f = add3(f, scale3(cross3(ra, rb), (la + lb) / den));
   }
   return f;

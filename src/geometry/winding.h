@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "geometry/lattice.h"
+#include "geometry/tolerances.h"
 
 namespace pic::detail {
 
@@ -44,7 +45,7 @@ AngleTerms triangle_angle_terms(const Vec3& p, const Vec3& a, const Vec3& b, con
   t.den = la * lb * lc + (A[0] * B[0] + A[1] * B[1] + A[2] * B[2]) * lc +
           (B[0] * C[0] + B[1] * C[1] + B[2] * C[2]) * la + (C[0] * A[0] + C[1] * A[1] + C[2] * A[2]) * lb;
   // In the plane (relative to the terms' size) the sign of det is noise: use the side given.
-  if (std::abs(t.det) <= 1e-10 * la * lb * lc) {
+  if (std::abs(t.det) <= kInPlaneDet * la * lb * lc) {
     const int s = side();
     if (s != 0) t.det = s > 0 ? 0.0 : -0.0;
   }
@@ -73,7 +74,7 @@ class AngleSum {
     if (lower_a && lower_b && !std::signbit(im)) --turns_;   // ... or -pi
     re_ = re;
     im_ = im;
-    if (std::abs(re_) + std::abs(im_) < 1e-100) {
+    if (std::abs(re_) + std::abs(im_) < kAngleRenormalize) {
       const double r = 1 / (std::abs(re_) + std::abs(im_));
       re_ *= r;
       im_ *= r;

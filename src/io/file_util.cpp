@@ -7,7 +7,8 @@
 #include <random>
 #include <string>
 
-#include "pic/pic.h"
+#include "pic/io.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

@@ -22,8 +22,9 @@
 #include "io/file_util.h"
 #include "mesh/clean.h"
 #include "io/readers.h"
+#include "pic/io.h"
 #include "pic/measure.h"
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic {
 namespace {

@@ -7,6 +7,7 @@
 #include "io/file_util.h"
 #include "pic/scad.h"
 #include "pic/types.h"
+#include "geometry/tolerances.h"
 
 namespace pic {
 namespace {
@@ -18,7 +19,7 @@ std::string num(double x) {
 }
 
 void write_svg(const Outline& o, std::ofstream& out) {
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  double lo[2] = {detail::kHuge, detail::kHuge}, hi[2] = {-detail::kHuge, -detail::kHuge};
   for (const auto& r : o.rings)
     for (const auto& p : r)
       for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);

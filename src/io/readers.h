@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/io.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

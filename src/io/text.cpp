@@ -3,7 +3,7 @@
 #include <charconv>
 #include <cstdlib>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

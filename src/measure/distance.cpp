@@ -8,8 +8,10 @@
 #include <numeric>
 
 #include "geometry/lattice.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/types.h"
 
 namespace pic {
 namespace {
@@ -100,8 +102,8 @@ class MeshDistance {
   // Builds the subtree of order_[first, last) into nodes_[id]; children are consecutive.
   void build(uint32_t id, uint32_t first, uint32_t last) {
     BNode nd;
-    nd.lo = {1e300, 1e300, 1e300};
-    nd.hi = {-1e300, -1e300, -1e300};
+    nd.lo = {detail::kHuge, detail::kHuge, detail::kHuge};
+    nd.hi = {-detail::kHuge, -detail::kHuge, -detail::kHuge};
     for (uint32_t i = first; i < last; ++i)
       for (int k = 0; k < 3; ++k) {
         nd.lo[k] = std::min(nd.lo[k], lo_[order_[i]][k]);

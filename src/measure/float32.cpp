@@ -20,7 +20,8 @@
 #include "geometry/box_tree.h"
 #include "geometry/predicates.h"
 #include "measure/self_intersect.h"
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/types.h"
 
 namespace pic {
 namespace {

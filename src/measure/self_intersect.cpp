@@ -19,7 +19,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/types.h"
 #include "geometry/box_tree.h"
 #include "geometry/predicates.h"
 #include "geometry/union_find.h"

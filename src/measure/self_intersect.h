@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

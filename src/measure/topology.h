@@ -4,7 +4,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/measure.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <unordered_map>
 
+#include "geometry/tolerances.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
 
@@ -127,7 +128,7 @@ void count_defects(const TriMesh& m, const std::vector<EdgeUse>& uses, MeshDefec
   });
   // Bounding boxes per shell (indexed by the shell's root triangle); a sweep along x finds
   // the first overlapping pair.
-  std::vector<std::array<Vec3, 2>> boxes(m.triangles.size(), {Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}});
+  std::vector<std::array<Vec3, 2>> boxes(m.triangles.size(), {Vec3{kHuge, kHuge, kHuge}, Vec3{-kHuge, -kHuge, -kHuge}});
   std::vector<uint32_t> roots;
   for (uint32_t f = 0; f < m.triangles.size(); ++f) {
     const size_t r = shells.root(f);

@@ -7,7 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/sample.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

@@ -2,6 +2,7 @@
 #include <algorithm>
 
 #include "octree/cell.h"
+#include "geometry/tolerances.h"
 
 namespace pic {
 
@@ -9,8 +10,8 @@ OctreeStats analyze(const Octree& tree) {
   OctreeStats s;
   s.memory_bytes = tree.nodes.size() * sizeof(Node) + tree.vertices.size() * sizeof(tree.vertices[0]);
   s.levels.resize(tree.max_depth + 1);
-  s.bbox_min = {1e300, 1e300, 1e300};
-  s.bbox_max = {-1e300, -1e300, -1e300};
+  s.bbox_min = {detail::kHuge, detail::kHuge, detail::kHuge};
+  s.bbox_max = {-detail::kHuge, -detail::kHuge, -detail::kHuge};
   std::function<void(uint32_t, const detail::Cell&)> walk = [&](uint32_t node, const detail::Cell& cell) {
     const Node& n = tree.nodes[node];
     ++s.nodes;  // reachable nodes: an octree edited in place may hold replaced ones

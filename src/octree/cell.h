@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "geometry/lattice.h"
-#include "pic/pic.h"
+#include "pic/octree.h"
+#include "pic/types.h"
 
 namespace pic::detail {
 

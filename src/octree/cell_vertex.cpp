@@ -1,19 +1,15 @@
 // The representative vertex of a gray cell (paper section 4, Figure 2).
 #include "octree/cell_vertex.h"
+#include "geometry/tolerances.h"
 
 #include <bit>
 
 namespace pic::detail {
 
-namespace {
-/// How much more than the QEF's minimum a tip corner's error may be, in cell sizes squared.
-constexpr double kTipTolerance = 1e-12;
-}  // namespace
-
 bool inside_cell(const Vec3& x, const Cell& cell) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
-  const double slack = 1e-9 * s;
+  const double slack = kInsideCellSlack * s;
   for (int k = 0; k < 3; ++k)
     if (x[k] < m[k] - slack || x[k] > m[k] + s + slack) return false;
   return true;
@@ -53,7 +49,7 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool ti
   if (inside_cell(sol.position, cell)) return sol;
   // Reseed from the corner closest to the surface (smallest QEF value).
   int best = 0;
-  double best_err = 1e300;
+  double best_err = kHuge;
   for (int c = 0; c < 8; ++c) {
     const Vec3 p{m[0] + (c & 1) * s, m[1] + ((c >> 1) & 1) * s, m[2] + ((c >> 2) & 1) * s};
     const double e = q.error(p);

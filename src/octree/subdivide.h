@@ -12,6 +12,7 @@
 #include "geometry/memo.h"
 #include "octree/cell.h"
 #include "geometry/qef.h"
+#include "geometry/tolerances.h"
 #include "octree/cell_vertex.h"
 
 namespace pic::detail {
@@ -89,7 +90,7 @@ using EdgeCountMemo = ThreadMemo<EdgeCount, 13>;
 
 struct SampleParams {
   int max_depth = 12;
-  double error = 1e-8;
+  double error = kDefaultQefError;
   bool invert = false;     // write complemented signs/colours (for black - X in CSG)
   int parallel_levels = 0; // build children of cells above this level with TBB
   /// Set: one triangle set through the whole call, whose edge crossing counts may be memoized.

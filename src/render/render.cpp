@@ -7,6 +7,7 @@
 #include "pic/render.h"
 
 #include "io/file_util.h"
+#include "geometry/tolerances.h"
 
 #include <png.h>
 #include <unistd.h>
@@ -136,7 +137,7 @@ Camera make_camera(const RenderOptions& opt, int w, int h, const Bounds& b,
   cam.forward = mul(forward, 1.0 / fl);
   Vec3 right = cross(cam.forward, up);
   double rl = norm(right);
-  if (!(rl > 1e-12) || !std::isfinite(rl))
+  if (!(rl > detail::kParallelUp) || !std::isfinite(rl))
     throw InvalidInput("render: camera up vector is parallel to the view direction");
   cam.right = mul(right, 1.0 / rl);
   cam.up = cross(cam.right, cam.forward);
@@ -160,7 +161,7 @@ Camera make_camera(const RenderOptions& opt, int w, int h, const Bounds& b,
 
   if (cam.perspective) {
     cam.scale = half_pixels / std::tan(0.5 * kFovY);
-    cam.near = 1e-4 * radius;
+    cam.near = detail::kNearPlane * radius;
     if (eye) {
       cam.origin = *eye;
       return cam;
@@ -175,7 +176,7 @@ Camera make_camera(const RenderOptions& opt, int w, int h, const Bounds& b,
       if (z > cam.near) extend(dot(r, cam.right) / z, dot(r, cam.up) / z);
     });
     if (x0 < x1 || y0 < y1) {
-      double ex = std::max(x1 - x0, 1e-3), ey = std::max(y1 - y0, 1e-3);
+      double ex = std::max(x1 - x0, detail::kMinViewExtent), ey = std::max(y1 - y0, detail::kMinViewExtent);
       cam.scale = 0.9 * std::min(w / ex, h / ey);
       cam.cx = 0.5 * w - 0.5 * (x0 + x1) * cam.scale;
       cam.cy = 0.5 * h + 0.5 * (y0 + y1) * cam.scale;
@@ -192,7 +193,7 @@ Camera make_camera(const RenderOptions& opt, int w, int h, const Bounds& b,
   for_each_drawn([&](const Vec3& p) { extend(dot(p, cam.right), dot(p, cam.up)); });
   if (!(x0 <= x1)) x0 = x1 = y0 = y1 = 0;
   // A flat or single-point object still gets a finite zoom.
-  double ex = std::max(x1 - x0, 1e-3 * radius), ey = std::max(y1 - y0, 1e-3 * radius);
+  double ex = std::max(x1 - x0, detail::kMinViewExtent * radius), ey = std::max(y1 - y0, detail::kMinViewExtent * radius);
   cam.scale = 0.9 * std::min(w / ex, h / ey);
   // origin: the point projecting to the centre of the projected extent, at the box centre depth.
   Vec3 c = b.center();
@@ -245,7 +246,7 @@ void draw_triangles(Canvas& cv, const Camera& cam, const TriMesh& mesh,
     // they only occur with a user camera placed inside the object.
     if (!a.ok || !b.ok || !c.ok) continue;
     double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    if (!(std::abs(area) > 1e-12)) continue;
+    if (!(std::abs(area) > detail::kDegenerateScreenArea)) continue;
     int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, c.x}))));
     int x1 = std::min(cv.w - 1, int(std::ceil(std::max({a.x, b.x, c.x}))));
     int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, c.y}))));
@@ -279,7 +280,7 @@ void draw_triangles(Canvas& cv, const Camera& cam, const TriMesh& mesh,
       size_t row = size_t(y) * cv.w;
       for (int x = x0; x <= x1; ++x) {
         // A small negative tolerance closes cracks between triangles sharing an edge.
-        if (u >= -1e-9 && v >= -1e-9 && s >= -1e-9) {
+        if (u >= -detail::kRasterEdgeSlack && v >= -detail::kRasterEdgeSlack && s >= -detail::kRasterEdgeSlack) {
           double zd = cam.depth(u * a.q + v * b.q + s * c.q);
           float z = float(back ? zd + cam.pixel_size(zd) : zd);
           size_t i = row + x;

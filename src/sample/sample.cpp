@@ -8,6 +8,7 @@
 #include "signs/invariants.h"
 #include "signs/settle.h"
 #include "geometry/stopwatch.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
 #include <algorithm>
@@ -24,7 +25,7 @@ using Lat = std::array<int64_t, 3>;
 
 Cube bounding_cube(const TriMesh& mesh, double margin) {
   if (mesh.positions.empty()) throw InvalidInput("mesh has no vertices");
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
   for (const Vec3& p : mesh.positions)
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);

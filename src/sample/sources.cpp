@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include "geometry/tolerances.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
 #include "mesh/clean.h"
@@ -22,13 +23,6 @@ namespace {
 int sgn(i128 v) { return (v > 0) - (v < 0); }
 
 constexpr i64 kGridMax = i64{1} << kGridBits;
-
-// Winding-number decisions stop refining once the far field's truncation bound is below these
-// (docs/algorithms.md): a cap's level set may move to where w is within the tolerance of 1/2.
-// A point cloud's w is itself an estimate (Barill et al. 2018): its decisions take the
-// far-field sum as it is.
-constexpr double kCapTolerance = 0.05;
-constexpr double kPointTolerance = 1e300;
 
 Vec3 unit_vec(const Vec3& v) {
   const double l = norm3(v);
@@ -80,7 +74,7 @@ std::optional<Vec3> level_on_edge(const Cell& cell, int c0, int axis, bool s0, G
       if (last == -1) flo /= 2;
       last = -1;
     }
-    if (std::abs(fx) < 1e-9) break;
+    if (std::abs(fx) < kLevelRootValue) break;
   }
   return to_unit(along(lattice_to_grid(cell.corner(c0)), axis, lo + (hi - lo) / 2));
 }
@@ -132,7 +126,7 @@ std::vector<Box> loop_boxes(const std::vector<std::vector<uint32_t>>& loops, con
                             double margin, double spread) {
   std::vector<Box> out;
   for (const auto& loop : loops) {
-    Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+    Box b{{kHuge, kHuge, kHuge}, {-kHuge, -kHuge, -kHuge}};
     for (uint32_t v : loop) {
       const Vec3 p = to_unit(grid[v]);
       for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], p[k]), b.hi[k] = std::max(b.hi[k], p[k]);
@@ -166,7 +160,7 @@ std::vector<CapExtent> cap_extents(const std::vector<std::array<uint32_t, 3>>& c
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
     const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(kHuge), hi = -lo;
     for (const auto& p : pts) {
       const Eigen::Vector3d q = axes.transpose() * (p - mean);
       lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
@@ -518,7 +512,7 @@ size_t WindingSource::drop_interior_triangles() {
     if (is_degenerate(t)) return;
     const Vec3 v[3] = {to_unit(t.v[0]), to_unit(t.v[1]), to_unit(t.v[2])};
     const Vec3 c{(v[0][0] + v[1][0] + v[2][0]) / 3, (v[0][1] + v[1][1] + v[2][1]) / 3, (v[0][2] + v[1][2] + v[2][2]) / 3};
-    const double delta = 1e-6;
+    const double delta = kInteriorProbe;
     // The centroid, then halfway to each vertex: a triangle is kept when the sign differs
     // across it anywhere we look.
     for (int s = 0; s < 4; ++s) {
@@ -552,7 +546,7 @@ std::vector<double> kth_neighbour_distance(const std::vector<Vec3>& pos, int k) 
   Vec3 lo = pos[0], hi = pos[0];
   for (const Vec3& p : pos)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], kTinyDivisor});
   // Points on a surface: about 2 per bucket of this size.
   const double g = 2 * extent / std::sqrt(double(n));
   auto key_of = [&](int64_t x, int64_t y, int64_t z) { return (uint64_t(x) * 73856093u) ^ (uint64_t(y) * 19349663u) ^ (uint64_t(z) * 83492791u); };

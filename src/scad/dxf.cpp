@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "pic/types.h"
+#include "geometry/tolerances.h"
 
 namespace pic::detail::scad {
 namespace {
@@ -215,7 +216,7 @@ Region read_dxf(const std::filesystem::path& path, const DxfImport& how) {
   double extent = 0;
   for (const Segment& s : segs)
     for (const P2& p : s) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
-  for (Ring& r : rings_from_segments(segs, std::max(extent, 1.0) * 1e-9)) rings.push_back(std::move(r));
+  for (Ring& r : rings_from_segments(segs, std::max(extent, 1.0) * kDxfJoin)) rings.push_back(std::move(r));
   return region_even_odd(rings);
 }
 

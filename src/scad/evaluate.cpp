@@ -11,9 +11,16 @@
 #include <sstream>
 
 #include "geometry/stopwatch.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
-#include "pic/pic.h"
 #include "mesh/clean.h"
+#include "pic/contour.h"
+#include "pic/csg.h"
+#include "pic/measure.h"
+#include "pic/octree.h"
+#include "pic/sample.h"
+#include "pic/scad.h"
+#include "pic/types.h"
 #include "scad/lower.h"
 
 namespace pic {
@@ -77,7 +84,7 @@ LeafExtent extent_of(const TriMesh& m) {
     const double len = norm3(n);
     if (!(len > 0)) continue;
     const Vec3 u = scale3(n, 1 / len);
-    const auto same = [&](const Vec3& d) { return std::abs(dot3(d, u)) > 1 - 1e-9; };
+    const auto same = [&](const Vec3& d) { return std::abs(dot3(d, u)) > 1 - detail::kParallelCosine; };
     if (std::any_of(e.dirs.begin(), e.dirs.end(), same)) continue;
     if (e.dirs.size() == kMaxDirs) {
       e.dirs.clear();
@@ -91,7 +98,7 @@ LeafExtent extent_of(const TriMesh& m) {
 /// Whether the ranges of the two meshes' vertices along `d` are apart.
 bool apart_along(const TriMesh& a, const TriMesh& b, const Vec3& d) {
   const auto range = [&](const TriMesh& m) {
-    double lo = 1e300, hi = -1e300;
+    double lo = detail::kHuge, hi = -detail::kHuge;
     for (const Vec3& p : m.positions) {
       const double x = detail::dot3(p, d);
       lo = std::min(lo, x);
@@ -269,7 +276,7 @@ void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& tr
 
 TriMesh solid_surface(const Solid& s, const EvalOptions& options) {
   if (s.kind == Solid::Kind::Mesh) return s.mesh;
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
   size_t leaves = 0, tris = 0;
   solid_bounds(s, lo, hi, leaves, tris);
   if (leaves == 0) return {};
@@ -310,7 +317,7 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
   EvalOptions first = options;
   if (options.smooth) first.smooth = false;
   Solid model = lower(0, &st.nodes);
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
   solid_bounds(model, lo, hi, st.leaves, st.triangles);
   if (model.kind == Solid::Kind::Empty || st.leaves == 0) throw InvalidInput(source + ": the model is empty");
   TriMesh corners;

@@ -13,7 +13,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "pic/measure.h"
 #include "geometry/predicates.h"
+#include "geometry/tolerances.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
 #include "scad/lower.h"
@@ -150,7 +152,7 @@ bool is_convex(const TriMesh& m) {
   for (const auto& t : m.triangles)
     for (uint32_t v : t)
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.positions[v][k]), hi[k] = std::max(hi[k], m.positions[v][k]);
-  const double eps = 1e-9 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  const double eps = kOnPlane * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
   by_edge.reserve(3 * m.triangles.size());
   for (uint32_t f = 0; f < m.triangles.size(); ++f)
@@ -186,7 +188,7 @@ std::vector<Plane> face_planes(const TriMesh& hull) {
     const Plane p{scale3(n, 1 / len), dot3(n, a) / len};
     // The two triangles of a quad give one plane: one clipped piece, not two.
     const bool seen = std::any_of(out.begin(), out.end(), [&](const Plane& q) {
-      return dot3(p.n, q.n) > 1 - 1e-12 && std::abs(p.d - q.d) <= 1e-12 * (1 + std::abs(p.d));
+      return dot3(p.n, q.n) > 1 - kSamePlaneCosine && std::abs(p.d - q.d) <= kSamePlaneOffset * (1 + std::abs(p.d));
     });
     if (!seen) out.push_back(p);
   }

@@ -13,6 +13,7 @@
 
 #include "pic/scad.h"
 #include "scad/scad_detail.h"
+#include "geometry/tolerances.h"
 
 namespace pic::detail::scad {
 
@@ -31,7 +32,7 @@ Solid lower(const Node& root, const EvalOptions& options, double finest_cell, si
 
 /// The bounding box of points: {lo, hi}.
 inline std::array<Vec3, 2> box_of(const std::vector<Vec3>& pts) {
-  std::array<Vec3, 2> b{Vec3{1e300, 1e300, 1e300}, Vec3{-1e300, -1e300, -1e300}};
+  std::array<Vec3, 2> b{Vec3{kHuge, kHuge, kHuge}, Vec3{-kHuge, -kHuge, -kHuge}};
   for (const Vec3& p : pts)
     for (int k = 0; k < 3; ++k) b[0][k] = std::min(b[0][k], p[k]), b[1][k] = std::max(b[1][k], p[k]);
   return b;

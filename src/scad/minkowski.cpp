@@ -7,8 +7,10 @@
 #include <optional>
 #include <unordered_map>
 
+#include "pic/measure.h"
 #include "scad/lower.h"
 #include "scad/region.h"
+#include "geometry/tolerances.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
 
@@ -35,7 +37,7 @@ std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol)
     const auto& t = m.triangles[f];
     for (int e = 0; e < 3; ++e) {
       const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
-      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) < 1 - 1e-8) continue;
+      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) < 1 - kFlatNeighbourCosine) continue;
       bool flat = true;
       for (uint32_t v : m.triangles[it->second])
         flat = flat && std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[t[0]]))) <= tol;
@@ -151,7 +153,7 @@ std::optional<Vec3> prism_axis(const TriMesh& m, double eps) {
   std::sort(normals.begin(), normals.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
   for (size_t i = 0; i < normals.size() && i < 16; ++i) {
     const Vec3& axis = normals[i].second;
-    double z0 = 1e300, z1 = -1e300;
+    double z0 = kHuge, z1 = -kHuge;
     for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
     bool two = z1 - z0 > eps;
     for (size_t k = 0; k < m.positions.size() && two; ++k) {
@@ -182,7 +184,7 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
   const std::optional<Vec3> found = prism_axis(m, eps);
   if (!found) return false;
   const Vec3 axis = *found;
-  double z0 = 1e300, z1 = -1e300;
+  double z0 = kHuge, z1 = -kHuge;
   for (const Vec3& p : m.positions) z0 = std::min(z0, dot3(axis, p)), z1 = std::max(z1, dot3(axis, p));
   const Vec3 seed = std::abs(axis[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
   Vec3 u = cross3(axis, seed);
@@ -211,7 +213,7 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
   const Region outline = region_union({cap});
   // The prism's volume must be the cap's area times its height (else the walls are not the
   // cap's outline moved straight up: a mesh with the same vertices but other faces).
-  if (std::abs(region_area(outline) * (z1 - z0) - volume(m)) > 1e-6 * std::abs(volume(m))) return false;
+  if (std::abs(region_area(outline) * (z1 - z0) - volume(m)) > kPrismVolume * std::abs(volume(m))) return false;
   for (const Ring& r : convex_pieces(outline)) {
     Convex c;
     for (const P2& q : r) {
@@ -315,11 +317,11 @@ void parts_of(const Solid& s, const EvalOptions& o, std::vector<Part>& out) {
     for (const Solid& c : s.children) parts_of(c, o, out);
     return;
   }
-  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
   size_t leaves = 0, triangles = 0;
   solid_bounds(s, lo, hi, leaves, triangles);
   std::vector<Convex> convex_parts;
-  if (convex_decomposition(s, 1e-9 * norm3(sub3(hi, lo)), convex_parts)) {
+  if (convex_decomposition(s, kOnPlane * norm3(sub3(hi, lo)), convex_parts)) {
     for (Convex& c : convex_parts) out.push_back({std::move(c), {}});
     return;
   }
@@ -354,7 +356,7 @@ void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& ou
   // Float contour vertices on a flat face sit within ~1e-7 of a cell of its plane: 1e-6 of the
   // extent. (Faces of a tessellated curve are not recovered at any useful tolerance: the
   // contour's vertices between them are the sampler's, not the facets'.)
-  const double tol = 1e-6 * norm3(sub3(hi, lo));
+  const double tol = kFlatFaceTolerance * norm3(sub3(hi, lo));
   const auto pieces = planar_pieces(n, tol);
   if (pieces.size() > kMaxPieces)
     throw InvalidInput("a non-convex operand with " + std::to_string(pieces.size()) +

@@ -2,6 +2,7 @@
 // integers with a power-of-two scale fitted to them (about 30 bits across the operands' extent,
 // Clipper's fast 64-bit range), runs, and converts back.
 #include "scad/region.h"
+#include "geometry/tolerances.h"
 
 #include <polyclipping/clipper.hpp>
 
@@ -94,7 +95,7 @@ Region region_difference(const std::vector<Region>& parts) {
 Region region_offset(const Region& region, double amount, OffsetJoin join, double arc_tolerance) {
   const double scale = fitted_scale({&region}) / 2;  // room for the region to grow
   // OpenSCAD's miter limit for delta is effectively unbounded (sharp corners stay sharp).
-  cl::ClipperOffset co(join == OffsetJoin::kMiter ? 1e6 : 2.0, std::max(arc_tolerance, 1e-9) * scale);
+  cl::ClipperOffset co(join == OffsetJoin::kMiter ? kUnboundedMiter : 2.0, std::max(arc_tolerance, kMinArcTolerance) * scale);
   const cl::JoinType jt = join == OffsetJoin::kRound ? cl::jtRound : join == OffsetJoin::kMiter ? cl::jtMiter : cl::jtSquare;
   co.AddPaths(to_paths(region, scale), jt, cl::etClosedPolygon);
   cl::Paths out;
@@ -154,7 +155,7 @@ bool convex_ring(const Ring& r) {
   const size_t n = r.size();
   double extent = 0;
   for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
-  const double eps = 1e-12 * extent * extent;
+  const double eps = kCollinearCross * extent * extent;
   for (size_t i = 0; i < n; ++i) {
     const P2 &a = r[i], &b = r[(i + 1) % n], &c = r[(i + 2) % n];
     if ((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) < -eps) return false;

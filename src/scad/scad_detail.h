@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pic/pic.h"
+#include "pic/types.h"
 
 namespace pic::detail::scad {
 

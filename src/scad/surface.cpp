@@ -11,6 +11,7 @@
 
 #include "io/file_util.h"
 #include "scad/lower.h"
+#include "geometry/tolerances.h"
 
 namespace pic::detail::scad {
 namespace {
@@ -65,7 +66,7 @@ TriMesh surface_mesh(const std::filesystem::path& path, bool center, bool invert
     if (r.size() != cols) throw InvalidInput(path.string() + ": rows of different lengths");
   TriMesh m;
   if (rows < 2 || cols < 2) return m;
-  double lo = 1e300;
+  double lo = kHuge;
   for (const auto& r : h)
     for (double v : r) lo = std::min(lo, v);
   const double bottom = lo - 1;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "pic/measure.h"
 #include "geometry/vec3.h"
 #include "scad/scad_detail.h"
 

@@ -1,5 +1,6 @@
 // text(): see text.h.
 #include "scad/text.h"
+#include "geometry/tolerances.h"
 
 #include <fontconfig/fontconfig.h>
 #include <ft2build.h>
@@ -170,7 +171,7 @@ Region text_region(const TextParams& p) {
   Region region = region_union({sink.rings});
   // Alignment: along the line by the advance, across it by the outlines' extent, which
   // OpenSCAD measures at the advances' scale too.
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  double lo[2] = {kHuge, kHuge}, hi[2] = {-kHuge, -kHuge};
   for (const Ring& r : region)
     for (const P2& q : r)
       for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);

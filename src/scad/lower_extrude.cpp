@@ -1,0 +1,164 @@
+// Lowering (lowering.h): linear_extrude and rotate_extrude of 2D subtrees, and moving solids.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "scad/lowering.h"
+#include "scad/region.h"
+
+namespace pic::detail::scad {
+
+// A region's rings (which do not cross) -> Booleans of extruded simple rings: each ring at
+// even nesting depth minus the rings directly inside it.
+template <class Extrude>
+Solid Lowering::extrude(const Region& region, const Extrude& ext) {
+  std::vector<Ring> rings;
+  for (const Ring& r : region)
+    if (r.size() >= 3 && signed_area(r) != 0) rings.push_back(r);
+  const size_t n = rings.size();
+  auto inside = [](const P2& p, const Ring& r) {
+    bool in = false;
+    for (size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
+      if ((r[i][1] > p[1]) != (r[j][1] > p[1]) &&
+          p[0] < (r[j][0] - r[i][0]) * (p[1] - r[i][1]) / (r[j][1] - r[i][1]) + r[i][0])
+        in = !in;
+    return in;
+  };
+  std::vector<int> depth(n, 0), parent(n, -1);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      if (i != j && inside(rings[i][0], rings[j])) {
+        ++depth[i];
+        if (parent[i] < 0 || std::abs(signed_area(rings[j])) < std::abs(signed_area(rings[size_t(parent[i])])))
+          parent[i] = static_cast<int>(j);
+      }
+  std::vector<Solid> outers;
+  for (size_t i = 0; i < n; ++i) {
+    if (depth[i] % 2) continue;
+    std::vector<Solid> parts;
+    parts.push_back(leaf(ext(rings[i]), kIdentity));
+    for (size_t j = 0; j < n; ++j)
+      if (parent[j] == static_cast<int>(i) && depth[j] == depth[i] + 1) parts.push_back(leaf(ext(rings[j]), kIdentity));
+    outers.push_back(combine(Solid::Kind::Difference, std::move(parts)));
+  }
+  return combine(Solid::Kind::Union, std::move(outers));
+}
+
+Region Lowering::shape_children(const Node& n, double st) {
+  if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
+    return import_2d(n);
+  stretch_3d_ = st;
+  Region r = region_union(children2(n, kIdentity2));
+  stretch_3d_ = 1;
+  return r;
+}
+
+Solid Lowering::linear_extrude(const Node& n, const Affine& m) {
+  const Region s = shape_children(n, stretch(m));
+  LinearExtrude e;
+  e.height = number(n, "height", 100);
+  e.center = flag(n, "center", false);
+  e.twist = number(n, "twist", 0);
+  if (const Value* v = arg(n, "scale")) {
+    const auto xs = numbers(n, *v, "scale");
+    if (xs.size() == 1) e.scale = {xs[0], xs[0]};
+    else if (xs.size() >= 2) e.scale = {xs[0], xs[1]};
+  }
+  e.scale = {std::max(0.0, e.scale[0]), std::max(0.0, e.scale[1])};
+  check_finite(n, {e.height, e.twist, e.scale[0], e.scale[1]});
+  // Slices when `slices` is not given, as OpenSCAD 2021.01 does (measured against its
+  // output; Calc::get_helix_slices / get_diagonal_slices): a twist takes the fewer of
+  // |twist| / $fa and (helix length of the outermost vertex) / $fs, at least one per 120
+  // degrees, or |twist| $fn / 360 when $fn is set; a non-uniform scale without twist takes
+  // (length of the longest vertex path) / $fs; otherwise one slice.
+  int slices = static_cast<int>(number(n, "slices", 0));
+  if (slices <= 0) {
+    const double fn = number(n, "$fn", 0), fs = number(n, "$fs", 2), fa = number(n, "$fa", 12);
+    double r2 = 0, d2 = 0;
+    for (const Ring& ring : s)
+      for (const P2& p : ring) {
+        r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
+        const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
+        d2 = std::max(d2, dx * dx + dy * dy);
+      }
+    const double tw = std::abs(e.twist);
+    slices = 1;
+    if (tw > 0) {
+      const int min_slices = std::max(static_cast<int>(std::ceil(tw / 120.0)), 1);
+      if (fn > 0) {
+        slices = std::max(static_cast<int>(std::ceil(tw / 360.0 * fn)), min_slices);
+      } else if (std::sqrt(r2) >= 0.00000095367431640625) {
+        // Length of the outermost vertex's path: a conical helix when scaled (Simpson's rule).
+        const double r0 = std::sqrt(r2), th = tw * std::numbers::pi / 180;
+        const double sc = std::max(e.scale[0], e.scale[1]);
+        auto speed = [&](double t) {
+          const double r = r0 * (1 + (sc - 1) * t), dr = r0 * (sc - 1);
+          return std::sqrt(r * r * th * th + dr * dr + e.height * e.height);
+        };
+        constexpr int kSteps = 64;
+        double len = speed(0) + speed(1);
+        for (int i = 1; i < kSteps; ++i) len += (i % 2 ? 4 : 2) * speed(double(i) / kSteps);
+        len /= 3.0 * kSteps;
+        const int fa_slices = static_cast<int>(std::ceil(tw / fa));
+        const int fs_slices = static_cast<int>(std::ceil(len / fs));
+        slices = std::max(std::min(fa_slices, fs_slices), min_slices);
+      } else {
+        slices = min_slices;
+      }
+    } else if (e.scale[0] != e.scale[1]) {
+      slices = fn > 0 ? std::max(static_cast<int>(fn), 1)
+                      : std::max(static_cast<int>(std::ceil(std::sqrt(d2 + e.height * e.height) / fs)), 1);
+    }
+  }
+  if (opt_.smooth && e.twist != 0) {
+    // The walls follow helices: keep the chord of the largest radius below the tolerance.
+    const auto [lo, hi] = x_range(s);
+    const double r = std::max(std::abs(lo), std::abs(hi)) * stretch(m);
+    const int per_turn = frags(n, r, 1);
+    slices = std::max(slices, static_cast<int>(std::ceil(per_turn * std::abs(e.twist) / 360)));
+  }
+  e.slices = std::max(slices, 1);
+  if (!(e.height > 0)) return {};
+  Solid out = extrude(s, [&](const Ring& r) { return extrude_linear(r, e); });
+  transform(out, m);
+  return out;
+}
+
+Solid Lowering::rotate_extrude(const Node& n, const Affine& m) {
+  const Region s = shape_children(n, stretch(m));
+  double angle = number(n, "angle", 360);
+  check_finite(n, {angle});
+  if (angle == 0 || s.empty()) return {};
+  const auto [lo, hi] = x_range(s);
+  if (lo < 0 && hi > 0) fail(n, "all points must have the same x coordinate sign");
+  // OpenSCAD 2021: fragments(max |x|) |angle| / 360, at least 1.
+  int f = static_cast<int>(std::fmax(
+      fragments_from_r(hi - lo, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12)) *
+          std::abs(std::min(angle, 360.0)) / 360,
+      1));
+  if (opt_.smooth) f = std::max(f, static_cast<int>(std::ceil(frags(n, hi - lo, stretch(m)) * std::min(std::abs(angle), 360.0) / 360)));
+  const bool mirrored = hi <= 0;  // profile left of the axis: revolve its mirror image
+  Solid out = extrude(s, [&](Ring r) {
+    if (mirrored)
+      for (P2& p : r) p[0] = -p[0];
+    return extrude_rotate(r, angle, f);
+  });
+  // OpenSCAD maps (x, y) at angle a to (x sin a, x cos a): a negative x lands half a turn on.
+  transform(out, mirrored ? Affine{-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0} : kIdentity);
+  transform(out, m);
+  return out;
+}
+
+std::pair<double, double> Lowering::x_range(const Region& r) {
+  double lo = 0, hi = 0;  // OpenSCAD's bounds include the origin
+  for (const Ring& ring : r)
+    for (const P2& p : ring) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+  return {lo, hi};
+}
+
+void Lowering::transform(Solid& s, const Affine& m) {
+  if (s.kind == Solid::Kind::Mesh) apply(m, s.mesh);
+  for (Solid& c : s.children) transform(c, m);
+}
+
+}  // namespace pic::detail::scad
