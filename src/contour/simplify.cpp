@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "pic/contour.h"
 #include "pic/measure.h"
@@ -21,6 +22,8 @@ namespace {
 using detail::cross3;
 using detail::dot3;
 using detail::norm3;
+using detail::kKeptNormalCosine;
+using detail::kMinTriangleQuality;
 
 /// A symmetric 4x4 quadric: the sum of squared distances to a set of planes.
 struct Quadric {
@@ -55,10 +58,6 @@ double quality(const Vec3& a, const Vec3& b, const Vec3& c) {
   return s > 0 ? 2 * std::sqrt(3.0) * norm3(normal_of(a, b, c)) / s : 0;
 }
 
-/// New triangles must be at least this good, or as good as the worst they replace: long
-/// needles across flat regions would cross their neighbours once positions are rounded to
-/// floats (STL), and they shade badly.
-constexpr double kMinQuality = 0.15;
 
 class Simplifier {
  public:
@@ -171,7 +170,7 @@ class Simplifier {
       const auto& t = tris_[f];
       worst_before = std::min(worst_before, quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
-    const double min_quality = std::min(kMinQuality, worst_before);
+    const double min_quality = std::min(kMinTriangleQuality, worst_before);
     for (uint32_t f : faces_[u]) {
       const auto& t = tris_[f];
       if (t[0] == v || t[1] == v || t[2] == v) continue;
@@ -181,7 +180,7 @@ class Simplifier {
       const Vec3 after = normal_of(p[0], p[1], p[2]);
       const double lb = norm3(before), la = norm3(after);
       // Turned by less than about 25 degrees, and not a sliver: the new fan covers the old star.
-      if (!(la > 0) || !(lb > 0) || dot3(before, after) < 0.9 * lb * la) return false;
+      if (!(la > 0) || !(lb > 0) || dot3(before, after) < kKeptNormalCosine * lb * la) return false;
       if (quality(p[0], p[1], p[2]) < min_quality) return false;
     }
     return true;

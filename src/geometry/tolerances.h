@@ -50,6 +50,13 @@ inline constexpr double kTouchingCellsGap = 1e-9;
 /// A ring's heights must lie this far (relative to the edge's length) strictly inside the
 /// edge's span, so rounding cannot put a triangle on the edge's end.
 inline constexpr double kRingHeightMargin = 1e-9;
+/// Simplification keeps a triangle it turns only when its normal stays within about 25
+/// degrees of where it was (the cosine): a fan that folds over its neighbours never passes.
+inline constexpr double kKeptNormalCosine = 0.9;
+/// Simplification makes no triangle worse than this (4 sqrt(3) area over the sum of squared
+/// sides: 1 equilateral, 0 flat) unless the ones it replaces were: long needles across a flat
+/// region cross their neighbours once positions are rounded to floats, and they shade badly.
+inline constexpr double kMinTriangleQuality = 0.15;
 
 // ---- sample/ -------------------------------------------------------------------------------
 

@@ -1,0 +1,87 @@
+// Simplified contours: fewer triangles where the surface is flat or runs straight along a
+// crease, the same solid within the tolerance, still closed, 2-manifold and crossing-free.
+#include <gtest/gtest.h>
+
+#include "pic/contour.h"
+#include "pic/csg.h"
+#include "pic/measure.h"
+#include "pic/primitives.h"
+#include "pic/sample.h"
+#include "support/mesh_checks.h"
+
+namespace pic {
+namespace {
+
+using test::IsClosedManifold;
+
+/// A box with a ball taken out of it (the ball cuts every face: curved rims, sharp corners).
+Octree box_minus_ball(int depth) {
+  SampleOptions o;
+  o.depth = depth;
+  o.cube = Cube{{-1, -1, -1}, 2};
+  const Octree box = sample(make_box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}), o);
+  const Octree ball = sample(make_sphere({0, 0, 0}, 0.8, 48), o);
+  return csg(box, ball, CsgOp::Subtract);
+}
+
+TEST(Simplify, BoxMinusBallKeepsItsSurfaceWithFewerTriangles) {
+  const Octree t = box_minus_ball(8);
+  const double cell = t.cube.size / double(1 << t.max_depth);
+  const TriMesh raw = contour(t);
+  ContourOptions o;
+  o.simplify = 0.1;
+  ContourStats st;
+  const TriMesh simple = contour(t, o, &st);
+  ASSERT_TRUE(IsClosedManifold(simple));
+  EXPECT_EQ(count_self_intersections(simple), 0u);
+  EXPECT_EQ(st.simplified_away, raw.triangles.size() - simple.triangles.size());
+  EXPECT_LT(simple.triangles.size() * 2, raw.triangles.size());
+  // The same surface: both ways within a fraction of a finest cell, the same volume.
+  const SurfaceDistance d = surface_distance(simple, raw, 20000);
+  EXPECT_LE(d.hausdorff, 0.25 * cell);
+  EXPECT_NEAR(volume(simple), volume(raw), 1e-3 * volume(raw));
+  // The box's corners (outside the ball) stay sharp: each is a vertex.
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? 0.6 : -0.6, c & 2 ? 0.6 : -0.6, c & 4 ? 0.6 : -0.6};
+    EXPECT_LE(test::nearest_vertex_distance(simple, p), 1e-6) << "corner " << c;
+  }
+  std::printf("  [measure] box - ball at depth 8: %zu -> %zu triangles, Hausdorff %.3f cells\n",
+              raw.triangles.size(), simple.triangles.size(), d.hausdorff / cell);
+}
+
+TEST(Simplify, ZeroToleranceLeavesTheMeshAlone) {
+  TriMesh m = contour(box_minus_ball(6));
+  const TriMesh before = m;
+  EXPECT_EQ(simplify(m, 0), 0u);
+  EXPECT_EQ(m.triangles, before.triangles);
+  EXPECT_EQ(m.positions, before.positions);
+}
+
+TEST(Simplify, AFlatSidedSolidBecomesItsFaces) {
+  // A tetrahedron's contour: four planes, so everything but the corners collapses.
+  SampleOptions o;
+  o.depth = 7;
+  o.cube = Cube{{-1, -1, -1}, 2};
+  const TriMesh tet{{{-0.5, -0.4, -0.3}, {0.6, -0.3, -0.35}, {0.0, 0.55, -0.3}, {0.05, 0.0, 0.6}},
+                    {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
+  const Octree t = sample(tet, o);
+  TriMesh m = contour(t);
+  const size_t raw = m.triangles.size();
+  const double cell = t.cube.size / double(1 << t.max_depth);
+  simplify(m, 0.1 * cell);
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(count_self_intersections(m), 0u);
+  EXPECT_LT(m.triangles.size(), raw);
+  EXPECT_LE(m.triangles.size(), 8u);
+  EXPECT_LE(test::two_sided_distance(m, tet), 0.5 * cell);
+  std::printf("  [measure] tetrahedron at depth 7: %zu -> %zu triangles\n", raw, m.triangles.size());
+}
+
+TEST(Simplify, NeverCollapsesTheSmallestClosedMesh) {
+  TriMesh tet{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
+  EXPECT_EQ(simplify(tet, 10.0), 0u);
+  EXPECT_EQ(tet.triangles.size(), 4u);
+}
+
+}  // namespace
+}  // namespace pic
