@@ -23,7 +23,7 @@ struct ContourOptions {
   /// intersection_free.
   bool fan_all = false;
   /// Merge the contour's vertices where the surface is flat or runs straight along a crease,
-  /// keeping every original plane within this many finest cells of the result (simplify());
+  /// each within this many finest cells of every original plane it replaces (simplify());
   /// 0: the raw contour, a vertex per gray leaf.
   double simplify = 0;
 };
@@ -62,12 +62,12 @@ inline TriMesh unsplit_contour(const Octree& tree) { return contour(tree, {true,
 /// positions would otherwise see the pinch again.
 size_t split_nonmanifold(TriMesh& mesh);
 
-/// Collapses edges of a closed 2-manifold mesh (one end moves onto the other) while every plane
-/// of the original triangles around the merged vertices passes within `tolerance` of the kept
-/// vertex (a quadric of squared distances, summed: each is below it): flat regions become a
-/// few large triangles, straight creases keep their line, curved parts stay within tolerance.
-/// Each collapse keeps the mesh closed and 2-manifold (the link condition) and its triangles'
-/// orientation; a result with a crossing is not taken. Returns the triangles removed.
+/// Collapses edges of a closed 2-manifold mesh, both ends moving to the point nearest their
+/// planes, while every original triangle's plane merged into the vertex passes within
+/// `tolerance` of it: flat regions become a few large triangles, straight creases keep their
+/// line, curved parts stay within tolerance. Each collapse keeps the mesh closed and
+/// 2-manifold (the link condition) and its triangles' orientation and shape; a result with a
+/// crossing is not taken. Returns the triangles removed.
 size_t simplify(TriMesh& mesh, double tolerance);
 
 }  // namespace pic

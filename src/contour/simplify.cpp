@@ -1,15 +1,20 @@
 // Output sized to the geometry: a dual contour has a vertex per gray cell, so a flat face or a
-// straight crease costs one vertex per finest cell along it. Half-edge collapses merge those
-// vertices where every plane of the original surface around both ends passes within the
-// tolerance of the kept end; each collapse is checked locally (the link condition keeps the
-// mesh closed and 2-manifold, the turned triangles must keep their orientation), and the whole
-// result is checked for crossings before it replaces the contour.
+// straight crease costs one vertex per finest cell along it. Edge collapses merge those
+// vertices: both ends move to the point nearest their planes (on a crease, onto its line),
+// allowed where every distinct plane of the original triangles merged into either end passes
+// within the tolerance of that point. Each collapse is checked locally (the link condition
+// keeps the mesh closed and 2-manifold; the turned triangles keep their orientation and do not
+// become needles), and the whole result is checked for crossings before it replaces the
+// contour.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+
+#include "geometry/qef.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "pic/contour.h"
@@ -32,9 +37,25 @@ struct Quadric {
     const double a = n[0], b = n[1], c = n[2];
     const double v[10] = {a * a, a * b, a * c, a * d, b * b, b * c, b * d, c * c, c * d, d * d};
     for (int i = 0; i < 10; ++i) q[i] += v[i];
+    ++count;
   }
   void add(const Quadric& o) {
     for (int i = 0; i < 10; ++i) q[i] += o.q[i];
+    count += o.count;
+  }
+  /// The mean squared distance: no plane is nearer than that on the whole.
+  double mean_at(const Vec3& p) const { return count ? at(p) / count : 0; }
+  double count = 0;
+  /// The point nearest the planes from `seed`: seed + A+ (b - A seed), with A+ the
+  /// pseudo-inverse truncated below a fraction of A's largest eigenvalue, so the point moves
+  /// only across the planes and stays at the seed along the directions they leave free.
+  Vec3 minimum_near(const Vec3& seed) const {
+    detail::Qef e;
+    e.a = {q[0], q[1], q[2], q[4], q[5], q[7]};
+    e.b = {-q[3], -q[6], -q[8]};
+    e.c = q[9];
+    e.weight = 1;
+    return e.solve(seed).position;
   }
   double at(const Vec3& p) const {
     const double x = p[0], y = p[1], z = p[2];
@@ -59,11 +80,34 @@ double quality(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 
+/// A plane n.x + d = 0, n of unit length.
+struct Plane {
+  Vec3 n;
+  double d;
+};
+/// The most planes one vertex may answer for: a merge beyond is refused (curved parts keep
+/// their vertices long before, flat parts and creases need one to three).
+constexpr size_t kMaxPlanes = 48;
+
+/// Adds p to a set of planes unless one already there is the same plane: normals within about
+/// 1e-5 radians, offsets within `same` (a hundredth of the tolerance).
+void add_plane(std::vector<Plane>& set, const Plane& p, double same) {
+  for (const Plane& q : set)
+    if (dot3(p.n, q.n) > 1 - 1e-10 && std::abs(p.d - q.d) <= same) return;
+  set.push_back(p);
+}
+/// The largest distance from x to the planes.
+double farthest(const std::vector<Plane>& set, const Vec3& x) {
+  double far = 0;
+  for (const Plane& p : set) far = std::max(far, std::abs(dot3(p.n, x) + p.d));
+  return far;
+}
+
 class Simplifier {
  public:
   Simplifier(const TriMesh& mesh, double tolerance)
-      : pos_(mesh.positions), tris_(mesh.triangles), tol2_(tolerance * tolerance), quadric_(pos_.size()),
-        faces_(pos_.size()), alive_(tris_.size(), 1) {
+      : pos_(mesh.positions), tris_(mesh.triangles), tol_(tolerance), same_(tolerance / 100), quadric_(pos_.size()),
+        planes_(pos_.size()), faces_(pos_.size()), alive_(tris_.size(), 1) {
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       const auto& t = tris_[f];
       const Vec3 n = normal_of(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
@@ -72,37 +116,28 @@ class Simplifier {
       if (!(len > 0)) continue;
       const Vec3 u{n[0] / len, n[1] / len, n[2] / len};
       const double d = -dot3(u, pos_[t[0]]);
-      for (int k = 0; k < 3; ++k) quadric_[t[k]].add_plane(u, d);
+      for (int k = 0; k < 3; ++k) {
+        quadric_[t[k]].add_plane(u, d);
+        add_plane(planes_[t[k]], {u, d}, same_);
+      }
     }
   }
 
-  /// Passes over the edges, shortest first (small triangles merge before long ones form),
-  /// until one collapses fewer than a thousandth of the vertices.
+  /// Passes over the vertices, each moving onto the neighbour that keeps the planes closest,
+  /// until one collapses fewer than a thousandth of them; after the first, only vertices whose
+  /// star changed are tried again.
   void run() {
-    std::vector<std::pair<double, std::pair<uint32_t, uint32_t>>> edges;
+    std::vector<uint8_t> dirty(pos_.size(), 1), next(pos_.size(), 0);
     for (int pass = 0; pass < 32; ++pass) {
-      edges.clear();
-      for (uint32_t f = 0; f < tris_.size(); ++f) {
-        if (!alive_[f]) continue;
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t a = tris_[f][k], b = tris_[f][(k + 1) % 3];
-          edges.push_back({dist2(pos_[a], pos_[b]), {a, b}});  // each edge once per side: both directions
-        }
-      }
-      std::sort(edges.begin(), edges.end());
       size_t done = 0;
-      for (const auto& [len, e] : edges) {
-        const auto [u, v] = e;
-        if (faces_[u].empty() || faces_[v].empty()) continue;
-        Quadric q = quadric_[u];
-        q.add(quadric_[v]);
-        if (!(q.at(pos_[v]) <= tol2_)) continue;
-        ring(u, ring_u_);
-        if (!std::binary_search(ring_u_.begin(), ring_u_.end(), v) || !can_collapse(u, v)) continue;
-        collapse(u, v);
-        ++done;
-      }
+      for (uint32_t u = 0; u < pos_.size(); ++u)
+        if (dirty[u] && !faces_[u].empty() && collapse_cheapest(u)) {
+          for (uint32_t w : ring_u_) next[w] = 1;
+          ++done;
+        }
       if (done * 1000 < pos_.size()) break;
+      dirty.swap(next);
+      std::fill(next.begin(), next.end(), 0);
     }
   }
 
@@ -128,11 +163,19 @@ class Simplifier {
  private:
   std::vector<Vec3> pos_;
   std::vector<std::array<uint32_t, 3>> tris_;
-  double tol2_;
-  std::vector<Quadric> quadric_;
+  double tol_, same_;
+  std::vector<Quadric> quadric_;       // per vertex: its planes summed (where to merge)
+  std::vector<std::vector<Plane>> planes_;  // per vertex: the distinct original planes merged into it
   std::vector<std::vector<uint32_t>> faces_;  // per vertex: its live triangles
   std::vector<uint8_t> alive_;
   std::vector<uint32_t> ring_u_, ring_v_;  // scratch
+  std::vector<Plane> merged_;
+  struct Candidate {
+    double error;
+    uint32_t v;
+    Vec3 x;
+  };
+  std::vector<Candidate> candidates_;
 
 
   void ring(uint32_t v, std::vector<uint32_t>& out) const {
@@ -144,9 +187,51 @@ class Simplifier {
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
+  /// Where u and v merge: the point nearest their planes (least squares, truncated along the
+  /// directions they leave free, from the edge's middle), or else the better end; nothing when
+  /// every choice is farther than the tolerance from one of the original planes merged into u
+  /// or v. `error`: the largest distance to them there.
+  std::optional<Vec3> merged_position(uint32_t u, uint32_t v, double& error) {
+    Quadric q = quadric_[u];
+    q.add(quadric_[v]);
+    const Vec3 &a = pos_[u], &b = pos_[v];
+    const Vec3 mid{(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2};
+    const Vec3 x = q.minimum_near(mid);
+    // The largest distance is at least the mean: where the mean is over, no need to look.
+    const double tol2 = tol_ * tol_;
+    if (q.mean_at(x) > tol2 && q.mean_at(a) > tol2 && q.mean_at(b) > tol2) return std::nullopt;
+    merged_.assign(planes_[u].begin(), planes_[u].end());
+    for (const Plane& p : planes_[v]) add_plane(merged_, p, same_);
+    if (merged_.size() > kMaxPlanes) return std::nullopt;
+    // Keep to the edge's neighbourhood: a far optimum of nearly parallel planes is no merge.
+    if (dist2(x, mid) <= dist2(a, b) && (error = farthest(merged_, x)) <= tol_) return x;
+    const double ea = farthest(merged_, a), eb = farthest(merged_, b);
+    error = std::min(ea, eb);
+    if (error > tol_) return std::nullopt;
+    return ea < eb ? a : b;
+  }
+
+  /// Merges u with the neighbour that keeps the planes closest, among those that may take it.
+  bool collapse_cheapest(uint32_t u) {
+    ring(u, ring_u_);
+    candidates_.clear();
+    double error = 0;
+    for (uint32_t v : ring_u_)
+      if (const auto x = merged_position(u, v, error)) candidates_.push_back({error, v, *x});
+    std::sort(candidates_.begin(), candidates_.end(),
+              [](const Candidate& a, const Candidate& b) { return a.error < b.error || (a.error == b.error && a.v < b.v); });
+    for (const Candidate& c : candidates_)
+      if (can_collapse(u, c.v, c.x)) {
+        collapse(u, c.v, c.x);
+        return true;
+      }
+    return false;
+  }
+
   /// The link condition (the vertices next to both u and v are exactly the two across the
-  /// edge uv), and every triangle of u that survives keeps its orientation when u moves to v.
-  bool can_collapse(uint32_t u, uint32_t v) {
+  /// edge uv), and every triangle of u or v that survives keeps its orientation and its shape
+  /// when both move to x.
+  bool can_collapse(uint32_t u, uint32_t v, const Vec3& x) {
     int shared = 0;
     std::array<uint32_t, 2> across{};
     for (uint32_t f : faces_[u]) {
@@ -165,28 +250,34 @@ class Simplifier {
     if (common != 2) return false;
     // A closed mesh of 4 vertices (a tetrahedron) would fold flat.
     if (ring_u_.size() <= 3 && ring_v_.size() <= 3) return false;
+    return keeps_shape(u, v, x) && keeps_shape(v, u, x);
+  }
+
+  /// Whether the triangles of `a` without `b` keep orientation and shape with `a` at x.
+  bool keeps_shape(uint32_t a, uint32_t b, const Vec3& x) const {
     double worst_before = 1;
-    for (uint32_t f : faces_[u]) {
+    for (uint32_t f : faces_[a]) {
       const auto& t = tris_[f];
       worst_before = std::min(worst_before, quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
     const double min_quality = std::min(kMinTriangleQuality, worst_before);
-    for (uint32_t f : faces_[u]) {
+    for (uint32_t f : faces_[a]) {
       const auto& t = tris_[f];
-      if (t[0] == v || t[1] == v || t[2] == v) continue;
+      if (t[0] == b || t[1] == b || t[2] == b) continue;
       std::array<Vec3, 3> p;
-      for (int k = 0; k < 3; ++k) p[k] = pos_[t[k] == u ? v : t[k]];
+      for (int k = 0; k < 3; ++k) p[k] = t[k] == a ? x : pos_[t[k]];
       const Vec3 before = normal_of(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
       const Vec3 after = normal_of(p[0], p[1], p[2]);
       const double lb = norm3(before), la = norm3(after);
-      // Turned by less than about 25 degrees, and not a sliver: the new fan covers the old star.
+      // Turned by less than about 25 degrees: the new fan covers the old star, folding nothing.
       if (!(la > 0) || !(lb > 0) || dot3(before, after) < kKeptNormalCosine * lb * la) return false;
       if (quality(p[0], p[1], p[2]) < min_quality) return false;
     }
     return true;
   }
 
-  void collapse(uint32_t u, uint32_t v) {
+  void collapse(uint32_t u, uint32_t v, const Vec3& x) {
+    pos_[v] = x;
     for (uint32_t f : faces_[u]) {
       auto& t = tris_[f];
       if (t[0] == v || t[1] == v || t[2] == v) {
@@ -201,6 +292,8 @@ class Simplifier {
     }
     faces_[u].clear();
     quadric_[v].add(quadric_[u]);
+    for (const Plane& p : planes_[u]) add_plane(planes_[v], p, same_);
+    planes_[u].clear();
   }
 };
 
