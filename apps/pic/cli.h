@@ -116,5 +116,6 @@ void add_prim(CLI::App& app);
 void add_render(CLI::App& app);
 void add_view(CLI::App& app);
 void add_compare(CLI::App& app);
+void add_volume(CLI::App& app);
 
 }  // namespace pic::cli

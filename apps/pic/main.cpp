@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every subcommand");
   using namespace pic::cli;
-  for (auto add : {add_sample, add_mesh, add_info, add_csg, add_eval, add_prim, add_render, add_view, add_compare})
+  for (auto add : {add_sample, add_mesh, add_info, add_csg, add_eval, add_prim, add_render, add_view, add_compare, add_volume})
     add(app);
   try {
     app.parse(argc, argv);

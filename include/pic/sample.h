@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -55,11 +56,12 @@ struct SampleStats {
   size_t pics = 0;
   size_t capped = 0;  ///< leaves accepted at the depth cap although a refinement rule failed
   double seconds = 0;
-  std::string classifier;   ///< "parity", "winding" or "points"
+  std::string classifier;   ///< "parity", "winding", "points" or "implicit"
   MeshDefects defects;      ///< of the input mesh (meshes only)
   size_t interior_triangles = 0;  ///< winding: triangles with the solid on both sides (dropped)
   size_t boundary_loops = 0;      ///< winding: closed curves of the input's boundary, capped
   int depth = 0;  ///< deepest level allowed: the option's, or for a point cloud its spacing's
+  size_t evaluations = 0;  ///< implicit solids: how many times f (or its gradient) was asked
 };
 
 /// Adaptively samples a triangle mesh into a PIC object. A clean closed mesh is classified by
@@ -75,6 +77,22 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options = {}, SampleStat
 /// stops where a cell is half the points' spacing (SampleStats::depth says where).
 /// \throws InvalidInput for an empty cloud, missing or zero normals, non-finite values.
 Octree sample(const PointCloud& cloud, const SampleOptions& options = {}, SampleStats* stats = nullptr);
+
+/// A solid given by a function of space: f(p) < 0 inside, f(p) >= 0 outside (world
+/// coordinates), with |f(p) - f(q)| <= lipschitz |p - q| (1 for a signed distance).
+struct ImplicitSolid {
+  std::function<double(const Vec3&)> value;
+  /// f's gradient (pointing out of the solid); empty: central differences of `value`.
+  std::function<Vec3(const Vec3&)> gradient;
+  double lipschitz = 1;
+};
+/// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs
+/// from f (0 counts as outside), edge crossings by root finding, Hermite normals from the
+/// gradient, refinement where the QEF residual exceeds the error; a cell that f's bound keeps
+/// away from the surface (|f| beyond its reach from the cell's centre or a corner) is never
+/// subdivided.
+/// 	hrows InvalidInput without a cube or a function, or when the solid is empty in the cube.
+Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats = nullptr);
 
 /// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.
 Cube bounding_cube(const TriMesh& mesh, double margin = 1.0 / 16);

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "geometry/lattice.h"
+#include "geometry/mesh_distance.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "pic/measure.h"
@@ -16,6 +17,7 @@
 namespace pic {
 namespace {
 
+using detail::MeshDistance;
 using detail::add3;
 using detail::scale3;
 using detail::cross3;
@@ -27,113 +29,6 @@ double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return std::sqrt(detail::point_triangle_distance2(p, a, b, c));
 }
 
-/// Exact unsigned distance from points to a triangle mesh, accelerated by a median-split BVH.
-class MeshDistance {
- public:
-  explicit MeshDistance(const TriMesh& mesh) : mesh_(mesh) {
-    const size_t n = mesh.triangles.size();
-    order_.resize(n);
-    std::iota(order_.begin(), order_.end(), uint32_t{0});
-    lo_.resize(n);
-    hi_.resize(n);
-    centre_.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const auto& t = mesh.triangles[i];
-      for (int k = 0; k < 3; ++k) {
-        lo_[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
-        hi_[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
-        centre_[i][k] = (lo_[i][k] + hi_[i][k]) / 2;
-      }
-    }
-    if (n > 0) {
-      nodes_.emplace_back();
-      build(0, 0, static_cast<uint32_t>(n));
-    }
-  }
-
-  double distance(const Vec3& p) const {
-    double best = std::numeric_limits<double>::infinity();
-    if (nodes_.empty()) return best;
-    uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const BNode& nd = nodes_[stack[--top]];
-      if (box_distance(nd, p) >= best) continue;
-      if (nd.count > 0) {
-        for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) {
-          const auto& t = mesh_.triangles[order_[i]];
-          best = std::min(best, point_triangle_distance(p, mesh_.positions[t[0]], mesh_.positions[t[1]],
-                                                        mesh_.positions[t[2]]));
-        }
-        continue;
-      }
-      const BNode &l = nodes_[nd.left], &r = nodes_[nd.left + 1];
-      const double dl = box_distance(l, p), dr = box_distance(r, p);
-      // Push the farther first so the nearer is explored first.
-      if (dl < dr) {
-        if (dr < best) stack[top++] = nd.left + 1;
-        if (dl < best) stack[top++] = nd.left;
-      } else {
-        if (dl < best) stack[top++] = nd.left;
-        if (dr < best) stack[top++] = nd.left + 1;
-      }
-    }
-    return best;
-  }
-
- private:
-  struct BNode {
-    Vec3 lo, hi;
-    uint32_t left = 0;   // internal: children at left, left + 1
-    uint32_t first = 0;  // leaf: range in order_
-    uint32_t count = 0;  // 0 = internal
-  };
-
-  static double box_distance(const BNode& nd, const Vec3& p) {
-    double s = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = std::max({nd.lo[k] - p[k], 0.0, p[k] - nd.hi[k]});
-      s += d * d;
-    }
-    return std::sqrt(s);
-  }
-
-  // Builds the subtree of order_[first, last) into nodes_[id]; children are consecutive.
-  void build(uint32_t id, uint32_t first, uint32_t last) {
-    BNode nd;
-    nd.lo = {detail::kHuge, detail::kHuge, detail::kHuge};
-    nd.hi = {-detail::kHuge, -detail::kHuge, -detail::kHuge};
-    for (uint32_t i = first; i < last; ++i)
-      for (int k = 0; k < 3; ++k) {
-        nd.lo[k] = std::min(nd.lo[k], lo_[order_[i]][k]);
-        nd.hi[k] = std::max(nd.hi[k], hi_[order_[i]][k]);
-      }
-    if (last - first <= 4) {
-      nd.first = first;
-      nd.count = last - first;
-      nodes_[id] = nd;
-      return;
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (nd.hi[k] - nd.lo[k] > nd.hi[axis] - nd.lo[axis]) axis = k;
-    const uint32_t mid = first + (last - first) / 2;
-    std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + last,
-                     [&](uint32_t a, uint32_t b) { return centre_[a][axis] < centre_[b][axis]; });
-    nd.left = static_cast<uint32_t>(nodes_.size());
-    nodes_.emplace_back();
-    nodes_.emplace_back();
-    nodes_[id] = nd;
-    build(nd.left, first, mid);
-    build(nd.left + 1, mid, last);
-  }
-
-  const TriMesh& mesh_;
-  std::vector<uint32_t> order_;
-  std::vector<Vec3> lo_, hi_, centre_;
-  std::vector<BNode> nodes_;
-};
 
 /// Deterministic 64-bit generator (SplitMix64) with a portable double in [0, 1).
 class Rng {

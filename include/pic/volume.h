@@ -1,0 +1,32 @@
+// PIC — operations only a volume does well: offsets, shells, rounds and thickened surfaces,
+// each sampled from a signed distance (pic::ImplicitSolid) with the paper's rules, so faces and
+// the creases the exact result keeps stay sharp and the output is a PIC object like any other.
+#pragma once
+
+#include "pic/octree.h"
+#include "pic/sample.h"
+
+namespace pic {
+
+/// The solid grown by `distance` (> 0) or shrunk by -distance (< 0): the points whose signed
+/// distance to the solid's surface is below `distance`. A mesh that is not a clean, closed,
+/// consistently oriented surface is sampled first (any input sample() takes) and its contour
+/// used; a PIC object through its contour. `options.cube` defaults to the solid's bounding
+/// cube grown to hold the offset.
+/// \throws InvalidInput for non-finite values, or a result with no solid in the cube.
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options = {});
+Octree offset(const Octree& solid, double distance, const SampleOptions& options = {});
+
+/// The solid hollowed to walls `thickness` thick (the solid minus its inward offset), or with
+/// `outward` a skin of that thickness around it (its outward offset minus the solid).
+Octree shell(const TriMesh& solid, double thickness, bool outward = false, const SampleOptions& options = {});
+
+/// Rounded edges: with `convex` the convex edges get radius `radius` (an opening: shrink, then
+/// grow back), else the concave ones are filled to it (a closing: grow, then shrink back).
+Octree round_edges(const TriMesh& solid, double radius, bool convex = true, const SampleOptions& options = {});
+
+/// The solid within thickness / 2 of a surface, open or closed (a sheet, a drawing's
+/// triangles, a scan with holes): the answer for inputs with no inside of their own.
+Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options = {});
+
+}  // namespace pic

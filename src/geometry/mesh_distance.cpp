@@ -1,0 +1,212 @@
+// Distances from points to a triangle mesh: see mesh_distance.h.
+#include "geometry/mesh_distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+#include "geometry/lattice.h"
+#include "geometry/tolerances.h"
+#include "geometry/vec3.h"
+
+namespace pic::detail {
+
+Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Voronoi regions of the vertices, then the edges, then the face (Ericson, Real-Time
+  // Collision Detection, 5.1.5).
+  const Vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
+  const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  auto at = [&](const Vec3& x, Feature f) { return Nearest{x, norm3(sub3(p, x)), 0, f}; };
+  if (d1 <= 0 && d2 <= 0) return at(a, Feature::V0);
+  const Vec3 bp = sub3(p, b);
+  const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return at(b, Feature::V1);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return at(add3(a, scale3(ab, d1 / (d1 - d3))), Feature::E01);
+  const Vec3 cp = sub3(p, c);
+  const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return at(c, Feature::V2);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return at(add3(a, scale3(ac, d2 / (d2 - d6))), Feature::E20);
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return at(add3(b, scale3(sub3(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)))), Feature::E12);
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > kTinyDivisor)) return at(a, Feature::V0);  // a degenerate triangle
+  const double v = vb / denom, w = vc / denom;
+  return at(add3(a, add3(scale3(ab, v), scale3(ac, w))), Feature::Face);
+}
+
+MeshDistance::MeshDistance(const TriMesh& mesh) : mesh_(mesh) {
+  const size_t n = mesh.triangles.size();
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), uint32_t{0});
+  lo_.resize(n);
+  hi_.resize(n);
+  centre_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const auto& t = mesh.triangles[i];
+    for (int k = 0; k < 3; ++k) {
+      lo_[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+      hi_[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+      centre_[i][k] = (lo_[i][k] + hi_[i][k]) / 2;
+    }
+  }
+  if (n > 0) {
+    nodes_.emplace_back();
+    build(0, 0, static_cast<uint32_t>(n));
+  }
+}
+
+double MeshDistance::box_distance2(const BNode& nd, const Vec3& p) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max({nd.lo[k] - p[k], 0.0, p[k] - nd.hi[k]});
+    s += d * d;
+  }
+  return s;
+}
+
+/// Visits the triangles that may be nearer than best2 (squared), nearer boxes first; `visit`
+/// lowers best2 as it finds nearer triangles.
+template <class Visit>
+void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
+  if (nodes_.empty()) return;
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BNode& nd = nodes_[stack[--top]];
+    if (box_distance2(nd, p) >= best2) continue;
+    if (nd.count > 0) {
+      for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) visit(order_[i]);
+      continue;
+    }
+    const BNode &l = nodes_[nd.left], &r = nodes_[nd.left + 1];
+    const double dl = box_distance2(l, p), dr = box_distance2(r, p);
+    // Push the farther first so the nearer is explored first.
+    if (dl < dr) {
+      if (dr < best2) stack[top++] = nd.left + 1;
+      if (dl < best2) stack[top++] = nd.left;
+    } else {
+      if (dl < best2) stack[top++] = nd.left;
+      if (dr < best2) stack[top++] = nd.left + 1;
+    }
+  }
+}
+
+double MeshDistance::distance(const Vec3& p) const {
+  double best2 = std::numeric_limits<double>::infinity();
+  search(p, best2, [&](uint32_t i) {
+    const auto& t = mesh_.triangles[i];
+    best2 = std::min(best2, point_triangle_distance2(p, mesh_.positions[t[0]], mesh_.positions[t[1]],
+                                                     mesh_.positions[t[2]]));
+  });
+  return std::sqrt(best2);
+}
+
+Nearest MeshDistance::nearest(const Vec3& p) const {
+  double best2 = std::numeric_limits<double>::infinity();
+  Nearest best;
+  search(p, best2, [&](uint32_t i) {
+    const auto& t = mesh_.triangles[i];
+    const Nearest n = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
+    if (n.distance * n.distance < best2) {
+      best2 = n.distance * n.distance;
+      best = n;
+      best.triangle = i;
+    }
+  });
+  return best;
+}
+
+void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last) {
+  BNode nd;
+  nd.lo = {kHuge, kHuge, kHuge};
+  nd.hi = {-kHuge, -kHuge, -kHuge};
+  for (uint32_t i = first; i < last; ++i)
+    for (int k = 0; k < 3; ++k) {
+      nd.lo[k] = std::min(nd.lo[k], lo_[order_[i]][k]);
+      nd.hi[k] = std::max(nd.hi[k], hi_[order_[i]][k]);
+    }
+  if (last - first <= 4) {
+    nd.first = first;
+    nd.count = last - first;
+    nodes_[id] = nd;
+    return;
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (nd.hi[k] - nd.lo[k] > nd.hi[axis] - nd.lo[axis]) axis = k;
+  const uint32_t mid = first + (last - first) / 2;
+  std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + last,
+                   [&](uint32_t a, uint32_t b) { return centre_[a][axis] < centre_[b][axis]; });
+  nd.left = static_cast<uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  nodes_.emplace_back();
+  nodes_[id] = nd;
+  build(nd.left, first, mid);
+  build(nd.left + 1, mid, last);
+}
+
+namespace {
+
+Vec3 unit_or_zero(const Vec3& v) {
+  const double l = norm3(v);
+  return l > 0 ? scale3(v, 1 / l) : Vec3{0, 0, 0};
+}
+
+}  // namespace
+
+SignedDistance::SignedDistance(const TriMesh& mesh)
+    : mesh_(mesh), distance_(mesh), face_normal_(mesh.triangles.size()), vertex_normal_(mesh.positions.size()),
+      edge_normal_(mesh.triangles.size()) {
+  const auto& P = mesh.positions;
+  std::unordered_map<uint64_t, Vec3> edge_sum;  // undirected edge -> sum of its faces' normals
+  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); };
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const Vec3 n = unit_or_zero(cross3(sub3(P[t[1]], P[t[0]]), sub3(P[t[2]], P[t[0]])));
+    face_normal_[f] = n;
+    for (int k = 0; k < 3; ++k) {
+      // The vertex's pseudonormal weights each face by its angle there.
+      const Vec3 e1 = unit_or_zero(sub3(P[t[(k + 1) % 3]], P[t[k]])), e2 = unit_or_zero(sub3(P[t[(k + 2) % 3]], P[t[k]]));
+      const double angle = std::acos(std::clamp(dot3(e1, e2), -1.0, 1.0));
+      vertex_normal_[t[k]] = add3(vertex_normal_[t[k]], scale3(n, angle));
+      Vec3& e = edge_sum[key(t[k], t[(k + 1) % 3])];
+      e = add3(e, n);
+    }
+  }
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) edge_normal_[f][k] = edge_sum[key(t[k], t[(k + 1) % 3])];
+  }
+}
+
+double SignedDistance::operator()(const Vec3& p) const {
+  Vec3 g;
+  return with_gradient(p, g);
+}
+
+double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient) const {
+  const Nearest n = distance_.nearest(p);
+  const auto& t = mesh_.triangles[n.triangle];
+  Vec3 pseudo;
+  switch (n.feature) {
+    case Feature::V0: pseudo = vertex_normal_[t[0]]; break;
+    case Feature::V1: pseudo = vertex_normal_[t[1]]; break;
+    case Feature::V2: pseudo = vertex_normal_[t[2]]; break;
+    case Feature::E01: pseudo = edge_normal_[n.triangle][0]; break;
+    case Feature::E12: pseudo = edge_normal_[n.triangle][1]; break;
+    case Feature::E20: pseudo = edge_normal_[n.triangle][2]; break;
+    case Feature::Face: pseudo = face_normal_[n.triangle]; break;
+  }
+  const Vec3 away = sub3(p, n.point);
+  const bool outside = dot3(away, pseudo) >= 0;
+  gradient = n.distance > 0 ? scale3(away, (outside ? 1 : -1) / n.distance) : unit_or_zero(pseudo);
+  return outside ? n.distance : -n.distance;
+}
+
+}  // namespace pic::detail

@@ -1,0 +1,71 @@
+// Distances from points to a triangle mesh: the nearest point over a median-split BVH (exact
+// point-triangle distances), and for a closed 2-manifold mesh the signed distance, its sign
+// from the angle-weighted pseudonormal of the nearest feature (Baerentzen and Aanaes 2005:
+// exact for such a mesh, no ray and no winding number).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "pic/types.h"
+
+namespace pic::detail {
+
+/// Where on a triangle a nearest point lies: a vertex (0-2), an edge (3 + k: from vertex k to
+/// vertex k + 1), or its interior.
+enum class Feature : uint8_t { V0, V1, V2, E01, E12, E20, Face };
+
+struct Nearest {
+  Vec3 point{};
+  double distance = 0;
+  uint32_t triangle = 0;
+  Feature feature = Feature::Face;
+};
+
+/// The point of triangle abc nearest p, and which feature holds it.
+Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+class MeshDistance {
+ public:
+  explicit MeshDistance(const TriMesh& mesh);
+  /// Unsigned distance from p to the mesh (infinity for an empty mesh).
+  double distance(const Vec3& p) const;
+  /// The mesh's point nearest p (the mesh must have a triangle).
+  Nearest nearest(const Vec3& p) const;
+
+ private:
+  struct BNode {
+    Vec3 lo, hi;
+    uint32_t left = 0;   // internal: children at left, left + 1
+    uint32_t first = 0;  // leaf: range in order_
+    uint32_t count = 0;  // 0 = internal
+  };
+  static double box_distance2(const BNode& nd, const Vec3& p);
+  void build(uint32_t id, uint32_t first, uint32_t last);
+  template <class Visit>
+  void search(const Vec3& p, double& best2, Visit&& visit) const;
+
+  const TriMesh& mesh_;
+  std::vector<uint32_t> order_;
+  std::vector<Vec3> lo_, hi_, centre_;
+  std::vector<BNode> nodes_;
+};
+
+/// Signed distance to a closed 2-manifold mesh (negative inside). Keeps a reference to `mesh`.
+class SignedDistance {
+ public:
+  explicit SignedDistance(const TriMesh& mesh);
+  double operator()(const Vec3& p) const;
+  /// The signed distance and its gradient (unit length, pointing outward; the nearest
+  /// feature's pseudonormal where p is on the surface).
+  double with_gradient(const Vec3& p, Vec3& gradient) const;
+
+ private:
+  const TriMesh& mesh_;
+  MeshDistance distance_;
+  std::vector<Vec3> face_normal_, vertex_normal_;
+  std::vector<std::array<Vec3, 3>> edge_normal_;  // per triangle, edge k: from vertex k to k + 1
+};
+
+}  // namespace pic::detail

@@ -1,0 +1,119 @@
+// Offsets, shells, rounds and thickened surfaces as implicit solids (pic/volume.h): a signed
+// distance to a closed surface (exact, by the nearest feature's pseudonormal) or an unsigned
+// distance to any surface, sampled by the implicit sampler.
+#include <algorithm>
+#include <cmath>
+
+#include "geometry/mesh_distance.h"
+#include "geometry/tolerances.h"
+#include "geometry/vec3.h"
+#include "pic/contour.h"
+#include "pic/measure.h"
+#include "pic/volume.h"
+
+namespace pic {
+
+namespace {
+
+using detail::MeshDistance;
+using detail::SignedDistance;
+
+/// A cube holding the mesh's box grown by `grow` on every side, plus the sampling margin.
+Cube cube_around(const TriMesh& mesh, double grow, const SampleOptions& options) {
+  if (options.cube) return *options.cube;
+  Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
+  for (const Vec3& p : mesh.positions)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  double extent = 0;
+  for (int k = 0; k < 3; ++k) extent = std::max(extent, hi[k] - lo[k] + 2 * std::max(grow, 0.0));
+  const double size = extent * (1 + 2 * options.margin);
+  Cube c;
+  for (int k = 0; k < 3; ++k) c.origin[k] = (lo[k] + hi[k]) / 2 - size / 2;
+  c.size = size;
+  return c;
+}
+
+void check_finite(double x, const char* what) {
+  if (!std::isfinite(x)) throw InvalidInput(std::string(what) + " must be finite");
+}
+
+/// The surface a signed distance can be taken to: the mesh itself when it is closed,
+/// 2-manifold and consistently oriented with positive volume; otherwise its PIC contour.
+TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
+  const MeshTopology t = analyze_topology(mesh);
+  if (t.closed() && t.manifold() && t.inconsistent_edges == 0 && volume(mesh) > 0) return mesh;
+  return contour(sample(mesh, options));
+}
+
+/// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1.
+template <class G>
+Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, G&& g) {
+  const SignedDistance sd(surface);
+  ImplicitSolid solid;
+  solid.value = [&](const Vec3& p) { return g(sd(p)).first; };
+  solid.gradient = [&](const Vec3& p) {
+    Vec3 grad;
+    const double d = sd.with_gradient(p, grad);
+    return detail::scale3(grad, g(d).second);
+  };
+  SampleOptions o = options;
+  o.cube = cube;
+  return sample(solid, o);
+}
+
+}  // namespace
+
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options) {
+  check_finite(distance, "the offset distance");
+  const TriMesh surface = closed_surface(solid, options);
+  const Cube cube = cube_around(surface, distance, options);
+  return sample_distance(surface, cube, options, [&](double d) { return std::pair{d - distance, 1.0}; });
+}
+
+Octree offset(const Octree& solid, double distance, const SampleOptions& options) {
+  SampleOptions o = options;
+  if (!o.cube && distance <= 0) o.cube = solid.cube;
+  return offset(contour(solid), distance, o);
+}
+
+Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options) {
+  check_finite(thickness, "the shell thickness");
+  if (!(thickness > 0)) throw InvalidInput("the shell thickness must be positive");
+  const TriMesh surface = closed_surface(solid, options);
+  const Cube cube = cube_around(surface, outward ? thickness : 0, options);
+  // Inward: inside the solid and farther than T from its surface's inside; outward: within T
+  // outside it. max of two distances of slope 1 is a distance bound of slope 1.
+  return sample_distance(surface, cube, options, [&](double d) {
+    const double a = outward ? d - thickness : d, b = outward ? -d : -d - thickness;
+    return a >= b ? std::pair{a, 1.0} : std::pair{b, -1.0};
+  });
+}
+
+Octree round_edges(const TriMesh& solid, double radius, bool convex, const SampleOptions& options) {
+  check_finite(radius, "the rounding radius");
+  if (!(radius > 0)) throw InvalidInput("the rounding radius must be positive");
+  const TriMesh surface = closed_surface(solid, options);
+  SampleOptions o = options;
+  o.cube = cube_around(surface, convex ? 0 : radius, options);
+  const Octree first = offset(surface, convex ? -radius : radius, o);
+  return offset(contour(first), convex ? radius : -radius, o);
+}
+
+Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options) {
+  check_finite(thickness, "the thickness");
+  if (!(thickness > 0)) throw InvalidInput("the thickness must be positive");
+  if (surface.triangles.empty()) throw InvalidInput("nothing to thicken: the mesh has no triangles");
+  const MeshDistance distance(surface);
+  ImplicitSolid solid;
+  const double half = thickness / 2;
+  solid.value = [&](const Vec3& p) { return distance.distance(p) - half; };
+  solid.gradient = [&](const Vec3& p) {
+    const detail::Nearest n = distance.nearest(p);
+    return n.distance > 0 ? detail::scale3(detail::sub3(p, n.point), 1 / n.distance) : Vec3{0, 0, 1};
+  };
+  SampleOptions o = options;
+  o.cube = cube_around(surface, half, options);
+  return sample(solid, o);
+}
+
+}  // namespace pic

@@ -1,0 +1,188 @@
+// Offsets, shells, rounds, thickened surfaces and implicit solids: volumes against the exact
+// formulas, vertices on the exact offset surface, sharp edges where the exact answer is sharp.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "pic/contour.h"
+#include "pic/csg.h"
+#include "pic/measure.h"
+#include "pic/primitives.h"
+#include "pic/sample.h"
+#include "pic/volume.h"
+#include "support/mesh_checks.h"
+
+namespace pic {
+namespace {
+
+using std::numbers::pi;
+using test::IsClosedManifold;
+
+/// Signed distance to the axis-aligned box [lo, hi].
+double box_distance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  double out2 = 0, in = -1e300;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max(lo[k] - p[k], p[k] - hi[k]);
+    if (d > 0) out2 += d * d;
+    in = std::max(in, d);
+  }
+  return out2 > 0 ? std::sqrt(out2) : in;
+}
+
+/// The volume of a box a x b x c grown by r (Minkowski sum with a ball).
+double grown_box_volume(double a, double b, double c, double r) {
+  return a * b * c + 2 * r * (a * b + b * c + c * a) + pi * r * r * (a + b + c) + 4.0 / 3 * pi * r * r * r;
+}
+
+double finest_cell(const Octree& t) { return t.cube.size / double(int64_t{1} << t.max_depth); }
+
+SampleOptions at_depth(int depth) {
+  SampleOptions o;
+  o.depth = depth;
+  return o;
+}
+
+void expect_valid(const TriMesh& m) {
+  ASSERT_TRUE(IsClosedManifold(m));
+  EXPECT_EQ(count_self_intersections(m), 0u);
+}
+
+TEST(Offset, UnitCubeGrownHasTheExactVolumeAndFlatFaces) {
+  const Octree t = offset(make_box({0, 0, 0}, {1, 1, 1}), 0.1, at_depth(9));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  const double exact = grown_box_volume(1, 1, 1, 0.1);
+  EXPECT_NEAR(volume(m), exact, 5e-4 * exact);
+  // Every vertex on the exact offset surface; those on the flat faces exactly.
+  double worst = 0;
+  size_t flat = 0;
+  for (const Vec3& p : m.positions) {
+    worst = std::max(worst, std::abs(box_distance(p, {0, 0, 0}, {1, 1, 1}) - 0.1));
+    // Beside a face, two cells away from its rounded border: the face's plane, 0.1 out.
+    const double c2 = 2 * finest_cell(t);
+    int inside = 0;
+    for (int k = 0; k < 3; ++k) inside += p[k] > c2 && p[k] < 1 - c2;
+    if (inside == 2) {
+      ++flat;
+      for (int k = 0; k < 3; ++k)
+        if (!(p[k] > c2 && p[k] < 1 - c2)) EXPECT_NEAR(std::abs(p[k] - 0.5), 0.6, 1e-6);
+    }
+  }
+  EXPECT_GT(flat, 0u);
+  EXPECT_LE(worst, 0.25 * finest_cell(t));
+  std::printf("  [measure] grown cube: volume %.7f (exact %.7f), worst vertex %.3f cells, %zu PICs\n", volume(m),
+              exact, worst / finest_cell(t), t.vertices.size());
+}
+
+TEST(Offset, UnitCubeShrunkIsTheSmallerCubeWithSharpEdges) {
+  const Octree t = offset(make_box({0, 0, 0}, {1, 1, 1}), -0.1, at_depth(9));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  EXPECT_NEAR(volume(m), 0.512, 1e-6);
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{c & 1 ? 0.9 : 0.1, c & 2 ? 0.9 : 0.1, c & 4 ? 0.9 : 0.1};
+    EXPECT_LE(test::nearest_vertex_distance(m, corner), 1e-6) << "corner " << c;
+  }
+}
+
+TEST(Offset, LPrismGrownKeepsItsConcaveEdgeSharp) {
+  // An L: [0,2]x[0,1]x[0,1] and [0,1]x[0,2]x[0,1]; its concave edge runs along z at x = y = 1.
+  SampleOptions o = at_depth(8);
+  o.cube = Cube{{-0.5, -0.5, -0.5}, 3};
+  const Octree lt = csg(sample(make_box({0, 0, 0}, {2, 1, 1}), o), sample(make_box({0, 0.5, 0}, {1, 2, 1}), o),
+                        CsgOp::Union);
+  const double r = 0.2;
+  const Octree t = offset(lt, r, at_depth(9));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  // The grown L's concave crease is the line x = y = 1 + r: a vertex on it, away from the ends.
+  double best = 1e300;
+  for (const Vec3& p : m.positions)
+    if (p[2] > 0.2 && p[2] < 0.8) best = std::min(best, std::hypot(p[0] - (1 + r), p[1] - (1 + r)));
+  EXPECT_LE(best, 1e-6);
+}
+
+TEST(Offset, SphereRadiusMovesByTheDistance) {
+  const TriMesh ball = make_sphere({0.3, -0.2, 0.1}, 1.0, 96);
+  for (const double d : {0.15, -0.15}) {
+    const Octree t = offset(ball, d, at_depth(8));
+    const TriMesh m = contour(t);
+    expect_valid(m);
+    // The faceted sphere's offset: each vertex at distance |d| from the input's surface.
+    const std::vector<double> dist = distance_to_mesh(ball, m.positions);
+    double worst = 0;
+    for (double x : dist) worst = std::max(worst, std::abs(x - std::abs(d)));
+    EXPECT_LE(worst, 0.1 * finest_cell(t)) << "distance " << d;
+  }
+}
+
+TEST(Offset, ShellHasWallsOfTheThickness) {
+  const double T = 0.1;
+  const Octree inward = shell(make_box({0, 0, 0}, {1, 1, 1}), T, false, at_depth(8));
+  const TriMesh m = contour(inward);
+  expect_valid(m);
+  EXPECT_NEAR(volume(m), 1 - std::pow(1 - 2 * T, 3), 1e-6);
+  const Octree outward = shell(make_box({0, 0, 0}, {1, 1, 1}), T, true, at_depth(8));
+  const TriMesh mo = contour(outward);
+  expect_valid(mo);
+  const double exact = grown_box_volume(1, 1, 1, T) - 1;
+  EXPECT_NEAR(volume(mo), exact, 1e-3 * exact);
+}
+
+TEST(Offset, RoundingAConvexBoxIsItsOpening) {
+  const double R = 0.1;
+  const Octree t = round_edges(make_box({0, 0, 0}, {1, 1, 1}), R, true, at_depth(8));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  const double exact = grown_box_volume(1 - 2 * R, 1 - 2 * R, 1 - 2 * R, R);
+  EXPECT_NEAR(volume(m), exact, 2e-3 * exact);
+}
+
+TEST(Offset, ThickenedSquareSheetHasTheSlabVolume) {
+  // One square of two triangles: no inside of its own.
+  const TriMesh sheet{{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 3}}};
+  const double T = 0.1;
+  const TriMesh m = contour(thicken(sheet, T, at_depth(8)));
+  expect_valid(m);
+  const double exact = 1 * T + 4 * pi * T * T / 8 + 4.0 / 3 * pi * std::pow(T / 2, 3);
+  EXPECT_NEAR(volume(m), exact, 0.02 * exact);
+}
+
+TEST(Implicit, BoxWithASphericalCavityMatchesTheBoolean) {
+  SampleOptions o = at_depth(7);
+  o.cube = Cube{{-1, -1, -1}, 2};
+  ImplicitSolid s;
+  s.value = [](const Vec3& p) {
+    const double box = box_distance(p, {-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6});
+    const double ball = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 0.4;
+    return std::max(box, -ball);
+  };
+  SampleStats st;
+  const Octree t = sample(s, o, &st);
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  const Octree boolean = csg(sample(make_box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}), o),
+                             sample(make_sphere({0, 0, 0}, 0.4, 128), o), CsgOp::Subtract);
+  EXPECT_LE(test::two_sided_distance(m, contour(boolean)), finest_cell(t));
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{c & 1 ? 0.6 : -0.6, c & 2 ? 0.6 : -0.6, c & 4 ? 0.6 : -0.6};
+    EXPECT_LE(test::nearest_vertex_distance(m, corner), 1e-6) << "corner " << c;
+  }
+  EXPECT_EQ(st.classifier, "implicit");
+  EXPECT_GT(st.evaluations, 0u);
+}
+
+TEST(Implicit, BadInputIsRefused) {
+  ImplicitSolid s;
+  SampleOptions o;
+  EXPECT_THROW(sample(s, o), InvalidInput);  // no function
+  s.value = [](const Vec3& p) { return p[0]; };
+  EXPECT_THROW(sample(s, o), InvalidInput);  // no cube
+  o.cube = Cube{{1, 1, 1}, 1};
+  EXPECT_THROW(sample(s, o), InvalidInput);  // all outside: no solid
+  EXPECT_THROW(offset(make_box({0, 0, 0}, {1, 1, 1}), std::nan(""), o), InvalidInput);
+}
+
+}  // namespace
+}  // namespace pic
