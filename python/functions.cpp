@@ -7,6 +7,7 @@
 #include "octree.h"
 #include "pic/primitives.h"
 #include "pic/scad.h"
+#include "pic/volume.h"
 
 namespace pic_python {
 
@@ -106,6 +107,64 @@ std::vector<pic::CsgTree> to_tree_leaves(py::iterable xs) {
   std::vector<pic::CsgTree> out;
   for (py::handle x : xs) out.push_back(to_tree_leaf(x, out.size()));
   return out;
+}
+
+/// A volumetric operation on a PIC object (through its contour) or a mesh, without the GIL.
+std::unique_ptr<PyOctree> volume_op(py::handle x, int depth, double error, py::handle cube, bool parallel,
+                                    const std::function<pic::Octree(const pic::TriMesh&, const pic::SampleOptions&)>& op) {
+  pic::SampleOptions o;
+  o.depth = depth;
+  o.error = error;
+  o.cube = to_cube(cube);
+  o.parallel = parallel;
+  pic::CsgOperand operand = to_operand(x, 0);
+  pic::Octree result;
+  {
+    py::gil_scoped_release nogil;
+    const pic::TriMesh mesh = operand.tree ? pic::contour(*operand.tree) : std::move(operand.mesh);
+    result = op(mesh, o);
+  }
+  return wrap(std::move(result));
+}
+
+/// An implicit solid from a Python function of an (n, 3) array of points returning n values
+/// (and optionally their (n, 3) gradients). Called one point at a time, with the GIL.
+std::unique_ptr<PyOctree> sample_function(py::object f, py::handle cube, int depth, double error, py::object gradient,
+                                          double lipschitz) {
+  pic::SampleOptions o;
+  o.depth = depth;
+  o.error = error;
+  o.cube = to_cube(cube);
+  if (!o.cube) throw py::value_error("sample_function needs a cube (x, y, z, size)");
+  o.parallel = false;  // one Python function: calls are serial anyway
+  auto as_row = [](const pic::Vec3& p) {
+    py::array_t<double> a({py::ssize_t{1}, py::ssize_t{3}});
+    auto r = a.mutable_unchecked<2>();
+    for (int k = 0; k < 3; ++k) r(0, k) = p[k];
+    return a;
+  };
+  pic::ImplicitSolid s;
+  s.lipschitz = lipschitz;
+  s.value = [&](const pic::Vec3& p) {
+    py::gil_scoped_acquire gil;
+    const py::array_t<double, py::array::c_style | py::array::forcecast> v = f(as_row(p));
+    if (v.size() != 1) throw pic::InvalidInput("sample_function: f must return one value per point");
+    return *v.data();
+  };
+  if (!gradient.is_none())
+    s.gradient = [&](const pic::Vec3& p) {
+      py::gil_scoped_acquire gil;
+      const py::array_t<double, py::array::c_style | py::array::forcecast> g = gradient(as_row(p));
+      if (g.size() != 3) throw pic::InvalidInput("sample_function: the gradient must be an (n, 3) array");
+      return pic::Vec3{g.data()[0], g.data()[1], g.data()[2]};
+    };
+  pic::SampleStats st;
+  pic::Octree tree;
+  {
+    py::gil_scoped_release nogil;
+    tree = pic::sample(s, o, &st);
+  }
+  return wrap(std::move(tree), sample_stats(st));
 }
 
 /// Evaluates an n-ary Boolean (pic::evaluate of a CsgTree) without the GIL.
@@ -258,6 +317,52 @@ sampled into one cube around them all at `depth`.)doc");
       },
       py::arg("a"), py::arg("solids"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
       py::arg("parallel") = true, "a minus the union of the others: difference(a, [b, c]) = a - (b | c).");
+  m.def(
+      "offset",
+      [](py::handle x, double distance, int depth, double error, py::object cube, bool parallel) {
+        return volume_op(x, depth, error, cube, parallel,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o) { return pic::offset(m, distance, o); });
+      },
+      py::arg("solid"), py::arg("distance"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
+      py::arg("cube") = py::none(), py::arg("parallel") = true,
+      R"doc(The solid grown by distance (> 0) or shrunk (< 0): pic::offset. solid: an Octree or a mesh.)doc");
+  m.def(
+      "shell",
+      [](py::handle x, double thickness, bool outward, int depth, double error, py::object cube, bool parallel) {
+        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
+          return pic::shell(m, thickness, outward, o);
+        });
+      },
+      py::arg("solid"), py::arg("thickness"), py::kw_only(), py::arg("outward") = false, py::arg("depth") = 12,
+      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true,
+      "The solid hollowed to walls `thickness` thick (outward: a skin around it): pic::shell.");
+  m.def(
+      "round",
+      [](py::handle x, double radius, bool concave, int depth, double error, py::object cube, bool parallel) {
+        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
+          return pic::round_edges(m, radius, !concave, o);
+        });
+      },
+      py::arg("solid"), py::arg("radius"), py::kw_only(), py::arg("concave") = false, py::arg("depth") = 12,
+      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true,
+      "Convex edges rounded to `radius` (concave=True: concave edges filled): pic::round_edges.");
+  m.def(
+      "thicken",
+      [](py::handle x, double thickness, int depth, double error, py::object cube, bool parallel) {
+        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
+          return pic::thicken(m, thickness, o);
+        });
+      },
+      py::arg("surface"), py::arg("thickness"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
+      py::arg("cube") = py::none(), py::arg("parallel") = true,
+      "The solid within thickness / 2 of a surface, open or closed: pic::thicken.");
+  m.def("sample_function", &sample_function, py::arg("f"), py::arg("cube"), py::kw_only(), py::arg("depth") = 8,
+        py::arg("error") = 1e-8, py::arg("gradient") = py::none(), py::arg("lipschitz") = 1.0,
+        R"doc(Samples the solid f < 0 (pic::sample of an ImplicitSolid).
+
+f: a function of an (n, 3) array of points returning n values, negative inside, with
+|f(p) - f(q)| <= lipschitz |p - q| (a signed distance: 1). gradient: optional, (n, 3) -> (n, 3).
+cube: (x, y, z, size), required.)doc");
   m.def(
       "bounding_cube",
       [](py::object vertices, double margin) {

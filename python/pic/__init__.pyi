@@ -141,6 +141,31 @@ def difference(a: Any, solids: Iterable[Any], *, depth: int = 12, error: float =
     """a minus the union of the others."""
     ...
 
+def offset(solid: Any, distance: float, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
+           parallel: bool = True) -> Octree:
+    """The solid grown by distance (> 0) or shrunk (< 0); solid: an Octree or a mesh."""
+    ...
+
+def shell(solid: Any, thickness: float, *, outward: bool = False, depth: int = 12, error: float = 1e-8,
+          cube: Any = None, parallel: bool = True) -> Octree:
+    """The solid hollowed to walls `thickness` thick (outward: a skin around it)."""
+    ...
+
+def round(solid: Any, radius: float, *, concave: bool = False, depth: int = 12, error: float = 1e-8,
+          cube: Any = None, parallel: bool = True) -> Octree:
+    """Convex edges rounded to `radius` (concave=True: concave edges filled)."""
+    ...
+
+def thicken(surface: Any, thickness: float, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
+            parallel: bool = True) -> Octree:
+    """The solid within thickness / 2 of a surface, open or closed."""
+    ...
+
+def sample_function(f: Any, cube: Any, *, depth: int = 8, error: float = 1e-8, gradient: Any = None,
+                    lipschitz: float = 1.0) -> Octree:
+    """The solid f < 0 for f a function of an (n, 3) array of points returning n values."""
+    ...
+
 def csg(a: Octree, b: Octree, op: str, error: float = 1e-8, parallel: bool = True) -> Octree:
     """Boolean on the octrees as a new object (pic::csg). op: 'union', 'intersect'
     ('intersection'), 'subtract' ('difference'). The result's .stats hold the statistics."""

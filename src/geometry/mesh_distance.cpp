@@ -107,10 +107,23 @@ double MeshDistance::distance(const Vec3& p) const {
   return std::sqrt(best2);
 }
 
-Nearest MeshDistance::nearest(const Vec3& p) const {
+Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;
+  if (hint && *hint < mesh_.triangles.size()) {
+    const auto& t = mesh_.triangles[*hint];
+    best = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
+    best.triangle = *hint;
+    // A hair more: the search must still find the hint's own triangle when it is the answer.
+    best2 = best.distance * best.distance * (1 + 1e-12) + kTinyDivisor;
+  }
   search(p, best2, [&](uint32_t i) {
+    double box2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max({lo_[i][k] - p[k], 0.0, p[k] - hi_[i][k]});
+      box2 += d * d;
+    }
+    if (box2 >= best2) return;
     const auto& t = mesh_.triangles[i];
     const Nearest n = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
     if (n.distance * n.distance < best2) {
@@ -119,6 +132,7 @@ Nearest MeshDistance::nearest(const Vec3& p) const {
       best.triangle = i;
     }
   });
+  if (hint) *hint = best.triangle;
   return best;
 }
 
@@ -185,13 +199,13 @@ SignedDistance::SignedDistance(const TriMesh& mesh)
   }
 }
 
-double SignedDistance::operator()(const Vec3& p) const {
+double SignedDistance::operator()(const Vec3& p, uint32_t* hint) const {
   Vec3 g;
-  return with_gradient(p, g);
+  return with_gradient(p, g, hint);
 }
 
-double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient) const {
-  const Nearest n = distance_.nearest(p);
+double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint) const {
+  const Nearest n = distance_.nearest(p, hint);
   const auto& t = mesh_.triangles[n.triangle];
   Vec3 pseudo;
   switch (n.feature) {

@@ -31,8 +31,10 @@ class MeshDistance {
   explicit MeshDistance(const TriMesh& mesh);
   /// Unsigned distance from p to the mesh (infinity for an empty mesh).
   double distance(const Vec3& p) const;
-  /// The mesh's point nearest p (the mesh must have a triangle).
-  Nearest nearest(const Vec3& p) const;
+  /// The mesh's point nearest p (the mesh must have a triangle). `hint`, when given, is a
+  /// triangle likely near p (the answer for a point close by): its distance bounds the search
+  /// from the start; it is set to the answer's triangle.
+  Nearest nearest(const Vec3& p, uint32_t* hint = nullptr) const;
 
  private:
   struct BNode {
@@ -56,10 +58,10 @@ class MeshDistance {
 class SignedDistance {
  public:
   explicit SignedDistance(const TriMesh& mesh);
-  double operator()(const Vec3& p) const;
+  double operator()(const Vec3& p, uint32_t* hint = nullptr) const;
   /// The signed distance and its gradient (unit length, pointing outward; the nearest
-  /// feature's pseudonormal where p is on the surface).
-  double with_gradient(const Vec3& p, Vec3& gradient) const;
+  /// feature's pseudonormal where p is on the surface). `hint`: see MeshDistance::nearest.
+  double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr) const;
 
  private:
   const TriMesh& mesh_;

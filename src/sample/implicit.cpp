@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "geometry/lattice.h"
+#include "geometry/memo.h"
 #include "geometry/qef.h"
 #include "geometry/stopwatch.h"
 #include "geometry/vec3.h"
@@ -31,6 +32,22 @@ Vec3 lattice_unit(const Lat& l) {
   constexpr double k = 1.0 / double(int64_t{1} << kMaxLevel);
   return {double(l[0]) * k, double(l[1]) * k, double(l[2]) * k};
 }
+
+/// f at a lattice point: up to 8 cells of a level ask for each of their corners, and a
+/// child grid's face and edge points are shared with the neighbours' grids.
+struct PointValue {
+  Lat p;
+  bool filled = false;
+  double f = 0;
+};
+/// The surface point on a cell edge and f's gradient there: up to 4 cells share the edge.
+struct EdgeHermite {
+  Lat a;
+  int64_t span = 0;
+  int axis = 0;
+  bool filled = false;
+  Vec3 x, g;
+};
 
 class ImplicitSampler {
  public:
@@ -70,9 +87,18 @@ class ImplicitSampler {
     subdivide(cell, v, out, slot, capped);
   }
 
+  /// f at lattice point p (memoized).
+  double value_at(const Lat& p) {
+    PointValue& e = values_.slot(memo_slot(p, 0, decltype(values_)::kBits));
+    if (!e.filled || e.p != p) e = {p, true, value(lattice_unit(p))};
+    return e.f;
+  }
+
   std::atomic<size_t> evaluations{0};
 
  private:
+  ThreadMemo<PointValue, 16> values_;
+  ThreadMemo<EdgeHermite, 14> edges_;
   const ImplicitSolid& f_;
   Cube cube_;
   int max_depth_;
@@ -144,10 +170,16 @@ class ImplicitSampler {
     const Vec3 m = cell.min_unit();
     const double s = cell.size();
     auto corner = [&](int k) { return Vec3{m[0] + (k & 1) * s, m[1] + ((k >> 1) & 1) * s, m[2] + ((k >> 2) & 1) * s}; };
-    for (const auto& [c0, c1] : kEdgeCorners) {
+    for (int e = 0; e < 12; ++e) {
+      const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
       if (((signs >> c0) & 1) == ((signs >> c1) & 1)) continue;
-      const Vec3 x = crossing(corner(c0), v[c0], corner(c1), v[c1]);
-      const Vec3 g = gradient(x, s);
+      const Lat a = cell.corner(c0);
+      EdgeHermite& h = edges_.slot(edge_memo_slot(a, edge_axis(e), cell.span(), decltype(edges_)::kBits));
+      if (!h.filled || h.a != a || h.axis != edge_axis(e) || h.span != cell.span()) {
+        const Vec3 x = crossing(corner(c0), v[c0], corner(c1), v[c1]);
+        h = {a, cell.span(), edge_axis(e), true, x, gradient(x, s)};
+      }
+      const Vec3 &x = h.x, &g = h.g;
       const double len = norm3(g);
       if (!(len > 0)) continue;
       const Vec3 n = scale3(g, 1 / len);
@@ -165,7 +197,7 @@ class ImplicitSampler {
         g[i] = v[(a / 2) | ((b / 2) << 1) | ((c / 2) << 2)];
         continue;
       }
-      g[i] = value(lattice_unit({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h}));
+      g[i] = value_at({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
     }
     auto child_values = [&](int c) {
       std::array<double, 8> cv;
@@ -205,7 +237,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   if (!(solid.lipschitz > 0) || !std::isfinite(solid.lipschitz)) throw InvalidInput("lipschitz must be positive");
   ImplicitSampler sampler(solid, *options.cube, options);
   std::array<double, 8> root{};
-  for (int k = 0; k < 8; ++k) root[k] = sampler.value(lattice_unit(Cell{}.corner(k)));
+  for (int k = 0; k < 8; ++k) root[k] = sampler.value_at(Cell{}.corner(k));
   for (double x : root)
     if (!std::isfinite(x)) throw InvalidInput("the function is not finite at a corner of the cube");
   Builder b;

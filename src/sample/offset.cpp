@@ -1,6 +1,8 @@
 // Offsets, shells, rounds and thickened surfaces as implicit solids (pic/volume.h): a signed
 // distance to a closed surface (exact, by the nearest feature's pseudonormal) or an unsigned
 // distance to any surface, sampled by the implicit sampler.
+#include <tbb/enumerable_thread_specific.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -49,11 +51,14 @@ TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
 template <class G>
 Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, G&& g) {
   const SignedDistance sd(surface);
+  // Per thread, the triangle nearest the last point asked: the sampler asks in cell order,
+  // so the next point's nearest triangle is usually that one or a neighbour.
+  tbb::enumerable_thread_specific<uint32_t> hints(uint32_t{0});
   ImplicitSolid solid;
-  solid.value = [&](const Vec3& p) { return g(sd(p)).first; };
+  solid.value = [&](const Vec3& p) { return g(sd(p, &hints.local())).first; };
   solid.gradient = [&](const Vec3& p) {
     Vec3 grad;
-    const double d = sd.with_gradient(p, grad);
+    const double d = sd.with_gradient(p, grad, &hints.local());
     return detail::scale3(grad, g(d).second);
   };
   SampleOptions o = options;
@@ -104,11 +109,12 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
   if (!(thickness > 0)) throw InvalidInput("the thickness must be positive");
   if (surface.triangles.empty()) throw InvalidInput("nothing to thicken: the mesh has no triangles");
   const MeshDistance distance(surface);
+  tbb::enumerable_thread_specific<uint32_t> hints(uint32_t{0});
   ImplicitSolid solid;
   const double half = thickness / 2;
-  solid.value = [&](const Vec3& p) { return distance.distance(p) - half; };
+  solid.value = [&](const Vec3& p) { return distance.nearest(p, &hints.local()).distance - half; };
   solid.gradient = [&](const Vec3& p) {
-    const detail::Nearest n = distance.nearest(p);
+    const detail::Nearest n = distance.nearest(p, &hints.local());
     return n.distance > 0 ? detail::scale3(detail::sub3(p, n.point), 1 / n.distance) : Vec3{0, 0, 1};
   };
   SampleOptions o = options;

@@ -501,3 +501,43 @@ def test_stubs_cover_the_module():
     assert octree_public <= members
     for name in public:
         assert getattr(pic, name).__doc__, name
+
+
+def _volume(tree):
+    v, f = pic.contour(tree)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
+
+
+def test_offset_shell_round_thicken_volumes():
+    cube_mesh = pic.make_box((0, 0, 0), (1, 1, 1))
+    grown = pic.offset(cube_mesh, 0.1, depth=8)
+    exact = 1 + 0.6 + 0.03 * math.pi + 4 / 3 * math.pi * 0.001
+    assert abs(_volume(grown) - exact) < 5e-4 * exact
+    assert abs(_volume(pic.offset(grown, -0.1, depth=8)) - 1) < 5e-3  # through an Octree's contour
+    assert abs(_volume(pic.shell(cube_mesh, 0.1, depth=7)) - (1 - 0.8 ** 3)) < 1e-6
+    opened = pic.round(cube_mesh, 0.1, depth=7)
+    assert _volume(opened) < 1 - 1e-3
+    sheet = (np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float), np.array([[0, 1, 2], [0, 2, 3]]))
+    slab = pic.thicken(sheet, 0.1, depth=7)
+    exact = 0.1 + 4 * math.pi * 0.01 / 8 + 4 / 3 * math.pi * 0.05 ** 3
+    assert abs(_volume(slab) - exact) < 0.02 * exact
+
+
+def test_sample_function_box_with_cavity_matches_boolean():
+    def f(p):
+        q = np.abs(p) - 0.6
+        box = np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(axis=1), 0)
+        return np.maximum(box, 0.4 - np.linalg.norm(p, axis=1))
+
+    t = pic.sample_function(f, (-1, -1, -1, 2), depth=6)
+    assert t.stats["inside"] == "implicit"
+    v, faces = pic.contour(t)
+    exact = 1.2 ** 3 - 4 / 3 * math.pi * 0.4 ** 3
+    assert abs(_volume(t) - exact) < 0.01 * exact
+    # The box's corners are vertices: the edges stay sharp.
+    corners = np.array([[x, y, z] for x in (-0.6, 0.6) for y in (-0.6, 0.6) for z in (-0.6, 0.6)])
+    d = np.linalg.norm(v[None, :, :] - corners[:, None, :], axis=2).min(axis=1)
+    assert d.max() < 1e-6
+    with pytest.raises(ValueError):
+        pic.sample_function(f, None)
