@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -105,9 +106,13 @@ double farthest(const std::vector<Plane>& set, const Vec3& x) {
 
 class Simplifier {
  public:
-  Simplifier(const TriMesh& mesh, double tolerance)
+  /// `frozen`: per vertex of `mesh`, whether it must stay where it is (empty: none).
+  Simplifier(const TriMesh& mesh, double tolerance, const std::vector<uint8_t>& frozen)
       : pos_(mesh.positions), tris_(mesh.triangles), tol_(tolerance), same_(tolerance / 100), quadric_(pos_.size()),
-        planes_(pos_.size()), faces_(pos_.size()), alive_(tris_.size(), 1) {
+        planes_(pos_.size()), faces_(pos_.size()), alive_(tris_.size(), 1), merged_into_(pos_.size()),
+        frozen_(frozen) {
+    std::iota(merged_into_.begin(), merged_into_.end(), 0u);
+    frozen_.resize(pos_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       const auto& t = tris_[f];
       const Vec3 n = normal_of(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
@@ -141,8 +146,16 @@ class Simplifier {
     }
   }
 
-  TriMesh result() const {
+  /// The input vertex that u was merged into, at last (u itself when it was kept).
+  uint32_t survivor(uint32_t u) const {
+    while (merged_into_[u] != u) u = merged_into_[u];
+    return u;
+  }
+
+  /// The simplified mesh; `kept[i]`: the vertex of the input that output vertex i is.
+  TriMesh result(std::vector<uint32_t>& kept) const {
     TriMesh out;
+    kept.clear();
     std::vector<uint32_t> remap(pos_.size(), UINT32_MAX);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       if (!alive_[f]) continue;
@@ -152,6 +165,7 @@ class Simplifier {
         if (r == UINT32_MAX) {
           r = uint32_t(out.positions.size());
           out.positions.push_back(pos_[tris_[f][k]]);
+          kept.push_back(tris_[f][k]);
         }
         t[k] = r;
       }
@@ -170,6 +184,8 @@ class Simplifier {
   std::vector<uint8_t> alive_;
   std::vector<uint32_t> ring_u_, ring_v_;  // scratch
   std::vector<Plane> merged_;
+  std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
+  std::vector<uint8_t> frozen_;
   struct Candidate {
     double error;
     uint32_t v;
@@ -213,11 +229,13 @@ class Simplifier {
 
   /// Merges u with the neighbour that keeps the planes closest, among those that may take it.
   bool collapse_cheapest(uint32_t u) {
+    if (frozen_[u]) return false;
     ring(u, ring_u_);
     candidates_.clear();
     double error = 0;
     for (uint32_t v : ring_u_)
-      if (const auto x = merged_position(u, v, error)) candidates_.push_back({error, v, *x});
+      if (!frozen_[v])
+        if (const auto x = merged_position(u, v, error)) candidates_.push_back({error, v, *x});
     std::sort(candidates_.begin(), candidates_.end(),
               [](const Candidate& a, const Candidate& b) { return a.error < b.error || (a.error == b.error && a.v < b.v); });
     for (const Candidate& c : candidates_)
@@ -278,6 +296,7 @@ class Simplifier {
 
   void collapse(uint32_t u, uint32_t v, const Vec3& x) {
     pos_[v] = x;
+    merged_into_[u] = v;
     for (uint32_t f : faces_[u]) {
       auto& t = tris_[f];
       if (t[0] == v || t[1] == v || t[2] == v) {
@@ -301,15 +320,31 @@ class Simplifier {
 
 size_t simplify(TriMesh& mesh, double tolerance) {
   if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
-  Simplifier s(mesh, tolerance);
-  s.run();
-  TriMesh out = s.result();
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
-  // not neighbours is checked once, on the result: the contour stays where one would appear.
-  if (out.triangles.size() == mesh.triangles.size() || !self_intersecting_pairs(out).empty()) return 0;
-  const size_t removed = mesh.triangles.size() - out.triangles.size();
-  mesh = std::move(out);
-  return removed;
+  // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
+  // input vertices merged into the crossing triangles stay as they are, and the rest is
+  // simplified again (a few rounds; the raw contour when crossings remain).
+  std::vector<uint8_t> frozen(mesh.positions.size(), 0);
+  for (int round = 0; round < 4; ++round) {
+    Simplifier s(mesh, tolerance, frozen);
+    s.run();
+    std::vector<uint32_t> kept;
+    TriMesh out = s.result(kept);
+    if (out.triangles.size() == mesh.triangles.size()) return 0;
+    const auto crossings = self_intersecting_pairs(out);
+    if (crossings.empty()) {
+      const size_t removed = mesh.triangles.size() - out.triangles.size();
+      mesh = std::move(out);
+      return removed;
+    }
+    std::vector<uint8_t> at_crossing(mesh.positions.size(), 0);
+    for (const auto& [a, b] : crossings)
+      for (uint32_t t : {a, b})
+        for (uint32_t v : out.triangles[t]) at_crossing[kept[v]] = 1;
+    for (uint32_t u = 0; u < mesh.positions.size(); ++u)
+      if (at_crossing[s.survivor(u)]) frozen[u] = 1;
+  }
+  return 0;
 }
 
 }  // namespace pic
