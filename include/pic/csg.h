@@ -67,8 +67,9 @@ struct CsgChainOptions {
   /// Optional: called after each Boolean with its operand's index and statistics.
   std::function<void(size_t, const CsgStats&)> on_step;
 };
-/// operands[0] ops[0] operands[1] ops[1] operands[2] ..., left to right. Mesh operands are
-/// sampled one at a time into one cube around all of them, so the Booleans between them need
+/// operands[0] ops[0] operands[1] ops[1] operands[2] ..., left to right: evaluate() of the
+/// left-deep tree ((a op b) op c) ..., each step's statistics to on_step in order. Mesh
+/// operands are sampled into one cube around all of them, so the Booleans between them need
 /// no resampling (a Boolean with a PIC object in another cube resamples as csg() does).
 /// \throws InvalidInput when ops.size() + 1 != operands.size() or as sample() and csg().
 Octree csg_chain(std::vector<CsgOperand> operands, const std::vector<CsgOp>& ops,
@@ -84,6 +85,7 @@ struct CsgTree {
   std::shared_ptr<const Octree> tree;   ///< Kind::Octree
   std::shared_ptr<const TriMesh> mesh;  ///< Kind::Mesh
   std::vector<CsgTree> children;        ///< inner nodes
+  std::string name;                     ///< optional, for progress messages ("sampling x")
 };
 CsgTree csg_leaf(Octree tree);
 CsgTree csg_leaf(std::shared_ptr<const Octree> tree);
@@ -98,6 +100,8 @@ CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away);
 /// half with the second, each half the same way, halves evaluated in parallel (with
 /// options.csg.parallel) — and no step copies a result: each Boolean is written into its left
 /// operand. Three children combine as (a op b) op c. An empty union is the empty solid.
+/// options.on_step gets each Boolean's statistics with its number in the order they finish
+/// (the chain's order for a left-deep tree).
 /// 	hrows InvalidInput as sample() and csg() do, or for a difference without children.
 Octree evaluate(const CsgTree& tree, const CsgChainOptions& options = {});
 

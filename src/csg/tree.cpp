@@ -4,6 +4,8 @@
 
 #include <tbb/parallel_invoke.h>
 
+#include <mutex>
+
 namespace pic {
 
 CsgTree csg_leaf(std::shared_ptr<const Octree> tree) {
@@ -59,10 +61,13 @@ class TreeEvaluator {
   TreeEvaluator(const CsgChainOptions& options, const SampleOptions& sampling, const Octree* empty_like)
       : options_(options), sampling_(sampling), empty_like_(empty_like) {}
 
-  Octree eval(const CsgTree& t) const {
+  Octree eval(const CsgTree& t) {
     switch (t.kind) {
       case CsgTree::Kind::Octree: return *t.tree;
-      case CsgTree::Kind::Mesh: return sample(*t.mesh, sampling_);
+      case CsgTree::Kind::Mesh: {
+        if (!t.name.empty()) say("sampling " + t.name);
+        return sample(*t.mesh, sampling_);
+      }
       case CsgTree::Kind::Union: return balanced(t.children, 0, t.children.size(), CsgOp::Union);
       case CsgTree::Kind::Intersection: return balanced(t.children, 0, t.children.size(), CsgOp::Intersect);
       case CsgTree::Kind::Difference: {
@@ -70,7 +75,7 @@ class TreeEvaluator {
         if (t.children.size() == 1) return eval(t.children[0]);
         Octree a, b;
         both([&] { a = eval(t.children[0]); }, [&] { b = balanced(t.children, 1, t.children.size(), CsgOp::Union); });
-        csg_inplace(a, b, CsgOp::Subtract, options_.csg);
+        boolean(a, b, CsgOp::Subtract, t.children.size() == 2 ? t.children[1].name : std::string());
         return a;
       }
     }
@@ -81,6 +86,8 @@ class TreeEvaluator {
   const CsgChainOptions& options_;
   SampleOptions sampling_;
   const Octree* empty_like_;
+  std::mutex step_mutex_;  // on_step and progress are called one at a time
+  uint32_t steps_ = 0;     // Booleans finished so far (under step_mutex_)
 
   /// The empty solid in the tree's cube.
   Octree empty() const {
@@ -91,19 +98,34 @@ class TreeEvaluator {
     return t;
   }
   template <class A, class B>
-  void both(const A& a, const B& b) const {
+  void both(const A& a, const B& b) {
     if (options_.csg.parallel) tbb::parallel_invoke(a, b);
     else a(), b();
   }
   /// kids[b, e) combined: the first ceil(n/2) with the rest, each half the same way.
-  Octree balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) const {
+  Octree balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) {
     if (b >= e) return empty();
     if (e - b == 1) return eval(kids[b]);
     const size_t mid = b + (e - b + 1) / 2;
     Octree x, y;
     both([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
-    csg_inplace(x, y, op, options_.csg);
+    boolean(x, y, op, e - mid == 1 ? kids[mid].name : std::string());
     return x;
+  }
+  /// x := x op y, reported (`name`: y's, when it is a named leaf).
+  void boolean(Octree& x, const Octree& y, CsgOp op, const std::string& name) {
+    if (!name.empty()) say(to_string(op) + " " + name);
+    CsgStats st;
+    csg_inplace(x, y, op, options_.csg, &st);
+    if (!options_.on_step) return;
+    const std::lock_guard lock(step_mutex_);
+    st.stamp = ++steps_;
+    options_.on_step(st.stamp, st);
+  }
+  void say(const std::string& m) {
+    if (!options_.progress) return;
+    const std::lock_guard lock(step_mutex_);
+    options_.progress(m);
   }
 };
 
@@ -116,7 +138,7 @@ Octree evaluate(const CsgTree& tree, const CsgChainOptions& options) {
     collect_mesh_points(tree, all.positions);
     if (!all.positions.empty()) sampling.cube = bounding_cube(all, sampling.margin);
   }
-  const TreeEvaluator ev(options, sampling, first_octree(tree));
+  TreeEvaluator ev(options, sampling, first_octree(tree));
   Octree r = ev.eval(tree);
   if (r.nodes.size() > detail::reachable_nodes(r)) detail::compact(r);
   return r;
