@@ -11,6 +11,7 @@
 //   sample.h   mesh / point cloud -> PIC object
 //   contour.h  PIC object -> closed triangle mesh
 //   csg.h      Booleans on PIC objects
+//   volume.h   offsets, shells, rounds, thickened surfaces
 //   io.h       .pic files, mesh and point cloud files
 //   measure.h  topology, validity, volume, distances
 //   primitives.h, scad.h, render.h, viewer.h: primitives, OpenSCAD, pictures
@@ -25,3 +26,4 @@
 #include "pic/sample.h"
 #include "pic/scad.h"
 #include "pic/types.h"
+#include "pic/volume.h"
