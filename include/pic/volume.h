@@ -13,20 +13,26 @@ namespace pic {
 /// consistently oriented surface is sampled first (any input sample() takes) and its contour
 /// used; a PIC object through its contour. `options.cube` defaults to the solid's bounding
 /// cube grown to hold the offset.
+/// `stats`: the implicit sampling's (for a round, its second offset's).
 /// \throws InvalidInput for non-finite values, or a result with no solid in the cube.
-Octree offset(const TriMesh& solid, double distance, const SampleOptions& options = {});
-Octree offset(const Octree& solid, double distance, const SampleOptions& options = {});
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options = {},
+              SampleStats* stats = nullptr);
+Octree offset(const Octree& solid, double distance, const SampleOptions& options = {},
+              SampleStats* stats = nullptr);
 
 /// The solid hollowed to walls `thickness` thick (the solid minus its inward offset), or with
 /// `outward` a skin of that thickness around it (its outward offset minus the solid).
-Octree shell(const TriMesh& solid, double thickness, bool outward = false, const SampleOptions& options = {});
+Octree shell(const TriMesh& solid, double thickness, bool outward = false, const SampleOptions& options = {},
+             SampleStats* stats = nullptr);
 
 /// Rounded edges: with `convex` the convex edges get radius `radius` (an opening: shrink, then
 /// grow back), else the concave ones are filled to it (a closing: grow, then shrink back).
-Octree round_edges(const TriMesh& solid, double radius, bool convex = true, const SampleOptions& options = {});
+Octree round_edges(const TriMesh& solid, double radius, bool convex = true, const SampleOptions& options = {},
+                   SampleStats* stats = nullptr);
 
 /// The solid within thickness / 2 of a surface, open or closed (a sheet, a drawing's
 /// triangles, a scan with holes): the answer for inputs with no inside of their own.
-Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options = {});
+Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options = {},
+               SampleStats* stats = nullptr);
 
 }  // namespace pic

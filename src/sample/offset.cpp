@@ -49,7 +49,8 @@ TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
 
 /// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1.
 template <class G>
-Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, G&& g) {
+Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, SampleStats* stats,
+                       G&& g) {
   const SignedDistance sd(surface);
   // Per thread, the triangle nearest the last point asked: the sampler asks in cell order,
   // so the next point's nearest triangle is usually that one or a neighbour.
@@ -63,48 +64,50 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
   };
   SampleOptions o = options;
   o.cube = cube;
-  return sample(solid, o);
+  return sample(solid, o, stats);
 }
 
 }  // namespace
 
-Octree offset(const TriMesh& solid, double distance, const SampleOptions& options) {
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options, SampleStats* stats) {
   check_finite(distance, "the offset distance");
   const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, distance, options);
-  return sample_distance(surface, cube, options, [&](double d) { return std::pair{d - distance, 1.0}; });
+  return sample_distance(surface, cube, options, stats, [&](double d) { return std::pair{d - distance, 1.0}; });
 }
 
-Octree offset(const Octree& solid, double distance, const SampleOptions& options) {
+Octree offset(const Octree& solid, double distance, const SampleOptions& options, SampleStats* stats) {
   SampleOptions o = options;
   if (!o.cube && distance <= 0) o.cube = solid.cube;
-  return offset(contour(solid), distance, o);
+  return offset(contour(solid), distance, o, stats);
 }
 
-Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options) {
+Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options,
+             SampleStats* stats) {
   check_finite(thickness, "the shell thickness");
   if (!(thickness > 0)) throw InvalidInput("the shell thickness must be positive");
   const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, outward ? thickness : 0, options);
   // Inward: inside the solid and farther than T from its surface's inside; outward: within T
   // outside it. max of two distances of slope 1 is a distance bound of slope 1.
-  return sample_distance(surface, cube, options, [&](double d) {
+  return sample_distance(surface, cube, options, stats, [&](double d) {
     const double a = outward ? d - thickness : d, b = outward ? -d : -d - thickness;
     return a >= b ? std::pair{a, 1.0} : std::pair{b, -1.0};
   });
 }
 
-Octree round_edges(const TriMesh& solid, double radius, bool convex, const SampleOptions& options) {
+Octree round_edges(const TriMesh& solid, double radius, bool convex, const SampleOptions& options,
+                   SampleStats* stats) {
   check_finite(radius, "the rounding radius");
   if (!(radius > 0)) throw InvalidInput("the rounding radius must be positive");
   const TriMesh surface = closed_surface(solid, options);
   SampleOptions o = options;
   o.cube = cube_around(surface, convex ? 0 : radius, options);
   const Octree first = offset(surface, convex ? -radius : radius, o);
-  return offset(contour(first), convex ? radius : -radius, o);
+  return offset(contour(first), convex ? radius : -radius, o, stats);
 }
 
-Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options) {
+Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options, SampleStats* stats) {
   check_finite(thickness, "the thickness");
   if (!(thickness > 0)) throw InvalidInput("the thickness must be positive");
   if (surface.triangles.empty()) throw InvalidInput("nothing to thicken: the mesh has no triangles");
@@ -119,7 +122,7 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
   };
   SampleOptions o = options;
   o.cube = cube_around(surface, half, options);
-  return sample(solid, o);
+  return sample(solid, o, stats);
 }
 
 }  // namespace pic
