@@ -149,6 +149,18 @@ TEST(Offset, ThickenedSquareSheetHasTheSlabVolume) {
   EXPECT_NEAR(volume(m), exact, 0.02 * exact);
 }
 
+TEST(Offset, ADegenerateTriangleDoesNotSpoilTheDistance) {
+  // The square sheet plus a triangle with two coincident vertices (common in STL files): its
+  // nearest point must not be NaN, or every later query on the thread would inherit it.
+  TriMesh sheet{{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 0}, {0.5, 0.5, 0}, {0.5, 0.6, 0}},
+                {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}}};
+  const double T = 0.1;
+  const TriMesh m = contour(thicken(sheet, T, at_depth(7)));
+  expect_valid(m);
+  const double exact = 1 * T + 4 * pi * T * T / 8 + 4.0 / 3 * pi * std::pow(T / 2, 3);
+  EXPECT_NEAR(volume(m), exact, 0.02 * exact);
+}
+
 TEST(Implicit, BoxWithASphericalCavityMatchesTheBoolean) {
   SampleOptions o = at_depth(7);
   o.cube = Cube{{-1, -1, -1}, 2};

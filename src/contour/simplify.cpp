@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <numeric>
 #include <optional>
+#include <utility>
 #include <vector>
 
 
@@ -147,9 +148,11 @@ class Simplifier {
   }
 
   /// The input vertex that u was merged into, at last (u itself when it was kept).
-  uint32_t survivor(uint32_t u) const {
-    while (merged_into_[u] != u) u = merged_into_[u];
-    return u;
+  uint32_t survivor(uint32_t u) {
+    uint32_t root = u;
+    while (merged_into_[root] != root) root = merged_into_[root];
+    while (merged_into_[u] != root) u = std::exchange(merged_into_[u], root);  // shorten the chain
+    return root;
   }
 
   /// The simplified mesh; `kept[i]`: the vertex of the input that output vertex i is.

@@ -24,17 +24,23 @@ Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
   if (d3 >= 0 && d4 <= d3) return at(b, Feature::V1);
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return at(add3(a, scale3(ab, d1 / (d1 - d3))), Feature::E01);
+  // Each edge's parameter only where its denominator is positive: a triangle with two
+  // coincident vertices would give 0/0 there.
+  if (vc <= 0 && d1 >= 0 && d3 <= 0 && d1 - d3 > 0) return at(add3(a, scale3(ab, d1 / (d1 - d3))), Feature::E01);
   const Vec3 cp = sub3(p, c);
   const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
   if (d6 >= 0 && d5 <= d6) return at(c, Feature::V2);
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return at(add3(a, scale3(ac, d2 / (d2 - d6))), Feature::E20);
+  if (vb <= 0 && d2 >= 0 && d6 <= 0 && d2 - d6 > 0) return at(add3(a, scale3(ac, d2 / (d2 - d6))), Feature::E20);
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0 && (d4 - d3) + (d5 - d6) > 0)
     return at(add3(b, scale3(sub3(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)))), Feature::E12);
   const double denom = va + vb + vc;
-  if (!(std::abs(denom) > kTinyDivisor)) return at(a, Feature::V0);  // a degenerate triangle
+  if (!(std::abs(denom) > kTinyDivisor)) {
+    // A degenerate triangle: the nearest of its corners.
+    const Nearest na = at(a, Feature::V0), nb = at(b, Feature::V1), nc = at(c, Feature::V2);
+    return na.distance <= nb.distance ? (na.distance <= nc.distance ? na : nc) : (nb.distance <= nc.distance ? nb : nc);
+  }
   const double v = vb / denom, w = vc / denom;
   return at(add3(a, add3(scale3(ab, v), scale3(ac, w))), Feature::Face);
 }
@@ -115,7 +121,7 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
     best = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
     best.triangle = *hint;
     // A hair more: the search must still find the hint's own triangle when it is the answer.
-    best2 = best.distance * best.distance * (1 + 1e-12) + kTinyDivisor;
+    if (std::isfinite(best.distance)) best2 = best.distance * best.distance * (1 + 1e-12) + kTinyDivisor;
   }
   search(p, best2, [&](uint32_t i) {
     double box2 = 0;

@@ -56,7 +56,10 @@ void check_corner_signs(const Octree& t, const std::vector<std::pair<uint32_t, C
       while (up > 0 && !contains(path[up].second, q)) --up;
       uint32_t n = path[up].first;
       Cell at = path[up].second;
+      // The neighbour's subtree may not be walked yet: its children are checked on the way down.
       while (t.nodes[n].kind == CellKind::Internal) {
+        if (at.level >= kMaxLevel || size_t(t.nodes[n].index) + 8 > t.nodes.size())
+          broken(phase, "bad children at " + where(at));
         const int k = at.child_toward(q);
         n = t.nodes[n].index + k;
         at = at.child(k);
