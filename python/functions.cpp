@@ -301,7 +301,7 @@ The result's stats['steps'] hold each Boolean's statistics.)doc");
       },
       py::arg("solids"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8, py::arg("parallel") = true,
       R"doc(The union of PIC objects and meshes (pic::evaluate of a CsgTree): combined in a balanced
-order, halves in parallel, no result copied per step; three combine as (a | b) | c. Meshes are
+order, halves in parallel, no result copied per step; three combine as a | (b | c). Meshes are
 sampled into one cube around them all at `depth`.)doc");
   m.def(
       "intersection",

@@ -608,14 +608,22 @@ TEST(Csg, LeavesItsOperandsUntouched) {
   EXPECT_TRUE(serialize(b) == bytes_b);
 }
 
-TEST(CsgTree, UnionOfThreeIsTheLeftToRightUnion) {
+TEST(CsgTree, UnionOfThreeIsTheFirstWithTheOthers) {
   const int depth = 8;
   const Octree a = sample_in_unit(make_sphere({0.4, 0.5, 0.5}, 0.2, 48), depth);
   const Octree b = sample_in_unit(make_box({0.45, 0.3, 0.3}, {0.8, 0.7, 0.6}), depth);
   const Octree c = sample_in_unit(make_cylinder({0.55, 0.5, 0.5}, 0.1, 0.8, 0, 48), depth);
-  const Octree chained = csg(csg(a, b, CsgOp::Union), c, CsgOp::Union);
+  // The balanced order puts floor(n/2) children first, as pic eval does: a | (b | c).
+  const Octree nested = csg(a, csg(b, c, CsgOp::Union), CsgOp::Union);
   const Octree tree = evaluate(csg_union({csg_leaf(a), csg_leaf(b), csg_leaf(c)}));
-  EXPECT_EQ(serialize(tree), serialize(chained));
+  EXPECT_EQ(serialize(tree), serialize(nested));
+  // Two children are the chain's one step; an empty child is skipped by a union and empties
+  // an intersection.
+  EXPECT_EQ(serialize(evaluate(csg_union({csg_leaf(a), csg_leaf(b)}))), serialize(csg(a, b, CsgOp::Union)));
+  EXPECT_EQ(serialize(evaluate(csg_union({csg_leaf(a), csg_empty(), csg_leaf(b)}))),
+            serialize(csg(a, b, CsgOp::Union)));
+  EXPECT_TRUE(evaluate(csg_intersection({csg_leaf(a), csg_empty()})).vertices.empty());
+  EXPECT_EQ(serialize(evaluate(csg_difference(csg_leaf(a), {csg_empty()}))), serialize(a));
   // A difference takes the union of the rest; an intersection of two is their Boolean.
   const Octree diff = evaluate(csg_difference(csg_leaf(b), {csg_leaf(a), csg_leaf(c)}));
   EXPECT_EQ(serialize(diff), serialize(csg(b, csg(a, c, CsgOp::Union), CsgOp::Subtract)));

@@ -225,6 +225,36 @@ TEST(Eval, UnsupportedNodeNamesNodeAndLine) {
   }
 }
 
+// pic eval runs the library's CSG tree: an n-ary union of parts that all meet is the same
+// balanced union, byte for byte, as evaluate() of the same meshes in the same cube.
+TEST(Eval, UnionIsTheLibrarysTreeByteForByte) {
+  const test::TempDir dir;
+  std::string text = "union() {\n";
+  std::vector<CsgTree> leaves;
+  for (int i = 0; i < 5; ++i) {
+    const double a = 2 * std::numbers::pi * i / 5;
+    const TriMesh ball = make_sphere({0.3 * std::cos(a), 0.3 * std::sin(a), 0.1 * i}, 0.5, 24);
+    const std::string name = "ball" + std::to_string(i) + ".obj";
+    write_mesh(ball, dir / name);
+    leaves.push_back(csg_leaf(read_mesh(dir / name)));
+    text += " import(file = \"" + name + "\");\n";
+  }
+  text += "}\n";
+  EvalOptions o;
+  o.depth = 7;
+  o.base_dir = dir.path();
+  EvalStats st;
+  const Octree via_eval = eval_csg(text, o, &st);
+  EXPECT_EQ(st.booleans, 4u);
+  CsgChainOptions co;
+  co.sampling.depth = o.depth;
+  co.sampling.cube = st.cube;
+  co.compact = false;
+  const Octree via_tree = evaluate(csg_union(std::move(leaves)), co);
+  EXPECT_EQ(serialize(via_eval), serialize(via_tree));
+  EXPECT_TRUE(IsClosedManifold(unsplit_contour(via_tree)));
+}
+
 // OpenSCAD warns about an import() of a file that does not exist and renders the rest; so
 // does pic eval (a file that exists but is broken is still an error).
 TEST(Eval, MissingImportIsLeftOutWithAWarning) {

@@ -66,6 +66,10 @@ struct CsgChainOptions {
   std::function<void(const std::string&)> progress;  ///< optional: "sampling x", "union y"
   /// Optional: called after each Boolean with its operand's index and statistics.
   std::function<void(size_t, const CsgStats&)> on_step;
+  /// Drop the nodes no leaf reaches from the result (smaller, and laid out as a loaded file).
+  bool compact = true;
+  /// Optional: called after each mesh leaf is sampled (from the thread that sampled it).
+  std::function<void()> on_leaf;
 };
 /// operands[0] ops[0] operands[1] ops[1] operands[2] ..., left to right: evaluate() of the
 /// left-deep tree ((a op b) op c) ..., each step's statistics to on_step in order. Mesh
@@ -80,7 +84,7 @@ Octree csg_chain(std::vector<CsgOperand> operands, const std::vector<CsgOp>& ops
 /// intersection, or a difference (its first child minus the union of the others). Build it
 /// with csg_leaf, csg_union, csg_intersection and csg_difference.
 struct CsgTree {
-  enum class Kind { Octree, Mesh, Union, Intersection, Difference };
+  enum class Kind { Empty, Octree, Mesh, Union, Intersection, Difference };
   Kind kind = Kind::Union;
   std::shared_ptr<const Octree> tree;   ///< Kind::Octree
   std::shared_ptr<const TriMesh> mesh;  ///< Kind::Mesh
@@ -90,6 +94,7 @@ struct CsgTree {
 CsgTree csg_leaf(Octree tree);
 CsgTree csg_leaf(std::shared_ptr<const Octree> tree);
 CsgTree csg_leaf(TriMesh mesh);
+CsgTree csg_empty();  ///< no solid: a union skips it, an intersection with it is empty
 CsgTree csg_union(std::vector<CsgTree> children);
 CsgTree csg_intersection(std::vector<CsgTree> children);
 CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away);
@@ -99,7 +104,7 @@ CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away);
 /// does. An n-ary union or intersection combines its children in a balanced order — the first
 /// half with the second, each half the same way, halves evaluated in parallel (with
 /// options.csg.parallel) — and no step copies a result: each Boolean is written into its left
-/// operand. Three children combine as (a op b) op c. An empty union is the empty solid.
+/// operand. Three children combine as a op (b op c). An empty union is the empty solid.
 /// options.on_step gets each Boolean's statistics with its number in the order they finish
 /// (the chain's order for a left-deep tree).
 /// 	hrows InvalidInput as sample() and csg() do, or for a difference without children.

@@ -129,7 +129,7 @@ def bounding_cube(vertices: ArrayLike, margin: float = 1 / 16) -> Cube:
 
 def union(solids: Iterable[Any], *, depth: int = 12, error: float = 1e-8, parallel: bool = True) -> Octree:
     """The union of PIC objects and meshes, combined in a balanced order (halves in parallel);
-    three combine as (a | b) | c."""
+    three combine as a | (b | c)."""
     ...
 
 def intersection(solids: Iterable[Any], *, depth: int = 12, error: float = 1e-8, parallel: bool = True) -> Octree:

@@ -5,6 +5,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <mutex>
+#include <optional>
 
 namespace pic {
 
@@ -19,6 +20,11 @@ CsgTree csg_leaf(TriMesh mesh) {
   CsgTree t;
   t.kind = CsgTree::Kind::Mesh;
   t.mesh = std::make_shared<const TriMesh>(std::move(mesh));
+  return t;
+}
+CsgTree csg_empty() {
+  CsgTree t;
+  t.kind = CsgTree::Kind::Empty;
   return t;
 }
 CsgTree csg_union(std::vector<CsgTree> children) {
@@ -61,33 +67,31 @@ class TreeEvaluator {
   TreeEvaluator(const CsgChainOptions& options, const SampleOptions& sampling, const Octree* empty_like)
       : options_(options), sampling_(sampling), empty_like_(empty_like) {}
 
-  Octree eval(const CsgTree& t) {
+  /// The solid of `t`, or nothing for an empty one.
+  std::optional<Octree> eval(const CsgTree& t) {
     switch (t.kind) {
+      case CsgTree::Kind::Empty: return std::nullopt;
       case CsgTree::Kind::Octree: return *t.tree;
       case CsgTree::Kind::Mesh: {
         if (!t.name.empty()) say("sampling " + t.name);
-        return sample(*t.mesh, sampling_);
+        Octree o = sample(*t.mesh, sampling_);
+        if (options_.on_leaf) options_.on_leaf();
+        return o;
       }
       case CsgTree::Kind::Union: return balanced(t.children, 0, t.children.size(), CsgOp::Union);
       case CsgTree::Kind::Intersection: return balanced(t.children, 0, t.children.size(), CsgOp::Intersect);
       case CsgTree::Kind::Difference: {
         if (t.children.empty()) throw InvalidInput("a difference needs the solid to take from");
         if (t.children.size() == 1) return eval(t.children[0]);
-        Octree a, b;
+        std::optional<Octree> a, b;
         both([&] { a = eval(t.children[0]); }, [&] { b = balanced(t.children, 1, t.children.size(), CsgOp::Union); });
-        boolean(a, b, CsgOp::Subtract, t.children.size() == 2 ? t.children[1].name : std::string());
+        if (!a || !b) return a;
+        boolean(*a, *b, CsgOp::Subtract, t.children.size() == 2 ? t.children[1].name : std::string());
         return a;
       }
     }
-    return empty();
+    return std::nullopt;
   }
-
- private:
-  const CsgChainOptions& options_;
-  SampleOptions sampling_;
-  const Octree* empty_like_;
-  std::mutex step_mutex_;  // on_step and progress are called one at a time
-  uint32_t steps_ = 0;     // Booleans finished so far (under step_mutex_)
 
   /// The empty solid in the tree's cube.
   Octree empty() const {
@@ -97,19 +101,31 @@ class TreeEvaluator {
     t.max_depth = empty_like_ ? empty_like_->max_depth : sampling_.depth;
     return t;
   }
+
+ private:
+  const CsgChainOptions& options_;
+  SampleOptions sampling_;
+  const Octree* empty_like_;
+  std::mutex step_mutex_;  // on_step and progress are called one at a time
+  uint32_t steps_ = 0;     // Booleans finished so far (under step_mutex_)
+
   template <class A, class B>
   void both(const A& a, const B& b) {
     if (options_.csg.parallel) tbb::parallel_invoke(a, b);
     else a(), b();
   }
-  /// kids[b, e) combined: the first ceil(n/2) with the rest, each half the same way.
-  Octree balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) {
-    if (b >= e) return empty();
+  /// kids[b, e) combined: the first floor(n/2) with the rest, each half the same way. An empty
+  /// part leaves a union as the other part and makes an intersection empty.
+  std::optional<Octree> balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) {
+    if (b >= e) return std::nullopt;
     if (e - b == 1) return eval(kids[b]);
-    const size_t mid = b + (e - b + 1) / 2;
-    Octree x, y;
+    const size_t mid = b + (e - b) / 2;
+    std::optional<Octree> x, y;
     both([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
-    boolean(x, y, op, e - mid == 1 ? kids[mid].name : std::string());
+    if (op == CsgOp::Intersect && (!x || !y)) return std::nullopt;
+    if (!x) return y;
+    if (!y) return x;
+    boolean(*x, *y, op, e - mid == 1 ? kids[mid].name : std::string());
     return x;
   }
   /// x := x op y, reported (`name`: y's, when it is a named leaf).
@@ -139,9 +155,11 @@ Octree evaluate(const CsgTree& tree, const CsgChainOptions& options) {
     if (!all.positions.empty()) sampling.cube = bounding_cube(all, sampling.margin);
   }
   TreeEvaluator ev(options, sampling, first_octree(tree));
-  Octree r = ev.eval(tree);
-  if (r.nodes.size() > detail::reachable_nodes(r)) detail::compact(r);
-  return r;
+  std::optional<Octree> result = ev.eval(tree);
+  if (!result) return ev.empty();
+  Octree& r = *result;
+  if (options.compact && r.nodes.size() > detail::reachable_nodes(r)) detail::compact(r);
+  return std::move(r);
 }
 
 }  // namespace pic

@@ -120,100 +120,112 @@ bool leaves_apart(const LeafExtent& a, const LeafExtent& b) {
   return false;
 }
 
-class Evaluator {
+/// Reports progress at most once a second: leaves sampled and Booleans done.
+class Progress {
  public:
-  Evaluator(const EvalOptions& o, const Cube& cube, size_t leaves) : opt_(o), cube_(cube), total_(leaves) {
-    t0_ = Clock::now();
-    last_ = t0_;
-  }
+  Progress(const EvalOptions& o, size_t leaves) : opt_(o), total_(leaves), t0_(Clock::now()), last_(t0_) {}
   std::atomic<size_t> booleans{0};
+  std::atomic<size_t> leaves_done{0};
+  void report() {
+    if (!opt_.progress) return;
+    std::lock_guard lock(mu_);
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < 1.0) return;
+    last_ = now;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%zu/%zu leaves sampled, %zu Booleans, %.1f s", leaves_done.load(), total_,
+                  booleans.load(), since(t0_));
+    opt_.progress(buf);
+  }
 
-  std::optional<Octree> eval(const Solid& s) {
+ private:
+  const EvalOptions& opt_;
+  size_t total_;
+  Clock::time_point t0_, last_;
+  std::mutex mu_;
+};
+
+/// The lowered model as the library's CSG tree, with the rules that belong to OpenSCAD
+/// models: a leaf thinner than a finest cell is empty, leaves of a union that are apart are
+/// sampled together, and a hull is the hull of its leaves' vertices (or of its subtree's
+/// contour). Everything else -- balanced n-ary Booleans, halves in parallel -- is evaluate()'s.
+class TreeBuilder {
+ public:
+  TreeBuilder(const EvalOptions& o, const Cube& cube, Progress& progress)
+      : opt_(o), cube_(cube), progress_(progress) {}
+
+  CsgTree build(const Solid& s) {
     switch (s.kind) {
-      case Solid::Kind::Empty: return std::nullopt;
-      case Solid::Kind::Mesh: {
-        // A leaf thinner than a finest cell (a sliver ring of a 2D Boolean, extruded) holds no
-        // solid at this depth: it is empty here, where a mesh given to `pic sample` is an error.
-        std::optional<Octree> t;
-        if (detail::plane_spread(s.mesh) >= cube_.size / double(int64_t{1} << opt_.depth)) t = sample_leaf(s.mesh);
-        ++done_;
-        report();
-        return t;
-      }
-      case Solid::Kind::Union: return united(s.children, 0, s.children.size());
-      case Solid::Kind::Intersect: return balanced(s.children, 0, s.children.size(), CsgOp::Intersect);
-      case Solid::Kind::Difference: {
-        std::optional<Octree> a, b;
-        invoke([&] { a = eval(s.children[0]); },
-               [&] { b = united(s.children, 1, s.children.size()); });
-        if (!a || !b) return a;
-        return boolean(std::move(*a), *b, CsgOp::Subtract);
-      }
-      case Solid::Kind::Hull: {
-        std::vector<Vec3> pts;
-        bool direct = true;
-        for (const Solid& c : s.children) direct = direct && hull_points(c, pts);
-        if (!direct) {
-          // A difference or intersection below the hull: take the vertices of its contour
-          // (within a finest cell of the exact result).
-          pts.clear();
-          auto u = balanced(s.children, 0, s.children.size(), CsgOp::Union);
-          if (!u) return std::nullopt;
-          pts = unsplit_contour(*u).positions;
-        }
-        TriMesh h = detail::scad::convex_hull(pts);
-        if (h.triangles.empty()) return std::nullopt;
-        return sample_leaf(h);
-      }
+      case Solid::Kind::Empty: return csg_empty();
+      case Solid::Kind::Mesh: return leaf(s.mesh);
+      case Solid::Kind::Union: return csg_union(united(s.children, 0, s.children.size()));
+      case Solid::Kind::Intersect: return csg_intersection(each(s.children, 0, s.children.size()));
+      case Solid::Kind::Difference:
+        return csg_difference(build(s.children[0]), united(s.children, 1, s.children.size()));
+      case Solid::Kind::Hull: return hull(s.children);
     }
-    return std::nullopt;
+    return csg_empty();
+  }
+
+  CsgChainOptions chain_options() const {
+    CsgChainOptions co;
+    co.sampling.depth = opt_.depth;
+    co.sampling.error = opt_.error;
+    co.sampling.cube = cube_;
+    co.sampling.parallel = opt_.parallel;
+    co.csg.error = opt_.error;
+    co.csg.parallel = opt_.parallel;
+    co.compact = false;  // the Booleans compact where it pays; the contour follows the node order
+    co.on_leaf = [p = &progress_] { ++p->leaves_done, p->report(); };
+    co.on_step = [p = &progress_](size_t, const CsgStats&) { ++p->booleans, p->report(); };
+    return co;
   }
 
  private:
   const EvalOptions& opt_;
   Cube cube_;
-  size_t total_;
-  std::atomic<size_t> done_{0};
-  Clock::time_point t0_, last_;
-  std::mutex mu_;
+  Progress& progress_;
 
-  template <class A, class B>
-  void invoke(const A& a, const B& b) {
-    if (opt_.parallel) tbb::parallel_invoke(a, b);
-    else a(), b();
+  /// A leaf thinner than a finest cell (a sliver ring of a 2D Boolean, extruded) holds no
+  /// solid at this depth: it is empty here, where a mesh given to `pic sample` is an error.
+  CsgTree leaf(const TriMesh& m) {
+    if (detail::plane_spread(m) >= cube_.size / double(int64_t{1} << opt_.depth)) return csg_leaf(m);
+    ++progress_.leaves_done;
+    return csg_empty();
   }
-  Octree sample_leaf(const TriMesh& m) {
-    SampleOptions so;
-    so.depth = opt_.depth;
-    so.error = opt_.error;
-    so.cube = cube_;
-    so.parallel = opt_.parallel;
-    return sample(m, so);
+  std::vector<CsgTree> each(const std::vector<Solid>& kids, size_t b, size_t e) {
+    std::vector<CsgTree> out;
+    for (size_t i = b; i < e; ++i) out.push_back(build(kids[i]));
+    return out;
   }
-  Octree boolean(Octree a, const Octree& b, CsgOp op) {
-    CsgOptions co;
-    co.error = opt_.error;
-    co.parallel = opt_.parallel;
-    csg_inplace(a, b, op, co);
-    ++booleans;
-    report();
-    return a;
+  CsgTree hull(const std::vector<Solid>& kids) {
+    std::vector<Vec3> pts;
+    bool direct = true;
+    for (const Solid& c : kids) direct = direct && hull_points(c, pts);
+    if (!direct) {
+      // A difference or intersection below the hull: take the vertices of its contour
+      // (within a finest cell of the exact result).
+      const Octree u = evaluate(csg_union(each(kids, 0, kids.size())), chain_options());
+      pts = unsplit_contour(u).positions;
+    }
+    TriMesh h = detail::scad::convex_hull(pts);
+    if (h.triangles.empty()) return csg_empty();
+    return leaf(h);
   }
-  /// The union of kids[b, e). Where they are all mesh leaves (or unions of them), the leaves
-  /// whose boxes are apart are sampled together: a soup of closed meshes that do not meet is
-  /// the union's surface as it is, so one sampling pass replaces a sampling per leaf and a
+  /// The parts whose union is kids[b, e). Where they are all mesh leaves (or unions of them),
+  /// the leaves that are apart are sampled together: a soup of closed meshes that do not meet
+  /// is the union's surface as it is, so one sampling pass replaces a sampling per leaf and a
   /// Boolean per pair (the holes of a die, the teeth of a gear). Leaves that meet are still
   /// combined by Booleans: sampled as one soup, the parts of their triangles inside another
   /// leaf pull the cells' vertices off the surface and refine them to the finest level (the
   /// Menger sponge's bars took 1.3x longer that way).
-  std::optional<Octree> united(const std::vector<Solid>& kids, size_t b, size_t e) {
-    const auto pairwise = [&] { return balanced(kids, b, e, CsgOp::Union); };
+  std::vector<CsgTree> united(const std::vector<Solid>& kids, size_t b, size_t e) {
     std::vector<const TriMesh*> leaves;
     for (size_t i = b; i < e; ++i)
-      if (!union_leaves(kids[i], leaves)) return pairwise();
+      if (!union_leaves(kids[i], leaves)) return each(kids, b, e);
     std::vector<LeafExtent> extents;
     for (const TriMesh* m : leaves) {
-      if (m->triangles.empty() || !(volume(*m) > 0)) return pairwise();
+      if (m->triangles.empty() || !(volume(*m) > 0)) return each(kids, b, e);
       extents.push_back(extent_of(*m));
     }
     // Greedily: each leaf joins the first group whose every leaf is apart from it.
@@ -226,40 +238,29 @@ class Evaluator {
       if (g == groups.end()) groups.push_back({i});
       else g->push_back(i);
     }
-    if (groups.size() == leaves.size()) return pairwise();
-    std::vector<Solid> parts(groups.size());
-    for (size_t g = 0; g < groups.size(); ++g) {
-      parts[g].kind = Solid::Kind::Mesh;
-      for (size_t i : groups[g]) append_mesh(parts[g].mesh, *leaves[i]);
+    if (groups.size() == leaves.size()) return each(kids, b, e);
+    std::vector<CsgTree> parts;
+    for (const auto& group : groups) {
+      TriMesh m;
+      for (size_t i : group) append_mesh(m, *leaves[i]);
+      parts.push_back(leaf(m));
     }
     // The groups count as one leaf each from here: progress counts the others as done.
-    done_ += leaves.size() - groups.size();
-    return balanced(parts, 0, parts.size(), CsgOp::Union);
-  }
-  // n-ary union/intersection in a balanced order: halves evaluated in parallel, then combined.
-  std::optional<Octree> balanced(const std::vector<Solid>& kids, size_t b, size_t e, CsgOp op) {
-    if (b >= e) return std::nullopt;
-    if (e - b == 1) return eval(kids[b]);
-    const size_t mid = b + (e - b) / 2;
-    std::optional<Octree> x, y;
-    invoke([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
-    if (op == CsgOp::Intersect && (!x || !y)) return std::nullopt;
-    if (!x) return y;
-    if (!y) return x;
-    return boolean(std::move(*x), *y, op);
-  }
-  void report() {
-    if (!opt_.progress) return;
-    std::lock_guard lock(mu_);
-    const auto now = Clock::now();
-    if (std::chrono::duration<double>(now - last_).count() < 1.0) return;
-    last_ = now;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%zu/%zu leaves sampled, %zu Booleans, %.1f s", done_.load(), total_,
-                  booleans.load(), since(t0_));
-    opt_.progress(buf);
+    progress_.leaves_done += leaves.size() - groups.size();
+    return parts;
   }
 };
+
+std::optional<Octree> evaluate_model(const Solid& model, const EvalOptions& options, const Cube& cube,
+                                     size_t leaves, size_t* booleans) {
+  Progress progress(options, leaves);
+  TreeBuilder builder(options, cube, progress);
+  const CsgTree tree = builder.build(model);
+  Octree out = evaluate(tree, builder.chain_options());
+  if (booleans) *booleans = progress.booleans.load();
+  if (out.vertices.empty()) return std::nullopt;
+  return out;
+}
 
 }  // namespace
 
@@ -284,9 +285,8 @@ TriMesh solid_surface(const Solid& s, const EvalOptions& options) {
   corners.positions = {lo, hi};
   EvalOptions o = options;
   o.progress = nullptr;
-  Evaluator ev(o, bounding_cube(corners), leaves);
-  const std::optional<Octree> t = ev.eval(s);
-  if (!t || t->vertices.empty()) return {};
+  const std::optional<Octree> t = evaluate_model(s, o, bounding_cube(corners), leaves, nullptr);
+  if (!t) return {};
   return contour(*t);
 }
 }  // namespace detail::scad
@@ -337,12 +337,10 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
     options.progress("sampling " + std::to_string(st.leaves) + " leaves (" + std::to_string(st.triangles) +
                      " triangles) at depth " + std::to_string(options.depth));
   const auto t1 = Clock::now();
-  Evaluator ev(options, st.cube, st.leaves);
-  std::optional<Octree> out = ev.eval(model);
+  std::optional<Octree> out = evaluate_model(model, options, st.cube, st.leaves, &st.booleans);
   st.octree_seconds = since(t1);
-  st.booleans = ev.booleans.load();
   st.seconds = since(t0);
-  if (!out || out->vertices.empty()) throw InvalidInput(source + ": the model is empty");
+  if (!out) throw InvalidInput(source + ": the model is empty");
   if (stats) *stats = st;
   return std::move(*out);
 }
