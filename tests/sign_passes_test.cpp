@@ -2,6 +2,7 @@
 // changes, and what it must leave alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <map>
 
@@ -9,6 +10,9 @@
 #include "pic/pic.h"
 #include "signs/consistency.h"
 #include "signs/refine.h"
+#include "signs/settle.h"
+
+#include <random>
 
 namespace pic {
 namespace {
@@ -242,6 +246,51 @@ TEST(RefinePass, SplitsTheCoarseLeavesAroundAPointDownToTheFinestLevel) {
   }
   EXPECT_GT(grown, 8u);
   EXPECT_EQ(detail::point_sign(t, mid), std::optional<bool>(true));
+}
+
+// ---- the settling loop: a guarantee where leaves cannot refine ----
+
+/// A random tree: cells split with probability `split` per level, so capped leaves sit
+/// beside leaves of every coarser level; every lattice point's sign is a coin toss (outside on the root cube's faces), and each
+/// gray leaf's vertex a random point inside its cell.
+Octree random_tree(uint64_t seed, int depth, double split) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::map<Lat, bool> coin;
+  Octree t = build(depth, [&](const Cell& c) { return c.level == 0 || u(rng) < split; }, [&](const Lat& p) {
+    const int64_t end = int64_t{1} << kMaxLevel;  // the root cube's faces are outside, as sampled
+    if (std::any_of(p.begin(), p.end(), [&](int64_t x) { return x == 0 || x == end; })) return false;
+    const auto [it, fresh] = coin.try_emplace(p, false);
+    if (fresh) it->second = u(rng) < 0.5;
+    return it->second;
+  });
+  detail::visit_leaves(t, 0, Cell{}, [&](uint32_t n, const Cell& c) {
+    if (t.nodes[n].kind != CellKind::Gray) return;
+    const Vec3 lo = c.min_unit();
+    auto& v = t.vertices[t.nodes[n].index];
+    for (int k = 0; k < 3; ++k) v[k] = float(lo[k] + c.size() * (0.1 + 0.8 * u(rng)));
+  });
+  return t;
+}
+
+TEST(Settle, RandomSignsAtEveryLevelContourValid) {
+  // Depth 4 and 5, every corner-sign pattern and neighbour level in some tree.
+  size_t invalid_unsettled = 0, trees = 0;
+  for (uint64_t seed = 1; seed <= 60; ++seed) {
+    Octree t = seed <= 40 ? random_tree(seed, 4, 0.6) : random_tree(seed, 5, 0.45);
+    invalid_unsettled += !check_validity(contour(t)).valid();
+    detail::settle_sampled(t, {});
+    const TriMesh m = contour(t);
+    if (m.triangles.empty()) continue;
+    ++trees;
+    const MeshValidity v = check_validity(m);
+    EXPECT_TRUE(v.valid()) << "tree " << seed << ": " << v.boundary_edges << " boundary edges, " << v.nonmanifold_edges
+                           << " non-manifold edges, " << v.nonmanifold_vertices << " non-manifold vertices, "
+                           << v.self_intersections << " self-intersections";
+    EXPECT_EQ(multi_component_leaves(t), 0u) << "tree " << seed;
+  }
+  EXPECT_GT(trees, 40u);
+  EXPECT_GT(invalid_unsettled, 30u);  // without the settling these trees do not contour valid
 }
 
 }  // namespace

@@ -82,4 +82,31 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
   return fix;
 }
 
+size_t erode_to_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
+                              const std::function<void(uint32_t)>* touched) {
+  size_t flipped = 0;
+  for (;;) {
+    std::vector<LeafRef> bad;
+    for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
+      if (multi_component(t.nodes[node].signs)) bad.push_back({node, cell});
+    });
+    if (bad.empty()) return flipped;
+    for (const LeafRef& l : bad) {
+      const uint8_t s = t.nodes[l.node].signs;
+      if (!multi_component(s)) continue;
+      // Of the inside corners, the one whose removal leaves the fewest two-component leaves.
+      int best = -1, best_cost = 1 << 30;
+      for (int k = 0; k < 8; ++k) {
+        if (!((s >> k) & 1)) continue;
+        int cost = 0;
+        for (const auto& a : leaves_around(t, l.cell.corner(k)))
+          cost += multi_component(with_corner(signs_of(t.nodes[a.node]), a.corner, false));
+        if (cost < best_cost) best_cost = cost, best = k;
+      }
+      set_point_sign(t, l.cell.corner(best), false, touched);
+      ++flipped;
+    }
+  }
+}
+
 }  // namespace pic::detail
