@@ -241,8 +241,10 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     const std::function<void(const Lat&)> refine = [&](const Lat& p) {
       refine_around(tree, p, from_input, [](uint32_t) {});
     };
-    if (capped > 0 && enforce_one_component(tree, nullptr, nullptr, nullptr, false, &refine).flipped > 0)
-      repair_cracks(tree, nullptr);
+    if (capped > 0) {
+      const size_t flipped = enforce_one_component(tree, nullptr, nullptr, nullptr, false, &refine).flipped;
+      if (flipped + erode_until_valid(tree, nullptr, nullptr, nullptr) > 0) repair_cracks(tree, nullptr);
+    }
   } else {
     tree = sample_winding(clean, grid, options, cube, st, capped);
   }

@@ -20,13 +20,22 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
                                                   plan.refine ? &plan.refine : nullptr);
     if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
   }
-  // The guarantee: both erosions only take points out, so together they end, and they end
-  // only where every leaf has one component and every coarse leaf a simple boundary.
-  while (erode_to_one_component(t, component_scope, &touched) + erode_to_simple_boundaries(t, plan.active, &touched) > 0) {
-  }
+  erode_until_valid(t, component_scope, plan.active, &touched);
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
   remove_specks(t, plan.active, plan.keep_speck ? plan.keep_speck : keep_none, plan.specks);
   return repair_cracks(t, plan.active);
+}
+
+size_t erode_until_valid(Octree& t, const std::function<bool(uint32_t)>* components,
+                         const std::function<bool(uint32_t)>* boundaries, const std::function<void(uint32_t)>* touched) {
+  // Both erosions only take points out, so together they end, and they end only where every
+  // leaf has one component and every coarse leaf a simple boundary.
+  size_t total = 0;
+  for (;;) {
+    const size_t flipped = erode_to_one_component(t, components, touched) + erode_to_simple_boundaries(t, boundaries, touched);
+    if (flipped == 0) return total;
+    total += flipped;
+  }
 }
 
 namespace {

@@ -33,6 +33,12 @@ struct SettlePlan {
 /// Returns how many leaves repair_cracks changed.
 size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned);
 
+/// The settling's last step and its guarantee: erode_to_one_component and
+/// erode_to_simple_boundaries in turn until neither flips a point (`components` and
+/// `boundaries`: the leaves each looks at, all when null). Returns how many points changed.
+size_t erode_until_valid(Octree& t, const std::function<bool(uint32_t)>* components,
+                         const std::function<bool(uint32_t)>* boundaries, const std::function<void(uint32_t)>* touched);
+
 /// Where a tree's signs may disagree between levels (islands, cracks): everywhere, or only
 /// within these unit-space boxes.
 struct SettleRegion {
