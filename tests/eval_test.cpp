@@ -255,6 +255,25 @@ TEST(Eval, UnionIsTheLibrarysTreeByteForByte) {
   EXPECT_TRUE(IsClosedManifold(unsplit_contour(via_tree)));
 }
 
+// minkowski() of a non-convex part and a faceted sphere: one distance sampling (not a hull
+// per convex piece), its volume within 0.5 % of OpenSCAD's exact polyhedral sum.
+TEST(Eval, MinkowskiWithASphereIsOneSampling) {
+  const std::string text =
+      "minkowski() {\n difference() {\n  cube(size = [20, 14, 8]);\n"
+      "  multmatrix([[1, 0, 0, 6], [0, 1, 0, -1], [0, 0, 1, 4], [0, 0, 0, 1]]) cube(size = [20, 16, 10]);\n"
+      "  multmatrix([[1, 0, 0, 3], [0, 1, 0, 7], [0, 0, 1, -1], [0, 0, 0, 1]]) cylinder(h = 10, r1 = 2, r2 = 2, $fn = 24);\n"
+      " }\n sphere(r = 1.5, $fn = 24);\n}\n";
+  EvalOptions o;
+  o.depth = 8;
+  EvalStats st;
+  const TriMesh m = unsplit_contour(eval_csg(text, o, &st));
+  EXPECT_EQ(st.leaves, 1u);
+  EXPECT_EQ(st.booleans, 0u);
+  EXPECT_TRUE(IsClosedManifold(m));
+  const double openscad = 3216.31;  // `openscad -o x.stl` of the same model, its volume by meshcheck
+  EXPECT_NEAR(volume(m), openscad, 5e-3 * openscad);
+}
+
 // OpenSCAD warns about an import() of a file that does not exist and renders the rest; so
 // does pic eval (a file that exists but is broken is still an error).
 TEST(Eval, MissingImportIsLeftOutWithAWarning) {

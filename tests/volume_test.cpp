@@ -103,6 +103,56 @@ TEST(Offset, LPrismGrownKeepsItsConcaveEdgeSharp) {
   EXPECT_LE(best, 1e-6);
 }
 
+TEST(Minkowski, CubePlusAFacetedSphereHasFlatFacesAtTheSupport) {
+  const TriMesh ball = make_sphere({0.3, -0.2, 0.1}, 0.1, 64);  // centred off the origin
+  ASSERT_TRUE(is_round_body(ball.positions));
+  EXPECT_FALSE(is_round_body(make_box({0, 0, 0}, {1, 1, 1}).positions));
+  EXPECT_FALSE(is_round_body(make_sphere({0, 0, 0}, 1, 6).positions));  // facets too deep
+  const Octree t = minkowski_round(make_box({0, 0, 0}, {1, 1, 1}), ball.positions, at_depth(9));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  // Faces move out by the ball's support along their normals (its extent from its centre),
+  // and the whole sum by the centre.
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = 1e300, hi[k] = -1e300;
+  for (const Vec3& p : ball.positions)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const Vec3 c{0.3, -0.2, 0.1};
+  size_t flat = 0;
+  const double c2 = 2 * finest_cell(t);
+  for (const Vec3& p : m.positions) {
+    int inside = 0;
+    for (int k = 0; k < 3; ++k) inside += p[k] - c[k] > c2 && p[k] - c[k] < 1 - c2;
+    if (inside != 2) continue;
+    ++flat;
+    for (int k = 0; k < 3; ++k) {
+      if (p[k] - c[k] <= c2) EXPECT_NEAR(p[k], lo[k], 1e-6);
+      if (p[k] - c[k] >= 1 - c2) EXPECT_NEAR(p[k], 1 + hi[k], 1e-6);
+    }
+  }
+  EXPECT_GT(flat, 0u);
+  // Volume: the box grown by a ball of about the same radius (facets 0.1 % deep).
+  const double exact = grown_box_volume(1, 1, 1, 0.1);
+  EXPECT_NEAR(volume(m), exact, 3e-3 * exact);
+}
+
+TEST(Minkowski, LPrismPlusASphereKeepsItsConcaveEdgeSharp) {
+  SampleOptions o = at_depth(8);
+  o.cube = Cube{{-0.5, -0.5, -0.5}, 3};
+  const TriMesh l = contour(csg(sample(make_box({0, 0, 0}, {2, 1, 1}), o),
+                                sample(make_box({0, 0.5, 0}, {1, 2, 1}), o), CsgOp::Union));
+  const TriMesh ball = make_sphere({0, 0, 0}, 0.2, 64);
+  const TriMesh m = contour(minkowski_round(l, ball.positions, at_depth(9)));
+  expect_valid(m);
+  // The crease at x = y = 1 + (the ball's extent along x and y).
+  double ext = 0;
+  for (const Vec3& p : ball.positions) ext = std::max(ext, p[0]);
+  double best = 1e300;
+  for (const Vec3& p : m.positions)
+    if (p[2] > 0.2 && p[2] < 0.8) best = std::min(best, std::hypot(p[0] - (1 + ext), p[1] - (1 + ext)));
+  EXPECT_LE(best, 1e-6);
+}
+
 TEST(Offset, SphereRadiusMovesByTheDistance) {
   const TriMesh ball = make_sphere({0.3, -0.2, 0.1}, 1.0, 96);
   for (const double d : {0.15, -0.15}) {

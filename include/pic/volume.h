@@ -20,6 +20,20 @@ Octree offset(const TriMesh& solid, double distance, const SampleOptions& option
 Octree offset(const Octree& solid, double distance, const SampleOptions& options = {},
               SampleStats* stats = nullptr);
 
+/// The Minkowski sum of a solid with a round convex body given by its vertices (a faceted
+/// sphere: every vertex within 2 % of one radius from their centroid c): the
+/// points whose distance to the solid, seen along the direction u from the nearest point, is
+/// below the body's support h(u) = max over vertices v of (v - c).u -- then moved by c. Exact
+/// on the solid's faces (each moves out by the body's support along its normal, as in the
+/// exact sum) and on its concave creases; where it rounds convex edges and corners, within
+/// the body's facet depth (r - its inradius) of the exact sum.
+/// 	hrows InvalidInput for fewer than 4 points, or a body that is not round.
+Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round_body, const SampleOptions& options = {},
+                       SampleStats* stats = nullptr);
+/// Whether minkowski_round takes these points: every one within 2 % of one radius from their
+/// centroid, and none of the body's facets deeper than 2 % of it.
+bool is_round_body(const std::vector<Vec3>& points);
+
 /// The solid hollowed to walls `thickness` thick (the solid minus its inward offset), or with
 /// `outward` a skin of that thickness around it (its outward offset minus the solid).
 Octree shell(const TriMesh& solid, double thickness, bool outward = false, const SampleOptions& options = {},

@@ -21,6 +21,7 @@
 #include "pic/sample.h"
 #include "pic/scad.h"
 #include "pic/types.h"
+#include "pic/volume.h"
 #include "scad/lower.h"
 
 namespace pic {
@@ -163,6 +164,7 @@ class TreeBuilder {
       case Solid::Kind::Difference:
         return csg_difference(build(s.children[0]), united(s.children, 1, s.children.size()));
       case Solid::Kind::Hull: return hull(s.children);
+      case Solid::Kind::RoundSum: return round_sum(s);
     }
     return csg_empty();
   }
@@ -197,6 +199,19 @@ class TreeBuilder {
     std::vector<CsgTree> out;
     for (size_t i = b; i < e; ++i) out.push_back(build(kids[i]));
     return out;
+  }
+  CsgTree round_sum(const Solid& s) {
+    const Solid& of = s.children[0];
+    const TriMesh surface = of.kind == Solid::Kind::Mesh ? of.mesh : solid_surface(of, opt_);
+    if (surface.triangles.empty()) return csg_empty();
+    SampleOptions so;
+    so.depth = opt_.depth;
+    so.error = opt_.error;
+    so.cube = cube_;
+    so.parallel = opt_.parallel;
+    Octree sum = minkowski_round(surface, s.body, so);
+    ++progress_.leaves_done;
+    return csg_leaf(std::move(sum));
   }
   CsgTree hull(const std::vector<Solid>& kids) {
     std::vector<Vec3> pts;
@@ -266,6 +281,16 @@ std::optional<Octree> evaluate_model(const Solid& model, const EvalOptions& opti
 
 namespace detail::scad {
 void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& triangles) {
+  if (s.kind == Solid::Kind::RoundSum) {
+    // The child's box grown by the body's.
+    Vec3 clo{kHuge, kHuge, kHuge}, chi{-kHuge, -kHuge, -kHuge};
+    size_t child_leaves = 0;
+    solid_bounds(s.children[0], clo, chi, child_leaves, triangles);
+    const auto [blo, bhi] = box_of(s.body);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], clo[k] + blo[k]), hi[k] = std::max(hi[k], chi[k] + bhi[k]);
+    ++leaves;
+    return;
+  }
   if (s.kind == Solid::Kind::Mesh) {
     ++leaves;
     triangles += s.mesh.triangles.size();

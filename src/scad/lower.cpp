@@ -6,6 +6,7 @@
 
 #include "io/file_util.h"
 #include "scad/lower.h"
+#include "pic/volume.h"
 #include "scad/lowering.h"
 #include "geometry/tolerances.h"
 
@@ -28,12 +29,18 @@ Solid Lowering::solid(const Node& n, const Affine& m) {
   }
   if (k == "minkowski") {  // of the operands where they are, then moved (a sum is not moved twice)
     Solid s;
+    const std::vector<Solid> operands = children3(n, kIdentity);
     try {
-      s = scad::minkowski(children3(n, kIdentity), opt_);
+      s = scad::minkowski(operands, opt_);
     } catch (const InvalidInput& e) {
       fail(n, e.what());
     }
     transform(s, m);
+    // A sum moved by a transform that is not a similarity holds an ellipsoid: the exact path.
+    if (s.kind == Solid::Kind::RoundSum && !is_round_body(s.body)) {
+      s = scad::minkowski(operands, opt_, true);
+      transform(s, m);
+    }
     return s;
   }
   if (k == "resize") {  // sized where it is, then moved

@@ -19,10 +19,13 @@ namespace pic::detail::scad {
 
 /// The lowered tree: Booleans over closed meshes (3D) ...
 struct Solid {
-  enum class Kind { Empty, Mesh, Union, Intersect, Difference, Hull };
+  /// RoundSum: the Minkowski sum of its one child with a round convex body (`body`: its
+  /// vertices), sampled as a distance (pic::minkowski_round).
+  enum class Kind { Empty, Mesh, Union, Intersect, Difference, Hull, RoundSum };
   Kind kind = Kind::Empty;
   TriMesh mesh;
   std::vector<Solid> children;
+  std::vector<Vec3> body;
 };
 
 /// Lowers `root`. `finest_cell` > 0 tessellates spheres, cylinders and circles against it
@@ -56,7 +59,9 @@ std::vector<Ring> project(const TriMesh& surface, bool cut);
 /// parts' vertex sums), at most one of them with non-convex parts (each such part plus a convex
 /// one: the part moved, and the hull of each surface triangle plus the convex part).
 /// \throws InvalidInput for two operands with non-convex parts.
-Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options);
+/// A non-convex operand plus a round one (a faceted sphere) is a RoundSum instead, unless
+/// `exact_only`.
+Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options, bool exact_only = false);
 
 /// Whether a closed surface bounds a convex solid: connected, positive volume, convex at
 /// every edge (hull.cpp).

@@ -5,6 +5,7 @@
 
 #include "scad/lowering.h"
 #include "scad/region.h"
+#include "geometry/vec3.h"
 
 namespace pic::detail::scad {
 
@@ -158,6 +159,17 @@ std::pair<double, double> Lowering::x_range(const Region& r) {
 
 void Lowering::transform(Solid& s, const Affine& m) {
   if (s.kind == Solid::Kind::Mesh) apply(m, s.mesh);
+  if (s.kind == Solid::Kind::RoundSum) {
+    // The body turns and scales with the sum; the move is the child's.
+    TriMesh body;
+    body.positions = s.body;
+    body.positions.push_back({0, 0, 0});
+    apply(m, body);
+    const Vec3 origin = body.positions.back();
+    body.positions.pop_back();
+    for (Vec3& p : body.positions) p = detail::sub3(p, origin);
+    s.body = std::move(body.positions);
+  }
   for (Solid& c : s.children) transform(c, m);
 }
 

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "pic/measure.h"
+#include "pic/volume.h"
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "geometry/tolerances.h"
@@ -381,14 +382,43 @@ Solid part_solid(const std::vector<Part>& parts) {
 
 }  // namespace
 
-Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o) {
+Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o, bool exact_only) {
+  std::vector<std::vector<Part>> all;
+  std::vector<const Solid*> given;
+  for (const Solid& s : operands) {
+    if (s.kind == Solid::Kind::Empty) continue;
+    all.emplace_back();
+    parts_of(s, o, all.back());
+    given.push_back(&s);
+  }
+  // A solid that is not one convex part plus a faceted sphere: one distance sampling instead
+  // of a hull per convex part, or per surface triangle of a non-convex one (below).
+  if (!exact_only && all.size() == 2)
+    for (int k = 0; k < 2; ++k) {
+      const std::vector<Part>& body = all[k];
+      const std::vector<Part>& other = all[1 - k];
+      if (body.size() != 1 || !body[0].convex() || !is_round_body(body[0].points)) continue;
+      if (other.size() == 1 && other[0].convex()) continue;  // one hull, exact
+      Solid sum;
+      sum.kind = Solid::Kind::RoundSum;
+      if (other.size() == 1) {
+        Solid leaf;
+        leaf.kind = Solid::Kind::Mesh;
+        leaf.mesh = other[0].surface;
+        sum.children.push_back(std::move(leaf));
+      } else {
+        sum.children.push_back(*given[1 - k]);
+      }
+      sum.body = body[0].points;
+      return sum;
+    }
   std::vector<Part> acc;
   bool first = true, single = true;
   const Solid* only = nullptr;
+  size_t next_parts = 0;
   for (const Solid& s : operands) {
     if (s.kind == Solid::Kind::Empty) continue;
-    std::vector<Part> parts;
-    parts_of(s, o, parts);
+    std::vector<Part> parts = std::move(all[next_parts++]);
     only = &s;
     if (first) {
       acc = std::move(parts);

@@ -29,6 +29,35 @@ struct Boundary {
   std::vector<std::pair<uint32_t, uint32_t>> edges;  ///< minimal edges between the points
 };
 
+/// Per node: whether a gray leaf lies in its subtree.
+std::vector<uint8_t> gray_below(const Octree& t) {
+  std::vector<uint8_t> gray(t.nodes.size(), 0);
+  auto walk = [&](auto&& self, uint32_t node) -> bool {
+    const Node& n = t.nodes[node];
+    bool any = n.kind == CellKind::Gray;
+    if (n.kind == CellKind::Internal)
+      for (int c = 0; c < 8; ++c) any = self(self, n.index + c) || any;
+    gray[node] = any;
+    return any;
+  };
+  walk(walk, 0);
+  return gray;
+}
+
+/// Whether a gray leaf finer than `level` touches the closed lattice box [lo, hi].
+bool finer_gray_touching(const Octree& t, const std::vector<uint8_t>& gray, uint32_t node, const Cell& cell,
+                         const Lat& lo, const Lat& hi, int level) {
+  if (!gray[node]) return false;
+  const int64_t s = cell.span();
+  for (int k = 0; k < 3; ++k)
+    if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return false;
+  const Node& n = t.nodes[node];
+  if (n.kind != CellKind::Internal) return cell.level > level;
+  for (int c = 0; c < 8; ++c)
+    if (finer_gray_touching(t, gray, n.index + c, cell.child(c), lo, hi, level)) return true;
+  return false;
+}
+
 Boundary boundary_of(const Octree& t, const LeafRef& l) {
   Boundary b;
   const Lat lo = l.cell.lat, hi = l.cell.corner(7);
@@ -144,6 +173,13 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
     }
   };
   walk(walk, 0, Cell{});
+  // Around a uniform leaf, finer uniform leaves tile its faces with its own sign (neighbours
+  // share corners): only a finer gray leaf can show it a sign change.
+  const std::vector<uint8_t> gray = gray_below(t);
+  std::erase_if(coarse, [&](const LeafRef& l) {
+    return t.nodes[l.node].kind != CellKind::Gray &&
+           !finer_gray_touching(t, gray, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
+  });
   // Which leaves need a flip, asked in parallel and reading only; then the flips in order,
   // each leaf looked at again until its boundary is simple (a flip for one leaf may mend or
   // break a neighbour's, which the next sweep of the caller's loop sees).
