@@ -29,32 +29,38 @@ struct Boundary {
   std::vector<std::pair<uint32_t, uint32_t>> edges;  ///< minimal edges between the points
 };
 
-/// Per node: whether a gray leaf lies in its subtree.
-std::vector<uint8_t> gray_below(const Octree& t) {
-  std::vector<uint8_t> gray(t.nodes.size(), 0);
-  auto walk = [&](auto&& self, uint32_t node) -> bool {
+/// Per node: which signs its subtree's leaves hold at their corners (bit 0: outside, bit 1:
+/// inside).
+std::vector<uint8_t> signs_below(const Octree& t) {
+  std::vector<uint8_t> held(t.nodes.size(), 0);
+  auto walk = [&](auto&& self, uint32_t node) -> uint8_t {
     const Node& n = t.nodes[node];
-    bool any = n.kind == CellKind::Gray;
-    if (n.kind == CellKind::Internal)
-      for (int c = 0; c < 8; ++c) any = self(self, n.index + c) || any;
-    gray[node] = any;
-    return any;
+    uint8_t h = 0;
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) h |= self(self, n.index + c);
+    } else {
+      const uint8_t s = signs_of(n);
+      h = uint8_t((s != 0xff) | (s != 0) << 1);
+    }
+    held[node] = h;
+    return h;
   };
   walk(walk, 0);
-  return gray;
+  return held;
 }
 
-/// Whether a gray leaf finer than `level` touches the closed lattice box [lo, hi].
-bool finer_gray_touching(const Octree& t, const std::vector<uint8_t>& gray, uint32_t node, const Cell& cell,
-                         const Lat& lo, const Lat& hi, int level) {
-  if (!gray[node]) return false;
+/// Whether a leaf finer than `level` with a corner of sign `want` (bit as in signs_below)
+/// touches the closed lattice box [lo, hi].
+bool finer_sign_touching(const Octree& t, const std::vector<uint8_t>& held, uint8_t want, uint32_t node,
+                         const Cell& cell, const Lat& lo, const Lat& hi, int level) {
+  if (!(held[node] & want)) return false;
   const int64_t s = cell.span();
   for (int k = 0; k < 3; ++k)
     if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return false;
   const Node& n = t.nodes[node];
   if (n.kind != CellKind::Internal) return cell.level > level;
   for (int c = 0; c < 8; ++c)
-    if (finer_gray_touching(t, gray, n.index + c, cell.child(c), lo, hi, level)) return true;
+    if (finer_sign_touching(t, held, want, n.index + c, cell.child(c), lo, hi, level)) return true;
   return false;
 }
 
@@ -72,32 +78,39 @@ Boundary boundary_of(const Octree& t, const LeafRef& l) {
   thread_local std::vector<LeafRef> near;  // scratch, cleared here
   near.clear();
   leaves_touching(t, 0, Cell{}, lo, hi, kMaxLevel, near);
-  // Leaves no finer than this one put only its own corners on its boundary; and around a
-  // uniform leaf, finer uniform leaves tile its faces with its own sign (neighbours share
-  // corners), so only a finer gray leaf can show it a sign change.
-  const bool gray = t.nodes[l.node].kind == CellKind::Gray;
-  if (std::none_of(near.begin(), near.end(), [&](const LeafRef& n) {
-        return n.cell.level > l.cell.level && (gray || t.nodes[n.node].kind == CellKind::Gray);
-      })) {
-    b.points.resize(8);
+  if (std::none_of(near.begin(), near.end(), [&](const LeafRef& n) { return n.cell.level > l.cell.level; })) {
+    b.points.resize(8);  // leaves no finer than this one put only its own corners there
     return b;
   }
-  std::unordered_map<uint64_t, uint32_t> index;
+  // Coarser and equal leaves put only this leaf's corners and edges there: it and the finer
+  // leaves say everything.
+  std::erase_if(near, [&](const LeafRef& n) { return n.cell.level <= l.cell.level && n.node != l.node; });
+  thread_local std::vector<std::pair<uint64_t, uint8_t>> keyed;  // scratch, cleared here
+  keyed.clear();
   for (const LeafRef& n : near) {
     const uint8_t s = signs_of(t.nodes[n.node]);
     for (int c = 0; c < 8; ++c) {
       const Lat p = n.cell.corner(c);
-      if (!on_boundary(p)) continue;
-      if (index.emplace(lattice_key(p), uint32_t(b.points.size())).second) {
-        b.points.push_back(p);
-        b.inside.push_back((s >> c) & 1);
-      }
+      if (on_boundary(p)) keyed.emplace_back(lattice_key(p), (s >> c) & 1);
     }
   }
-  if (b.points.size() == 8) return b;  // no finer corner anywhere on it
+  std::sort(keyed.begin(), keyed.end());
+  keyed.erase(std::unique(keyed.begin(), keyed.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+              keyed.end());
+  if (keyed.size() == 8) {  // no finer corner anywhere on it
+    b.points.resize(8);
+    return b;
+  }
+  b.points.reserve(keyed.size());
+  for (const auto& [key, inside] : keyed) {
+    const auto mask = (int64_t{1} << 21) - 1;
+    b.points.push_back({int64_t(key) & mask, int64_t(key >> 21) & mask, int64_t(key >> 42) & mask});
+    b.inside.push_back(inside);
+  }
   const auto find = [&](const Lat& p) {
-    const auto it = index.find(lattice_key(p));
-    return it == index.end() ? -1 : int64_t(it->second);
+    const uint64_t key = lattice_key(p);
+    const auto it = std::lower_bound(keyed.begin(), keyed.end(), std::pair<uint64_t, uint8_t>{key, 0});
+    return it == keyed.end() || it->first != key ? -1 : int64_t(it - keyed.begin());
   };
   for (const LeafRef& n : near)
     for (int c = 0; c < 8; ++c)
@@ -173,12 +186,14 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
     }
   };
   walk(walk, 0, Cell{});
-  // Around a uniform leaf, finer uniform leaves tile its faces with its own sign (neighbours
-  // share corners): only a finer gray leaf can show it a sign change.
-  const std::vector<uint8_t> gray = gray_below(t);
+  // A uniform leaf's boundary is all its own sign unless a finer leaf with a corner of the
+  // other sign touches it (in a subtree the walk does not prune).
+  const std::vector<uint8_t> held = signs_below(t);
   std::erase_if(coarse, [&](const LeafRef& l) {
-    return t.nodes[l.node].kind != CellKind::Gray &&
-           !finer_gray_touching(t, gray, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
+    const CellKind kind = t.nodes[l.node].kind;
+    if (kind == CellKind::Gray) return false;
+    const uint8_t other = kind == CellKind::Black ? 1 : 2;
+    return !finer_sign_touching(t, held, other, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
   });
   // Which leaves need a flip, asked in parallel and reading only; then the flips in order,
   // each leaf looked at again until its boundary is simple (a flip for one leaf may mend or
