@@ -29,39 +29,21 @@ struct Boundary {
   std::vector<std::pair<uint32_t, uint32_t>> edges;  ///< minimal edges between the points
 };
 
-/// Per node: which signs its subtree's leaves hold at their corners (bit 0: outside, bit 1:
-/// inside).
-std::vector<uint8_t> signs_below(const Octree& t) {
-  std::vector<uint8_t> held(t.nodes.size(), 0);
-  auto walk = [&](auto&& self, uint32_t node) -> uint8_t {
-    const Node& n = t.nodes[node];
-    uint8_t h = 0;
-    if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) h |= self(self, n.index + c);
-    } else {
-      const uint8_t s = signs_of(n);
-      h = uint8_t((s != 0xff) | (s != 0) << 1);
-    }
-    held[node] = h;
-    return h;
-  };
-  walk(walk, 0);
-  return held;
-}
-
-/// Whether a leaf finer than `level` with a corner of sign `want` (bit as in signs_below)
-/// touches the closed lattice box [lo, hi].
-bool finer_sign_touching(const Octree& t, const std::vector<uint8_t>& held, uint8_t want, uint32_t node,
-                         const Cell& cell, const Lat& lo, const Lat& hi, int level) {
-  if (!(held[node] & want)) return false;
+/// Whether a leaf finer than `level` with a corner of sign `inside` touches the closed lattice
+/// box [lo, hi]; stops at the first.
+bool finer_sign_touching(const Octree& t, bool inside, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
+                         int level) {
   const int64_t s = cell.span();
   for (int k = 0; k < 3; ++k)
     if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return false;
   const Node& n = t.nodes[node];
-  if (n.kind != CellKind::Internal) return cell.level > level;
-  for (int c = 0; c < 8; ++c)
-    if (finer_sign_touching(t, held, want, n.index + c, cell.child(c), lo, hi, level)) return true;
-  return false;
+  if (n.kind == CellKind::Internal) {
+    for (int c = 0; c < 8; ++c)
+      if (finer_sign_touching(t, inside, n.index + c, cell.child(c), lo, hi, level)) return true;
+    return false;
+  }
+  const uint8_t signs = signs_of(n);
+  return cell.level > level && (inside ? signs != 0 : signs != 0xff);
 }
 
 Boundary boundary_of(const Octree& t, const LeafRef& l) {
@@ -187,13 +169,11 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
   };
   walk(walk, 0, Cell{});
   // A uniform leaf's boundary is all its own sign unless a finer leaf with a corner of the
-  // other sign touches it (in a subtree the walk does not prune).
-  const std::vector<uint8_t> held = signs_below(t);
+  // other sign touches it.
   std::erase_if(coarse, [&](const LeafRef& l) {
     const CellKind kind = t.nodes[l.node].kind;
-    if (kind == CellKind::Gray) return false;
-    const uint8_t other = kind == CellKind::Black ? 1 : 2;
-    return !finer_sign_touching(t, held, other, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
+    return kind != CellKind::Gray &&
+           !finer_sign_touching(t, kind == CellKind::White, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
   });
   // Which leaves need a flip, asked in parallel and reading only; then the flips in order,
   // each leaf looked at again until its boundary is simple (a flip for one leaf may mend or

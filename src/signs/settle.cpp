@@ -14,13 +14,15 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
     rounds.touched.push_back(n);
     if (plan.touched) (*plan.touched)(n);
   };
+  bool quiet = false;  // a round changed nothing and left no leaf with two components
   for (int round = 0; round < 4; ++round) {
     const size_t islands = remove_islands(t, plan.active, &touched, &pinned, &rounds);
     const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse,
                                                   plan.refine ? &plan.refine : nullptr);
+    quiet = islands == 0 && fix.flipped == 0 && fix.remaining == 0;
     if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
   }
-  erode_until_valid(t, component_scope, plan.active, &touched);
+  if (!quiet || plan.erode_after_quiet) erode_until_valid(t, component_scope, plan.active, &touched);
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
   remove_specks(t, plan.active, plan.keep_speck ? plan.keep_speck : keep_none, plan.specks);
   return repair_cracks(t, plan.active);
@@ -79,6 +81,7 @@ void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf
   plan.active = region.everywhere ? nullptr : &active;
   plan.touched = region.everywhere ? nullptr : &touched;
   plan.one_component_everywhere = true;
+  plan.erode_after_quiet = true;
   // Where |w| hovers at 1/2 (an open part's end inside another part) the level set leaves
   // specks a cell across, closed shells or voids of a few triangles: resolution noise.
   plan.specks = {tree.max_depth - 1, true};

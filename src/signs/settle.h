@@ -26,10 +26,17 @@ struct SettlePlan {
   /// flip in place); see enforce_one_component.
   std::function<void(const std::array<int64_t, 3>&)> refine;
   SpeckSearch specks;
+  /// Run the erosions (erode_until_valid) even when a round of the passes above changed
+  /// nothing and left every leaf one component. Sampling does: its capped leaves may hold any
+  /// pattern. The CSG clean-up does not: its leaves come from valid operands and the Boolean's
+  /// rules, and a quiet round leaves them so in every harness case and sculpt, while checking
+  /// every stamped coarse leaf's boundary costs the Boolean 1.5x; where the rounds run out or
+  /// a leaf keeps two components, it erodes too.
+  bool erode_after_quiet = false;
 };
 
 /// Islands and one component per leaf, alternated until both are quiet (at most 4 rounds);
-/// then specks; then cracks. `pinned`: points set earlier in this operation (sign hints).
+/// then the erosions (see erode_after_quiet); then specks; then cracks. `pinned`: points set earlier in this operation (sign hints).
 /// Returns how many leaves repair_cracks changed.
 size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned);
 
