@@ -252,7 +252,7 @@ TEST(RefinePass, SplitsTheCoarseLeavesAroundAPointDownToTheFinestLevel) {
 
 /// A random tree: cells split with probability `split` per level, so capped leaves sit
 /// beside leaves of every coarser level; every lattice point's sign is a coin toss (outside on the root cube's faces), and each
-/// gray leaf's vertex a random point inside its cell.
+/// gray leaf's vertex a random point inside its cell; the finest gray leaves are capped.
 Octree random_tree(uint64_t seed, int depth, double split) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
@@ -267,6 +267,7 @@ Octree random_tree(uint64_t seed, int depth, double split) {
   detail::visit_leaves(t, 0, Cell{}, [&](uint32_t n, const Cell& c) {
     if (t.nodes[n].kind != CellKind::Gray) return;
     const Vec3 lo = c.min_unit();
+    if (c.level == t.max_depth) t.nodes[n].flags |= kFlagCapped;  // at the cap: any pattern
     auto& v = t.vertices[t.nodes[n].index];
     for (int k = 0; k < 3; ++k) v[k] = float(lo[k] + c.size() * (0.1 + 0.8 * u(rng)));
   });

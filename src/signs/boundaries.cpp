@@ -29,17 +29,39 @@ struct Boundary {
   std::vector<std::pair<uint32_t, uint32_t>> edges;  ///< minimal edges between the points
 };
 
+/// Per node: which signs its subtree's leaves hold at their corners (bit 0: outside, bit 1:
+/// inside).
+std::vector<uint8_t> signs_below(const Octree& t) {
+  std::vector<uint8_t> held(t.nodes.size(), 0);
+  auto walk = [&](auto&& self, uint32_t node) -> uint8_t {
+    const Node& n = t.nodes[node];
+    uint8_t h = 0;
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) h |= self(self, n.index + c);
+    } else {
+      const uint8_t s = signs_of(n);
+      h = uint8_t((s != 0xff) | (s != 0) << 1);
+    }
+    held[node] = h;
+    return h;
+  };
+  walk(walk, 0);
+  return held;
+}
+
 /// Whether a leaf finer than `level` with a corner of sign `inside` touches the closed lattice
-/// box [lo, hi]; stops at the first.
-bool finer_sign_touching(const Octree& t, bool inside, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi,
-                         int level) {
+/// box [lo, hi]; stops at the first. `held` (signs_below; may be empty) prunes subtrees
+/// without such a corner.
+bool finer_sign_touching(const Octree& t, const std::vector<uint8_t>& held, bool inside, uint32_t node,
+                         const Cell& cell, const Lat& lo, const Lat& hi, int level) {
+  if (!held.empty() && !(held[node] & (inside ? 2 : 1))) return false;
   const int64_t s = cell.span();
   for (int k = 0; k < 3; ++k)
     if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return false;
   const Node& n = t.nodes[node];
   if (n.kind == CellKind::Internal) {
     for (int c = 0; c < 8; ++c)
-      if (finer_sign_touching(t, inside, n.index + c, cell.child(c), lo, hi, level)) return true;
+      if (finer_sign_touching(t, held, inside, n.index + c, cell.child(c), lo, hi, level)) return true;
     return false;
   }
   const uint8_t signs = signs_of(n);
@@ -169,11 +191,13 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
   };
   walk(walk, 0, Cell{});
   // A uniform leaf's boundary is all its own sign unless a finer leaf with a corner of the
-  // other sign touches it.
+  // other sign touches it. Over a whole tree, per-subtree sign masks prune that search (a
+  // partial run, a Boolean's clean-up, stays local without them).
+  const std::vector<uint8_t> held = active ? std::vector<uint8_t>{} : signs_below(t);
   std::erase_if(coarse, [&](const LeafRef& l) {
     const CellKind kind = t.nodes[l.node].kind;
-    return kind != CellKind::Gray &&
-           !finer_sign_touching(t, kind == CellKind::White, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level);
+    return kind != CellKind::Gray && !finer_sign_touching(t, held, kind == CellKind::White, 0, Cell{}, l.cell.lat,
+                                                          l.cell.corner(7), l.cell.level);
   });
   // Which leaves need a flip, asked in parallel and reading only; then the flips in order,
   // each leaf looked at again until its boundary is simple (a flip for one leaf may mend or

@@ -1,9 +1,31 @@
 // The settling loop: see settle.h.
 #include "signs/settle.h"
 
+#include <algorithm>
 #include <numeric>
 
+#include "signs/leaf_walks.h"
+
 namespace pic::detail {
+
+namespace {
+
+/// Per node: whether its closed cell meets a capped leaf's (ancestors included).
+std::vector<uint8_t> near_capped(const Octree& t) {
+  std::vector<uint8_t> near(t.nodes.size(), 0);
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    const Node& n = t.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && (n.flags & kFlagCapped)) {
+      for_each_node_meeting(t, 0, Cell{}, cell.lat, cell.corner(7), [&](uint32_t m) { near[m] = 1; });
+    }
+  };
+  walk(walk, 0, Cell{});
+  return near;
+}
+
+}  // namespace
 
 size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
   const auto* component_scope = plan.one_component_everywhere ? nullptr : plan.active;
@@ -14,15 +36,31 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
     rounds.touched.push_back(n);
     if (plan.touched) (*plan.touched)(n);
   };
-  bool quiet = false;  // a round changed nothing and left no leaf with two components
+  bool converged = false;  // the last round changed no sign
+  bool kept_two = false;   // and left leaves with two components (capped ones)
   for (int round = 0; round < 4; ++round) {
     const size_t islands = remove_islands(t, plan.active, &touched, &pinned, &rounds);
     const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse,
                                                   plan.refine ? &plan.refine : nullptr);
-    quiet = islands == 0 && fix.flipped == 0 && fix.remaining == 0;
+    converged = islands == 0 && fix.flipped == 0;
+    kept_two = fix.remaining > 0;
     if (fix.flipped == 0 && (islands == 0 || round > 0)) break;
   }
-  if (!quiet || plan.erode_after_quiet) erode_until_valid(t, component_scope, plan.active, &touched);
+  // The guarantee's erosions: where the rounds ran out, over the whole scope; else around the
+  // capped leaves (those the passes left two components in, and, when sampling, every one).
+  // Above the cap the rules hold by refinement and by the passes' own checks.
+  if (!converged) {
+    erode_until_valid(t, component_scope, plan.active, &touched);
+  } else if (kept_two || plan.erode_after_quiet) {
+    std::vector<uint8_t> near = near_capped(t);
+    const std::function<bool(uint32_t)> in = [&](uint32_t n) { return n < near.size() && near[n] != 0; };
+    const std::function<void(uint32_t)> mark = [&](uint32_t n) {
+      if (n >= near.size()) near.resize(t.nodes.size(), 0);
+      near[n] = 1;
+      touched(n);
+    };
+    if (std::find(near.begin(), near.end(), 1) != near.end()) erode_until_valid(t, &in, &in, &mark);
+  }
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
   remove_specks(t, plan.active, plan.keep_speck ? plan.keep_speck : keep_none, plan.specks);
   return repair_cracks(t, plan.active);

@@ -26,12 +26,11 @@ struct SettlePlan {
   /// flip in place); see enforce_one_component.
   std::function<void(const std::array<int64_t, 3>&)> refine;
   SpeckSearch specks;
-  /// Run the erosions (erode_until_valid) even when a round of the passes above changed
-  /// nothing and left every leaf one component. Sampling does: its capped leaves may hold any
-  /// pattern. The CSG clean-up does not: its leaves come from valid operands and the Boolean's
-  /// rules, and a quiet round leaves them so in every harness case and sculpt, while checking
-  /// every stamped coarse leaf's boundary costs the Boolean 1.5x; where the rounds run out or
-  /// a leaf keeps two components, it erodes too.
+  /// After a round that changed no sign, still run the erosions (erode_until_valid) around
+  /// every capped leaf, which may hold any pattern. Sampling does; the CSG clean-up erodes
+  /// around the capped leaves the passes left two components in, and over its whole scope
+  /// only where its rounds ran out (checking every stamped coarse leaf's boundary on every
+  /// Boolean costs it 1.5x).
   bool erode_after_quiet = false;
 };
 
