@@ -347,6 +347,18 @@ sampled into one cube around them all at `depth`.)doc");
       py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true,
       "Convex edges rounded to `radius` (concave=True: concave edges filled): pic::round_edges.");
   m.def(
+      "minkowski_round",
+      [](py::handle x, py::object body, int depth, double error, py::object cube, bool parallel) {
+        const std::vector<pic::Vec3> points = to_points(body, "body");
+        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
+          return pic::minkowski_round(m, points, o);
+        });
+      },
+      py::arg("solid"), py::arg("body"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
+      py::arg("cube") = py::none(), py::arg("parallel") = true,
+      R"doc(The Minkowski sum of a solid with a round convex body given by its (n, 3) vertices (a faceted
+sphere): pic::minkowski_round. Faces exact; rounds within the body's facet depth.)doc");
+  m.def(
       "thicken",
       [](py::handle x, double thickness, int depth, double error, py::object cube, bool parallel) {
         return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {

@@ -146,6 +146,11 @@ def offset(solid: Any, distance: float, *, depth: int = 12, error: float = 1e-8,
     """The solid grown by distance (> 0) or shrunk (< 0); solid: an Octree or a mesh."""
     ...
 
+def minkowski_round(solid: Any, body: Any, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
+                    parallel: bool = True) -> Octree:
+    """The Minkowski sum of a solid with a round convex body (its (n, 3) vertices: a faceted sphere)."""
+    ...
+
 def shell(solid: Any, thickness: float, *, outward: bool = False, depth: int = 12, error: float = 1e-8,
           cube: Any = None, parallel: bool = True) -> Octree:
     """The solid hollowed to walls `thickness` thick (outward: a skin around it)."""

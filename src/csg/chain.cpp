@@ -1,6 +1,5 @@
 // Chains of Booleans over PIC objects and meshes (pic csg, Python's csg_meshes).
 #include "pic/csg.h"
-#include "octree/cell.h"
 
 #include <algorithm>
 

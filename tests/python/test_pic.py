@@ -525,6 +525,22 @@ def test_offset_shell_round_thicken_volumes():
     assert abs(_volume(slab) - exact) < 0.02 * exact
 
 
+def test_minkowski_round_moves_faces_by_the_support():
+    ball_v, _ = pic.make_sphere((0, 0, 0), 0.1, segments=64)
+    cube_mesh = pic.make_box((0, 0, 0), (1, 1, 1))
+    summed = pic.minkowski_round(cube_mesh, ball_v, depth=8)
+    v, f = pic.contour(summed)
+    assert edges_closed_manifold(f)
+    # Over the middle of the top face, the vertices lie at 1 + the ball's extent along z, exactly.
+    mid = (np.abs(v[:, 0] - 0.5) < 0.3) & (np.abs(v[:, 1] - 0.5) < 0.3) & (v[:, 2] > 1)
+    assert mid.sum() > 0
+    assert np.abs(v[mid, 2] - (1 + ball_v[:, 2].max())).max() < 1e-6
+    exact = 1 + 0.6 + 0.03 * math.pi + 4 / 3 * math.pi * 0.001
+    assert abs(_volume(summed) - exact) < 3e-3 * exact
+    with pytest.raises(ValueError):
+        pic.minkowski_round(cube_mesh, cube_mesh[0], depth=6)  # a cube is not round
+
+
 def test_sample_function_box_with_cavity_matches_boolean():
     def f(p):
         q = np.abs(p) - 0.6
