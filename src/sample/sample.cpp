@@ -243,7 +243,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     };
     if (capped > 0) {
       const size_t flipped = enforce_one_component(tree, nullptr, nullptr, nullptr, false, &refine).flipped;
-      if (flipped + erode_until_valid(tree, nullptr, nullptr, nullptr) > 0) repair_cracks(tree, nullptr);
+      if (flipped + erode_around_capped(tree, nullptr) > 0) repair_cracks(tree, nullptr);
     }
   } else {
     tree = sample_winding(clean, grid, options, cube, st, capped);

@@ -52,18 +52,23 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
   if (!converged) {
     erode_until_valid(t, component_scope, plan.active, &touched);
   } else if (kept_two || plan.erode_after_quiet) {
-    std::vector<uint8_t> near = near_capped(t);
-    const std::function<bool(uint32_t)> in = [&](uint32_t n) { return n < near.size() && near[n] != 0; };
-    const std::function<void(uint32_t)> mark = [&](uint32_t n) {
-      if (n >= near.size()) near.resize(t.nodes.size(), 0);
-      near[n] = 1;
-      touched(n);
-    };
-    if (std::find(near.begin(), near.end(), 1) != near.end()) erode_until_valid(t, &in, &in, &mark);
+    erode_around_capped(t, &touched);
   }
   const std::function<bool(const Speck&)> keep_none = [](const Speck&) { return false; };
   remove_specks(t, plan.active, plan.keep_speck ? plan.keep_speck : keep_none, plan.specks);
   return repair_cracks(t, plan.active);
+}
+
+size_t erode_around_capped(Octree& t, const std::function<void(uint32_t)>* touched) {
+  std::vector<uint8_t> near = near_capped(t);
+  if (std::find(near.begin(), near.end(), 1) == near.end()) return 0;
+  const std::function<bool(uint32_t)> in = [&](uint32_t n) { return n < near.size() && near[n] != 0; };
+  const std::function<void(uint32_t)> mark = [&](uint32_t n) {
+    if (n >= near.size()) near.resize(t.nodes.size(), 0);
+    near[n] = 1;
+    if (touched) (*touched)(n);
+  };
+  return erode_until_valid(t, &in, &in, &mark);
 }
 
 size_t erode_until_valid(Octree& t, const std::function<bool(uint32_t)>* components,

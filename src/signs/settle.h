@@ -45,6 +45,10 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned);
 size_t erode_until_valid(Octree& t, const std::function<bool(uint32_t)>* components,
                          const std::function<bool(uint32_t)>* boundaries, const std::function<void(uint32_t)>* touched);
 
+/// erode_until_valid over the capped leaves and every leaf touching them (the leaves a flip
+/// there reaches join as it goes). Returns how many points changed.
+size_t erode_around_capped(Octree& t, const std::function<void(uint32_t)>* touched);
+
 /// Where a tree's signs may disagree between levels (islands, cracks): everywhere, or only
 /// within these unit-space boxes.
 struct SettleRegion {
