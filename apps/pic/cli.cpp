@@ -163,6 +163,15 @@ Cube parse_cube(const std::string& s) {
   return Cube{{v[0], v[1], v[2]}, v[3]};
 }
 
+SampleOptions sample_options(int depth, double error, bool serial, const std::string& cube) {
+  SampleOptions o;
+  o.depth = depth;
+  o.error = error;
+  o.parallel = !serial;
+  if (!cube.empty()) o.cube = parse_cube(cube);
+  return o;
+}
+
 std::string extension(const std::string& path) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot);

@@ -97,6 +97,9 @@ void print_info_table(const Octree& tree, size_t file_bytes);
 std::vector<double> parse_numbers(const std::string& s, size_t n, const std::string& what);
 /// --cube X,Y,Z,SIZE.
 Cube parse_cube(const std::string& s);
+/// The sampling flags every sampling command takes: --depth, --error, --serial, --cube (may be
+/// empty: the input's own cube).
+SampleOptions sample_options(int depth, double error, bool serial, const std::string& cube);
 
 /// Lower-case extension with its dot ("" when none).
 std::string extension(const std::string& path);

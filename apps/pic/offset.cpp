@@ -19,14 +19,7 @@ struct VolumeArgs {
   bool outward = false, convex = false, concave = false, json = false, serial = false;
 };
 
-SampleOptions options_of(const VolumeArgs& a) {
-  SampleOptions o;
-  o.depth = a.depth;
-  o.error = a.error;
-  o.parallel = !a.serial;
-  if (!a.cube.empty()) o.cube = parse_cube(a.cube);
-  return o;
-}
+SampleOptions options_of(const VolumeArgs& a) { return sample_options(a.depth, a.error, a.serial, a.cube); }
 
 /// The input as a mesh: a mesh file as read, a .pic through its contour.
 TriMesh input_mesh(const std::string& path) {

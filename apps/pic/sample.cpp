@@ -17,11 +17,7 @@ struct SampleArgs {
 };
 
 void run(const SampleArgs& a) {
-  SampleOptions o;
-  o.depth = a.depth;
-  o.error = a.error;
-  o.parallel = !a.serial;
-  if (!a.cube.empty()) o.cube = parse_cube(a.cube);
+  SampleOptions o = sample_options(a.depth, a.error, a.serial, a.cube);
   const auto mode = parse_inside_mode(a.inside);
   if (!mode) throw InvalidInput("--inside must be auto, parity or winding");
   o.inside = *mode;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "geometry/mesh_distance.h"
 #include "geometry/tolerances.h"
@@ -105,20 +106,29 @@ RoundBody round_body(const std::vector<Vec3>& points) {
 
 }  // namespace
 
-bool is_round_body(const std::vector<Vec3>& points) {
-  if (points.size() < 4) return false;
+namespace {
+
+/// The body about its centroid when it is round (see is_round_body), else nothing.
+std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
+  if (points.size() < 4) return std::nullopt;
   for (const Vec3& p : points)
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return false;
-  const RoundBody b = round_body(points);
-  return b.outer > 0 && b.inner >= 0.98 * b.outer;
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return std::nullopt;
+  RoundBody b = round_body(points);
+  if (!(b.outer > 0 && b.inner >= 0.98 * b.outer)) return std::nullopt;
+  return b;
 }
+
+}  // namespace
+
+bool is_round_body(const std::vector<Vec3>& points) { return round_body_if_round(points).has_value(); }
 
 Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, const SampleOptions& options,
                        SampleStats* stats) {
-  if (!is_round_body(round))
+  const std::optional<RoundBody> found = round_body_if_round(round);
+  if (!found)
     throw InvalidInput("the Minkowski sum takes a round body here: a faceted sphere, every vertex and facet "
                        "within 2 % of one radius from its centre");
-  const RoundBody body = round_body(round);
+  const RoundBody& body = *found;
   TriMesh surface = closed_surface(solid, options);
   for (Vec3& p : surface.positions) p = detail::add3(p, body.centre);
   const Cube cube = cube_around(surface, body.outer, options);
