@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli.h"
 
@@ -13,8 +14,25 @@ struct CompareArgs {
   std::string a, b;
   double unit = 0;
   size_t samples = 200000;
+  std::optional<double> offset;
   bool json = false;
 };
+
+/// --offset D: how far A lies from B's surface offset by D (one-sided).
+void run_offset(const TriMesh& a, const TriMesh& b, double offset, double unit, const CompareArgs& args) {
+  const OffsetDistance d = offset_distance(a, b, offset, args.samples);
+  Json j;
+  j.add("offset", offset)
+      .add("offset_worst", d.worst / unit)
+      .add("offset_worst_vertex", d.worst_vertex / unit)
+      .add("offset_mean", d.mean / unit)
+      .raw("offset_where", vec_json(d.where))
+      .add("unit", unit);
+  if (args.json) std::cout << j.str() << "\n";
+  else
+    std::printf("from B's offset by %g: worst %.3g (vertices %.3g), mean %.3g in units of %g\n", offset,
+                d.worst / unit, d.worst_vertex / unit, d.mean / unit, unit);
+}
 
 void run(const CompareArgs& args) {
   double unit = args.unit;
@@ -28,6 +46,7 @@ void run(const CompareArgs& args) {
   };
   const TriMesh a = surface(args.a), b = surface(args.b);
   if (unit <= 0) unit = 1;
+  if (args.offset) return run_offset(a, b, *args.offset, unit, args);
   const SurfaceDistance d = surface_distance(a, b, args.samples);
   const double va = volume(a), vb = volume(b);
   Json j;
@@ -58,6 +77,8 @@ void add_compare(CLI::App& app) {
   c->add_option("b", a->b, "A .pic file or a mesh (the reference)")->required();
   c->add_option("--unit", a->unit, "Divide distances by this length (default: the root cube of the first .pic, else 1)");
   c->add_option("--samples", a->samples, "Area-weighted samples per side, besides all vertices")->capture_default_str();
+  c->add_option("--offset", a->offset,
+                 "Instead: how far A lies from B's surface offset by this distance (B closed; one-sided)");
   c->add_flag("--json", a->json, "Print one JSON object on stdout");
   c->callback([a] { run(*a); });
 }

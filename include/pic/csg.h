@@ -107,7 +107,7 @@ CsgTree csg_difference(CsgTree from, std::vector<CsgTree> take_away);
 /// operand. Three children combine as a op (b op c). An empty union is the empty solid.
 /// options.on_step gets each Boolean's statistics with its number in the order they finish
 /// (the chain's order for a left-deep tree).
-/// 	hrows InvalidInput as sample() and csg() do, or for a difference without children.
+/// Throws InvalidInput as sample() and csg() do, or for a difference without children.
 Octree evaluate(const CsgTree& tree, const CsgChainOptions& options = {});
 
 }  // namespace pic

@@ -80,6 +80,17 @@ struct SurfaceDistance {
 };
 /// Two-sided (Hausdorff) distance sampled at all vertices plus `samples` points per side.
 SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samples = 100000);
+struct OffsetDistance {
+  double worst = 0, mean = 0;  ///< over every vertex and sample
+  double worst_vertex = 0;     ///< over the vertices alone
+  Vec3 where{};                ///< the worst point
+};
+/// How far `surface` lies from `reference`'s surface offset by `offset` (> 0 outward):
+/// |signed distance to reference - offset| at every vertex plus `samples` area-weighted points.
+/// One-sided: the exact offset surface is no mesh. \throws InvalidInput when `reference` is not
+/// closed, 2-manifold and consistently oriented (its sign comes from pseudonormals).
+OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference, double offset,
+                               size_t samples = 100000);
 ///@}
 
 }  // namespace pic

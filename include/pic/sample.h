@@ -84,6 +84,9 @@ struct ImplicitSolid {
   std::function<double(const Vec3&)> value;
   /// f's gradient (pointing out of the solid); empty: central differences of `value`.
   std::function<Vec3(const Vec3&)> gradient;
+  /// f and its gradient from one evaluation (optional; a distance's nearest point gives both):
+  /// edge crossings are then found by Newton steps, about two evaluations per edge.
+  std::function<double(const Vec3&, Vec3&)> value_gradient;
   double lipschitz = 1;
 };
 /// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs
@@ -91,7 +94,7 @@ struct ImplicitSolid {
 /// gradient, refinement where the QEF residual exceeds the error; a cell that f's bound keeps
 /// away from the surface (|f| beyond its reach from the cell's centre or a corner) is never
 /// subdivided.
-/// 	hrows InvalidInput without a cube or a function, or when the solid is empty in the cube.
+/// Throws InvalidInput without a cube or a function, or when the solid is empty in the cube.
 Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats = nullptr);
 
 /// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.

@@ -27,7 +27,7 @@ Octree offset(const Octree& solid, double distance, const SampleOptions& options
 /// on the solid's faces (each moves out by the body's support along its normal, as in the
 /// exact sum) and on its concave creases; where it rounds convex edges and corners, within
 /// the body's facet depth (r - its inradius) of the exact sum.
-/// 	hrows InvalidInput for fewer than 4 points, or a body that is not round.
+/// Throws InvalidInput for fewer than 4 points, or a body that is not round.
 Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round_body, const SampleOptions& options = {},
                        SampleStats* stats = nullptr);
 /// Whether minkowski_round takes these points: every one within 2 % of one radius from their

@@ -13,12 +13,18 @@
 
 namespace pic::detail {
 
-Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+namespace {
+
+/// nearest_on_triangle with the squared distance in `distance`.
+Nearest nearest_on_triangle2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Voronoi regions of the vertices, then the edges, then the face (Ericson, Real-Time
   // Collision Detection, 5.1.5).
   const Vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
   const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
-  auto at = [&](const Vec3& x, Feature f) { return Nearest{x, norm3(sub3(p, x)), 0, f}; };
+  auto at = [&](const Vec3& x, Feature f) {
+    const Vec3 d = sub3(p, x);
+    return Nearest{x, dot3(d, d), 0, f};
+  };
   if (d1 <= 0 && d2 <= 0) return at(a, Feature::V0);
   const Vec3 bp = sub3(p, b);
   const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
@@ -45,31 +51,55 @@ Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   return at(add3(a, add3(scale3(ab, v), scale3(ac, w))), Feature::Face);
 }
 
-MeshDistance::MeshDistance(const TriMesh& mesh) : mesh_(mesh) {
+float round_down(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+}  // namespace
+
+Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  Nearest n = nearest_on_triangle2(p, a, b, c);
+  n.distance = std::sqrt(n.distance);
+  return n;
+}
+
+MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size()) {
   const size_t n = mesh.triangles.size();
-  order_.resize(n);
-  std::iota(order_.begin(), order_.end(), uint32_t{0});
-  lo_.resize(n);
-  hi_.resize(n);
-  centre_.resize(n);
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), uint32_t{0});
+  std::vector<Vec3> lo(n), hi(n), centre(n);
   for (size_t i = 0; i < n; ++i) {
     const auto& t = mesh.triangles[i];
     for (int k = 0; k < 3; ++k) {
-      lo_[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
-      hi_[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
-      centre_[i][k] = (lo_[i][k] + hi_[i][k]) / 2;
+      lo[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+      hi[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
+      centre[i][k] = (lo[i][k] + hi[i][k]) / 2;
     }
   }
-  if (n > 0) {
-    nodes_.emplace_back();
-    build(0, 0, static_cast<uint32_t>(n));
+  if (n == 0) return;
+  nodes_.emplace_back();
+  build(0, 0, static_cast<uint32_t>(n), order, lo, hi, centre);
+  tris_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const auto& t = mesh.triangles[order[i]];
+    LeafTriangle& l = tris_[i];
+    l.a = mesh.positions[t[0]], l.b = mesh.positions[t[1]], l.c = mesh.positions[t[2]];
+    for (int k = 0; k < 3; ++k) l.lo[k] = round_down(lo[order[i]][k]), l.hi[k] = round_up(hi[order[i]][k]);
+    l.id = order[i];
   }
 }
 
-double MeshDistance::box_distance2(const BNode& nd, const Vec3& p) {
+template <class Box>
+double MeshDistance::box_distance2(const Box& box, const Vec3& p) {
   double s = 0;
   for (int k = 0; k < 3; ++k) {
-    const double d = std::max({nd.lo[k] - p[k], 0.0, p[k] - nd.hi[k]});
+    const double d = std::max({double(box.lo[k]) - p[k], 0.0, p[k] - double(box.hi[k])});
     s += d * d;
   }
   return s;
@@ -87,28 +117,26 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
     const BNode& nd = nodes_[stack[--top]];
     if (box_distance2(nd, p) >= best2) continue;
     if (nd.count > 0) {
-      for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) visit(order_[i]);
+      for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) visit(tris_[i]);
       continue;
     }
-    const BNode &l = nodes_[nd.left], &r = nodes_[nd.left + 1];
+    const BNode &l = nodes_[nd.first], &r = nodes_[nd.first + 1];
     const double dl = box_distance2(l, p), dr = box_distance2(r, p);
     // Push the farther first so the nearer is explored first.
     if (dl < dr) {
-      if (dr < best2) stack[top++] = nd.left + 1;
-      if (dl < best2) stack[top++] = nd.left;
+      if (dr < best2) stack[top++] = nd.first + 1;
+      if (dl < best2) stack[top++] = nd.first;
     } else {
-      if (dl < best2) stack[top++] = nd.left;
-      if (dr < best2) stack[top++] = nd.left + 1;
+      if (dl < best2) stack[top++] = nd.first;
+      if (dr < best2) stack[top++] = nd.first + 1;
     }
   }
 }
 
 double MeshDistance::distance(const Vec3& p) const {
   double best2 = std::numeric_limits<double>::infinity();
-  search(p, best2, [&](uint32_t i) {
-    const auto& t = mesh_.triangles[i];
-    best2 = std::min(best2, point_triangle_distance2(p, mesh_.positions[t[0]], mesh_.positions[t[1]],
-                                                     mesh_.positions[t[2]]));
+  search(p, best2, [&](const LeafTriangle& t) {
+    if (box_distance2(t, p) < best2) best2 = std::min(best2, point_triangle_distance2(p, t.a, t.b, t.c));
   });
   return std::sqrt(best2);
 }
@@ -116,41 +144,39 @@ double MeshDistance::distance(const Vec3& p) const {
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;
-  if (hint && *hint < mesh_.triangles.size()) {
-    const auto& t = mesh_.triangles[*hint];
-    best = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
-    best.triangle = *hint;
+  if (hint && *hint < triangles_) {
+    const LeafTriangle& t = tris_[*hint];
+    best = nearest_on_triangle2(p, t.a, t.b, t.c);
+    best.triangle = t.id;
     // A hair more: the search must still find the hint's own triangle when it is the answer.
-    if (std::isfinite(best.distance)) best2 = best.distance * best.distance * (1 + 1e-12) + kTinyDivisor;
+    if (std::isfinite(best.distance)) best2 = best.distance * (1 + 1e-12) + kTinyDivisor;
   }
-  search(p, best2, [&](uint32_t i) {
-    double box2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = std::max({lo_[i][k] - p[k], 0.0, p[k] - hi_[i][k]});
-      box2 += d * d;
-    }
-    if (box2 >= best2) return;
-    const auto& t = mesh_.triangles[i];
-    const Nearest n = nearest_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
-    if (n.distance * n.distance < best2) {
-      best2 = n.distance * n.distance;
+  uint32_t slot = hint ? *hint : 0;
+  search(p, best2, [&](const LeafTriangle& t) {
+    if (box_distance2(t, p) >= best2) return;
+    const Nearest n = nearest_on_triangle2(p, t.a, t.b, t.c);
+    if (n.distance < best2) {
+      best2 = n.distance;
       best = n;
-      best.triangle = i;
+      best.triangle = t.id;
+      slot = static_cast<uint32_t>(&t - tris_.data());
     }
   });
-  if (hint) *hint = best.triangle;
+  if (hint) *hint = slot;
+  best.distance = std::sqrt(best.distance);
   return best;
 }
 
-void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last) {
-  BNode nd;
-  nd.lo = {kHuge, kHuge, kHuge};
-  nd.hi = {-kHuge, -kHuge, -kHuge};
+void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
+                         const std::vector<Vec3>& lo, const std::vector<Vec3>& hi, const std::vector<Vec3>& centre) {
+  Vec3 blo{kHuge, kHuge, kHuge}, bhi{-kHuge, -kHuge, -kHuge};
   for (uint32_t i = first; i < last; ++i)
     for (int k = 0; k < 3; ++k) {
-      nd.lo[k] = std::min(nd.lo[k], lo_[order_[i]][k]);
-      nd.hi[k] = std::max(nd.hi[k], hi_[order_[i]][k]);
+      blo[k] = std::min(blo[k], lo[order[i]][k]);
+      bhi[k] = std::max(bhi[k], hi[order[i]][k]);
     }
+  BNode nd;
+  for (int k = 0; k < 3; ++k) nd.lo[k] = round_down(blo[k]), nd.hi[k] = round_up(bhi[k]);
   if (last - first <= 4) {
     nd.first = first;
     nd.count = last - first;
@@ -159,16 +185,16 @@ void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last) {
   }
   int axis = 0;
   for (int k = 1; k < 3; ++k)
-    if (nd.hi[k] - nd.lo[k] > nd.hi[axis] - nd.lo[axis]) axis = k;
+    if (bhi[k] - blo[k] > bhi[axis] - blo[axis]) axis = k;
   const uint32_t mid = first + (last - first) / 2;
-  std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + last,
-                   [&](uint32_t a, uint32_t b) { return centre_[a][axis] < centre_[b][axis]; });
-  nd.left = static_cast<uint32_t>(nodes_.size());
+  std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + last,
+                   [&](uint32_t a, uint32_t b) { return centre[a][axis] < centre[b][axis]; });
+  nd.first = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   nodes_.emplace_back();
   nodes_[id] = nd;
-  build(nd.left, first, mid);
-  build(nd.left + 1, mid, last);
+  build(nd.first, first, mid, order, lo, hi, centre);
+  build(nd.first + 1, mid, last, order, lo, hi, centre);
 }
 
 namespace {
@@ -184,6 +210,10 @@ SignedDistance::SignedDistance(const TriMesh& mesh)
     : mesh_(mesh), distance_(mesh), face_normal_(mesh.triangles.size()), vertex_normal_(mesh.positions.size()),
       edge_normal_(mesh.triangles.size()) {
   const auto& P = mesh.positions;
+  Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
+  for (const Vec3& p : P)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  if (!P.empty()) on_surface_ = kOnSurface * norm3(sub3(hi, lo));
   std::unordered_map<uint64_t, Vec3> edge_sum;  // undirected edge -> sum of its faces' normals
   auto key = [](uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); };
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
@@ -225,7 +255,10 @@ double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hi
   }
   const Vec3 away = sub3(p, n.point);
   const bool outside = dot3(away, pseudo) >= 0;
-  gradient = n.distance > 0 ? scale3(away, (outside ? 1 : -1) / n.distance) : unit_or_zero(pseudo);
+  // On the surface (a root finder lands there) the gradient is the nearest face's normal: the
+  // direction to the nearest point is noise, and on an edge or a vertex the pseudonormal's
+  // plane would cut the crease where each face's plane holds the point.
+  gradient = n.distance > on_surface_ ? scale3(away, (outside ? 1 : -1) / n.distance) : face_normal_[n.triangle];
   return outside ? n.distance : -n.distance;
 }
 

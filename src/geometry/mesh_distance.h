@@ -31,26 +31,32 @@ class MeshDistance {
   explicit MeshDistance(const TriMesh& mesh);
   /// Unsigned distance from p to the mesh (infinity for an empty mesh).
   double distance(const Vec3& p) const;
-  /// The mesh's point nearest p (the mesh must have a triangle). `hint`, when given, is a
-  /// triangle likely near p (the answer for a point close by): its distance bounds the search
-  /// from the start; it is set to the answer's triangle.
+  /// The mesh's point nearest p (the mesh must have a triangle). `hint`, when given, names
+  /// where the answer for a point close by was found (opaque; start with 0): that triangle's
+  /// distance bounds the search from the start. It is set to this answer's.
   Nearest nearest(const Vec3& p, uint32_t* hint = nullptr) const;
 
  private:
+  // Boxes in float, rounded outward: half the bytes per node, and a box only prunes.
   struct BNode {
-    Vec3 lo, hi;
-    uint32_t left = 0;   // internal: children at left, left + 1
-    uint32_t first = 0;  // leaf: range in order_
+    float lo[3], hi[3];
+    uint32_t first = 0;  // internal: children at first, first + 1; leaf: range in tris_
     uint32_t count = 0;  // 0 = internal
   };
-  static double box_distance2(const BNode& nd, const Vec3& p);
-  void build(uint32_t id, uint32_t first, uint32_t last);
+  struct LeafTriangle {
+    Vec3 a, b, c;
+    float lo[3], hi[3];
+    uint32_t id;  // index in the mesh
+  };
+  template <class Box>
+  static double box_distance2(const Box& box, const Vec3& p);
+  void build(uint32_t id, uint32_t first, uint32_t last, std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+             const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
 
-  const TriMesh& mesh_;
-  std::vector<uint32_t> order_;
-  std::vector<Vec3> lo_, hi_, centre_;
+  size_t triangles_ = 0;
+  std::vector<LeafTriangle> tris_;  // in leaf order
   std::vector<BNode> nodes_;
 };
 
@@ -60,7 +66,7 @@ class SignedDistance {
   explicit SignedDistance(const TriMesh& mesh);
   double operator()(const Vec3& p, uint32_t* hint = nullptr) const;
   /// The signed distance and its gradient (unit length, pointing outward; the nearest
-  /// feature's pseudonormal where p is on the surface). `hint`: see MeshDistance::nearest.
+  /// face's normal where p is on the surface). `hint`: see MeshDistance::nearest.
   double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr) const;
 
  private:
@@ -68,6 +74,7 @@ class SignedDistance {
   MeshDistance distance_;
   std::vector<Vec3> face_normal_, vertex_normal_;
   std::vector<std::array<Vec3, 3>> edge_normal_;  // per triangle, edge k: from vertex k to k + 1
+  double on_surface_ = 0;                          // nearer than this: on the surface
 };
 
 }  // namespace pic::detail

@@ -98,6 +98,9 @@ inline constexpr double kFlatNeighbourCosine = 1e-8;
 /// A point this close to a face's plane, as a fraction of the solid's extent, is on it (convex
 /// tests and the clipping of convex pieces).
 inline constexpr double kOnPlane = 1e-9;
+/// A point nearer a mesh than this fraction of the mesh's size is on it: the direction to its
+/// nearest point is rounding noise there, so the nearest face's normal stands for the gradient.
+inline constexpr double kOnSurface = 1e-10;
 /// Two planes of a hull are one when their normals' cosine is within this of 1 ...
 inline constexpr double kSamePlaneCosine = 1e-12;
 /// ... and their offsets agree to this, relative to the offset (plus one).

@@ -112,4 +112,25 @@ SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samp
   return r;
 }
 
+OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference, double offset, size_t samples) {
+  const MeshTopology t = analyze_topology(reference);
+  if (!t.closed() || !t.manifold() || t.inconsistent_edges != 0)
+    throw InvalidInput("the offset's reference must be closed, 2-manifold and consistently oriented");
+  const detail::SignedDistance sd(reference);
+  const std::vector<Vec3> pts = sample_surface(surface, samples, 12345);
+  std::vector<double> d(pts.size());
+  tbb::parallel_for(size_t{0}, pts.size(), size_t{4096}, [&](size_t begin) {
+    const size_t end = std::min(pts.size(), begin + 4096);
+    for (size_t i = begin; i < end; ++i) d[i] = std::abs(sd(pts[i]) - offset);
+  });
+  OffsetDistance r;
+  for (size_t i = 0; i < d.size(); ++i) {
+    if (d[i] > r.worst) r.worst = d[i], r.where = pts[i];
+    if (i < surface.positions.size()) r.worst_vertex = std::max(r.worst_vertex, d[i]);
+    r.mean += d[i];
+  }
+  if (!d.empty()) r.mean /= double(d.size());
+  return r;
+}
+
 }  // namespace pic

@@ -165,6 +165,29 @@ class ImplicitSampler {
     return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
   }
 
+  /// The crossing between a (value fa) and b as crossing() finds it, with f's gradient there,
+  /// by Newton steps on f and its gradient from one evaluation, kept inside the bracket that
+  /// the values shrink (bisection where a step would leave it).
+  std::pair<Vec3, Vec3> newton_crossing(const Vec3& a, double fa, const Vec3& b, double fb) {
+    const Vec3 ab = sub3(b, a);
+    auto at = [&](double t) { return add3(a, scale3(ab, t)); };
+    double lo = 0, hi = 1, t = std::clamp(fa / (fa - fb), 0.0, 1.0);
+    Vec3 g{0, 0, 0};
+    for (int it = 0; it < 40; ++it) {
+      ++evaluations;
+      const double fx = f_.value_gradient(world(at(t)), g);
+      if (fx == 0) break;
+      ((fx < 0) == (fa < 0) ? lo : hi) = t;
+      const double slope = dot3(g, ab) * cube_.size;
+      double next = t - fx / slope;
+      if (!(next > lo && next < hi)) next = (lo + hi) / 2;
+      const bool done = std::abs(next - t) < 1e-6;
+      t = next;
+      if (done || hi - lo < 1e-6) break;
+    }
+    return {at(t), g};
+  }
+
   /// A plane per sign-changing edge: through f's zero on it, normal to f's gradient there.
   void hermite_planes(const Cell& cell, const std::array<double, 8>& v, uint8_t signs, Qef& q) {
     const Vec3 m = cell.min_unit();
@@ -176,8 +199,13 @@ class ImplicitSampler {
       const Lat a = cell.corner(c0);
       EdgeHermite& h = edges_.slot(edge_memo_slot(a, edge_axis(e), cell.span(), decltype(edges_)::kBits));
       if (!h.filled || h.a != a || h.axis != edge_axis(e) || h.span != cell.span()) {
-        const Vec3 x = crossing(corner(c0), v[c0], corner(c1), v[c1]);
-        h = {a, cell.span(), edge_axis(e), true, x, gradient(x, s)};
+        if (f_.value_gradient) {
+          const auto [x, g] = newton_crossing(corner(c0), v[c0], corner(c1), v[c1]);
+          h = {a, cell.span(), edge_axis(e), true, x, g};
+        } else {
+          const Vec3 x = crossing(corner(c0), v[c0], corner(c1), v[c1]);
+          h = {a, cell.span(), edge_axis(e), true, x, gradient(x, s)};
+        }
       }
       const Vec3 &x = h.x, &g = h.g;
       const double len = norm3(g);
@@ -188,28 +216,39 @@ class ImplicitSampler {
   }
 
   void subdivide(const Cell& cell, const std::array<double, 8>& v, Builder& out, uint32_t slot, size_t& capped) {
-    // The 27-point child grid: the parent's corners known, the other 19 evaluated once.
+    // The 27-point child grid: the parent's corners known, the other 19 evaluated when a child
+    // needs them (a child that a parent corner's value proves away from the surface does not).
     std::array<double, 27> g{};
+    std::array<bool, 27> known{};
     const int64_t h = cell.span() / 2;
     for (int i = 0; i < 27; ++i) {
       const int a = i % 3, b = (i / 3) % 3, c = i / 9;
-      if (a != 1 && b != 1 && c != 1) {
-        g[i] = v[(a / 2) | ((b / 2) << 1) | ((c / 2) << 2)];
-        continue;
-      }
-      g[i] = value_at({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
+      if (a != 1 && b != 1 && c != 1) g[i] = v[(a / 2) | ((b / 2) << 1) | ((c / 2) << 2)], known[i] = true;
     }
+    auto grid = [&](int i) {
+      if (!known[i]) {
+        const int a = i % 3, b = (i / 3) % 3, c = i / 9;
+        g[i] = value_at({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
+        known[i] = true;
+      }
+      return g[i];
+    };
     auto child_values = [&](int c) {
       std::array<double, 8> cv;
       for (int k = 0; k < 8; ++k) {
         const int a = (c & 1) + (k & 1), b = ((c >> 1) & 1) + ((k >> 1) & 1), d = ((c >> 2) & 1) + ((k >> 2) & 1);
-        cv[k] = g[a + 3 * b + 9 * d];
+        cv[k] = grid(a + 3 * b + 9 * d);
       }
       return cv;
     };
+    // The child at corner c is out of reach when |f| there exceeds its diagonal: sample() would
+    // find it so from that one value.
+    const double child_diagonal = f_.lipschitz * cell.size() / 2 * cube_.size * std::sqrt(3.0);
+    auto away = [&](int c) { return std::abs(v[c]) > child_diagonal; };
     const uint32_t first = out.alloc_children();
     out.nodes[slot] = Node{first, CellKind::Internal, 0, 0, 0};
     if (cell.level < parallel_levels_) {
+      for (int i = 0; i < 27; ++i) grid(i);
       std::array<Builder, 8> subs;
       std::array<size_t, 8> caps{};
       tbb::parallel_for(0, 8, [&](int c) {
@@ -222,7 +261,10 @@ class ImplicitSampler {
       }
       return;
     }
-    for (int c = 0; c < 8; ++c) sample(cell.child(c), child_values(c), out, first + c, capped);
+    for (int c = 0; c < 8; ++c) {
+      if (away(c)) out.set_uniform(first + c, v[c] < 0);
+      else sample(cell.child(c), child_values(c), out, first + c, capped);
+    }
   }
 };
 

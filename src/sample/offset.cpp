@@ -63,6 +63,11 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     const double d = sd.with_gradient(p, grad, &hints.local());
     return detail::scale3(grad, g(d).second);
   };
+  solid.value_gradient = [&](const Vec3& p, Vec3& grad) {
+    const auto [v, slope] = g(sd.with_gradient(p, grad, &hints.local()));
+    grad = detail::scale3(grad, slope);
+    return v;
+  };
   SampleOptions o = options;
   o.cube = cube;
   return sample(solid, o, stats);
@@ -150,6 +155,7 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
     value(p, g);
     return g;
   };
+  f.value_gradient = value;
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
