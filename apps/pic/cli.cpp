@@ -87,12 +87,16 @@ ContourFile write_contour(const Octree& tree, const std::string& path, const Con
   const auto t0 = Clock::now();
   f.mesh = contour(tree, o, &f.stats);
   f.seconds = since(t0);
+  write_contoured(f, path, o);
+  return f;
+}
+
+void write_contoured(ContourFile& f, const std::string& path, const ContourOptions& o) {
   // What the file will hold: the checks after this count the file's crossings, not those of
   // positions it cannot store.
   if (stores_float32(path)) f.mesh = round_to_float32(f.mesh);
   write_mesh(f.mesh, path);
   f.written = {path, analyze_topology(f.mesh), known_crossings(o)};
-  return f;
 }
 
 std::string info_json(const Octree& tree, size_t file_bytes) {

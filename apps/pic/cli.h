@@ -88,6 +88,8 @@ struct ContourFile {
 };
 /// Contours `tree` with options `o` and writes the mesh to `path`.
 ContourFile write_contour(const Octree& tree, const std::string& path, const ContourOptions& o);
+/// Writes a contour made with options `o` (f.mesh) to `path`, filling f.written.
+void write_contoured(ContourFile& f, const std::string& path, const ContourOptions& o);
 
 /// `pic info` as JSON and as a table.
 std::string info_json(const Octree& tree, size_t file_bytes);

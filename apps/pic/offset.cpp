@@ -29,13 +29,17 @@ TriMesh input_mesh(const std::string& path) {
   return g.mesh;
 }
 
-/// Runs `op`, writes the result (a .pic, or a mesh contoured from it) and reports.
-void finish(const VolumeArgs& a, const std::string& what, const std::function<Octree(SampleStats*)>& op) {
+/// Runs `op`, writes the result (a .pic, or its mesh with the edge points on the exact
+/// surface) and reports.
+void finish(const VolumeArgs& a, const std::string& what,
+            const std::function<Octree(SampleStats*, VolumeMesh*)>& op) {
   const auto t0 = Clock::now();
   progress(what + " " + a.in);
   SampleStats st;
-  const Octree tree = op(&st);
-  const double seconds = since(t0);
+  const bool to_mesh = is_mesh_path(a.out);
+  VolumeMesh vm;
+  const Octree tree = op(&st, to_mesh ? &vm : nullptr);
+  const double seconds = since(t0) - vm.seconds;
   Json j;
   j.add("seconds", seconds)
       .add("pics", analyze(tree).pics)
@@ -43,10 +47,13 @@ void finish(const VolumeArgs& a, const std::string& what, const std::function<Oc
       .add("evaluations", st.evaluations)
       .raw("cube", cube_json(tree.cube));
   std::optional<WrittenMesh> written;
-  if (is_mesh_path(a.out)) {
-    const ContourFile f = write_contour(tree, a.out, ContourOptions{});
+  if (to_mesh) {
+    ContourFile f;
+    f.mesh = std::move(vm.mesh);
+    f.stats = vm.stats;
+    write_contoured(f, a.out, vm.options);
     written = f.written;
-    j.add("contour_seconds", f.seconds)
+    j.add("contour_seconds", vm.seconds)
         .add("triangles", f.mesh.triangles.size())
         .add("volume", volume(f.mesh))
         .raw("topology", topology_json(f.written.topology));
@@ -77,7 +84,7 @@ void add_volume(CLI::App& app) {
     auto a = std::make_shared<VolumeArgs>();
     auto* c = add_common(app, "offset", "Grow (distance > 0) or shrink (distance < 0) a solid", a);
     c->add_option("--distance", a->amount, "Offset distance in input units")->required();
-    c->callback([a] { finish(*a, "offsetting", [a](SampleStats* st) { return offset(input_mesh(a->in), a->amount, options_of(*a), st); }); });
+    c->callback([a] { finish(*a, "offsetting", [a](SampleStats* st, VolumeMesh* m) { return offset(input_mesh(a->in), a->amount, options_of(*a), st, m); }); });
   }
   {
     auto a = std::make_shared<VolumeArgs>();
@@ -85,7 +92,7 @@ void add_volume(CLI::App& app) {
     c->add_option("--thickness", a->amount, "Wall thickness in input units")->required();
     c->add_flag("--outward", a->outward, "A skin outside the solid instead of walls inside it");
     c->callback([a] {
-      finish(*a, "hollowing", [a](SampleStats* st) { return shell(input_mesh(a->in), a->amount, a->outward, options_of(*a), st); });
+      finish(*a, "hollowing", [a](SampleStats* st, VolumeMesh* m) { return shell(input_mesh(a->in), a->amount, a->outward, options_of(*a), st, m); });
     });
   }
   {
@@ -96,14 +103,14 @@ void add_volume(CLI::App& app) {
     c->add_flag("--concave", a->concave, "Fill the concave edges instead (fillets)");
     c->callback([a] {
       if (a->convex && a->concave) throw InvalidInput("--convex and --concave exclude each other");
-      finish(*a, "rounding", [a](SampleStats* st) { return round_edges(input_mesh(a->in), a->amount, !a->concave, options_of(*a), st); });
+      finish(*a, "rounding", [a](SampleStats* st, VolumeMesh* m) { return round_edges(input_mesh(a->in), a->amount, !a->concave, options_of(*a), st, m); });
     });
   }
   {
     auto a = std::make_shared<VolumeArgs>();
     auto* c = add_common(app, "thicken", "Make the solid within thickness / 2 of a surface (open or closed)", a);
     c->add_option("--thickness", a->amount, "Total thickness in input units")->required();
-    c->callback([a] { finish(*a, "thickening", [a](SampleStats* st) { return thicken(input_mesh(a->in), a->amount, options_of(*a), st); }); });
+    c->callback([a] { finish(*a, "thickening", [a](SampleStats* st, VolumeMesh* m) { return thicken(input_mesh(a->in), a->amount, options_of(*a), st, m); }); });
   }
 }
 

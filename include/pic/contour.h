@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 
 #include "pic/octree.h"
 
@@ -26,6 +27,11 @@ struct ContourOptions {
   /// each within this many finest cells of every original plane it replaces (simplify());
   /// 0: the raw contour, a vertex per gray leaf.
   double simplify = 0;
+  /// The sampled solid's function, when known (input coordinates, < 0 inside: the function a
+  /// volume operation or pic::sample of an ImplicitSolid sampled): the points the contour adds
+  /// on cell edges go where it changes sign there, on the surface, instead of where the edge
+  /// meets the surface the vertices around it span.
+  std::function<double(const Vec3&)> surface;
 };
 struct ContourStats {
   size_t fans = 0;            ///< polygons triangulated as a fan around a point on their edge

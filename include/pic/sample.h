@@ -94,7 +94,8 @@ struct ImplicitSolid {
 /// gradient, refinement where the QEF residual exceeds the error; a cell that f's bound keeps
 /// away from the surface (|f| beyond its reach from the cell's centre or a corner) is never
 /// subdivided.
-/// Throws InvalidInput without a cube or a function, or when the solid is empty in the cube.
+/// Throws InvalidInput without a cube or a function; EmptySolid when the solid is empty in the
+/// cube (or fills it).
 Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats = nullptr);
 
 /// The automatic root cube for a mesh: bounding cube enlarged by `margin` of the extent.

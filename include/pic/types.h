@@ -17,6 +17,11 @@ class InvalidInput : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
+/// An operation whose result has no surface in its cube: nothing (or everything) inside.
+class EmptySolid : public InvalidInput {
+ public:
+  using InvalidInput::InvalidInput;
+};
 /// A file could not be read or written, or a .pic file is corrupted / foreign.
 class IoError : public std::runtime_error {
  public:

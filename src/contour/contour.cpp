@@ -61,7 +61,7 @@ TriMesh contour(const Octree& tree, const ContourOptions& options, ContourStats*
   for (auto& p : polys)
     for (int k = 0; k < p.count; ++k) p.v[k] = remap[p.v[k]];
   TriangulationStats ts;
-  out.triangles = triangulate(out.positions, cells, polys, how, inset, &ts);
+  out.triangles = triangulate(out.positions, cells, polys, how, inset, options.surface, &ts);
   if (stats) {
     stats->fans = ts.fans;
     stats->other_diagonal = ts.other_diagonal;

@@ -26,6 +26,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "geometry/root.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
@@ -249,6 +250,7 @@ struct PlainSurface {
   const std::vector<MeshPolygon>& polys;
   const std::vector<Split>& splits;
   std::vector<uint32_t> first, around;
+  const SurfaceFunction& level;  // the sampled function, when known
 
   std::pair<const uint32_t*, size_t> near(uint32_t v) const {
     return {around.data() + first[v], size_t(first[v + 1] - first[v])};
@@ -260,6 +262,27 @@ struct PlainSurface {
 // further out (a fold can put the plain crossing a polygon away); else the ring's mean plane.
 double edge_parameter(const PlainSurface& s, size_t i) {
   const MeshPolygon& p = s.polys[i];
+  if (s.level) {
+    // The function's own zero on the edge. Where its ends' values agree in sign (the settling
+    // turned a corner), the zero between the first two of 32 samples that disagree, else the
+    // sample where |f| is least.
+    const auto at = [&](double t) { return add3(p.e0, scale3(sub3(p.e1, p.e0), t)); };
+    const auto f = [&](double t) { return s.level(at(t)); };
+    const double f0 = f(0), f1 = f(1);
+    if ((f0 < 0) != (f1 < 0)) return illinois_root(f, f0, f1, 1e-6, 40);
+    constexpr int kSamples = 32;
+    double best = 0, least = std::abs(f0), prev = f0;
+    for (int k = 1; k <= kSamples; ++k) {
+      const double t = double(k) / kSamples, ft = k == kSamples ? f1 : f(t);
+      if ((ft < 0) != (prev < 0)) {
+        const double t0 = double(k - 1) / kSamples;
+        return t0 + illinois_root([&](double u) { return f(t0 + u / kSamples); }, prev, ft, 1e-5, 40) / kSamples;
+      }
+      if (std::abs(ft) < least) least = std::abs(ft), best = t;
+      prev = ft;
+    }
+    return best;
+  }
   std::array<Vec3, 4> q;
   for (int k = 0; k < p.count; ++k) q[k] = s.x[p.v[k]];
   const double prefer = ring_height(q, p.count, p.e0, p.e1);
@@ -315,6 +338,35 @@ bool chord_across_face(const PlainSurface& s, uint32_t a, uint32_t b, const Face
   for (int k = 0; k < 3; ++k)
     if (k != face.axis) f[k] = std::clamp(f[k], face.lo[k] + inset, face.hi[k] - inset);
   return true;
+}
+
+// Moves face point f, within its face, onto the zero of the solid's function: Newton steps
+// along the function's gradient in the face's plane (central differences), kept `inset` inside
+// the face, each taken only when it lowers |level|. A face point anywhere strictly inside its
+// face keeps the construction's argument, so this moves no triangle across another.
+void onto_level_in_face(const SurfaceFunction& level, const Face& face, double inset, Vec3& f) {
+  double size = 0;
+  for (int d = 0; d < 3; ++d)
+    if (d != face.axis) size = std::max(size, face.hi[d] - face.lo[d]);
+  const double h = size * 1e-4, enough = size * 1e-4;
+  double v = level(f);
+  for (int it = 0; it < 4 && std::abs(v) > enough; ++it) {
+    Vec3 g{0, 0, 0};
+    for (int d = 0; d < 3; ++d) {
+      if (d == face.axis) continue;
+      Vec3 a = f, b = f;
+      a[d] -= h, b[d] += h;
+      g[d] = (level(b) - level(a)) / (2 * h);
+    }
+    const double g2 = dot3(g, g);
+    if (!(g2 > 0)) return;
+    Vec3 next = sub3(f, scale3(g, v / g2));
+    for (int d = 0; d < 3; ++d)
+      if (d != face.axis) next[d] = std::clamp(next[d], face.lo[d] + inset, face.hi[d] - inset);
+    const double w = level(next);
+    if (!(std::abs(w) < std::abs(v))) return;
+    f = next, v = w;
+  }
 }
 
 // True when the triangles `tris` (index triples into ring `r`) lie in the ring of tetrahedra
@@ -456,7 +508,7 @@ std::array<std::array<int, 3>, 2> split_quad(const std::array<Vec3, 4>& p) {
 
 std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
                              const std::vector<MeshPolygon>& polys, Triangulation how, double inset,
-                             TriangulationStats* stats) {
+                             const SurfaceFunction& level, TriangulationStats* stats) {
   const size_t n = polys.size();
   const auto ring_of = [&](size_t i) {
     std::array<Vec3, 4> q;
@@ -494,7 +546,7 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
         plain[i] = uint8_t(tris + (other ? 4 : 0));
   });
   // Each vertex's polygons (CSR): the plain surface around a polygon.
-  PlainSurface surface{x, polys, splits, std::vector<uint32_t>(x.size() + 1, 0), {}};
+  PlainSurface surface{x, polys, splits, std::vector<uint32_t>(x.size() + 1, 0), {}, level};
   std::vector<uint32_t>&first = surface.first, &around = surface.around;
   for (const MeshPolygon& p : polys)
     for (int k = 0; k < p.count; ++k) ++first[p.v[k] + 1];
@@ -548,6 +600,7 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       for (int d = 0; d < 3; ++d)
         if (d != face.axis) f[d] = std::clamp(q[d], face.lo[d] + inset, face.hi[d] - inset);
     }
+    if (level) onto_level_in_face(level, face, inset, f);
     face_x[j] = f;
   });
   // A polygon with face points: its ring (the sides split there) as a fan from one of its

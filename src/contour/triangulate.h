@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "octree/dual_walk.h"
@@ -30,12 +31,18 @@ struct TriangulationStats {
   size_t face_fans = 0;       // polygons with face points, fanned from a point of their own ring
 };
 
+/// The solid's function in output coordinates (< 0 inside), or empty.
+using SurfaceFunction = std::function<double(const Vec3&)>;
+
 /// Triangles of the dual polygons (vertex ids into `x`; edge and face points are appended to
 /// `x`). `cells`: each vertex's cell; with kConstruct and kFanAll every vertex must lie
-/// strictly inside its cell. Edge and face points stay `inset` inside their edge or face.
+/// strictly inside its cell. Edge and face points stay `inset` inside their edge or face; an
+/// edge point lies where `level` changes sign on its edge when given, else where the edge
+/// meets the plain split of the polygons around it.
 std::vector<std::array<uint32_t, 3>> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>& cells,
                                                  const std::vector<MeshPolygon>& polys, Triangulation how,
-                                                 double inset, TriangulationStats* stats);
+                                                 double inset, const SurfaceFunction& level,
+                                                 TriangulationStats* stats);
 
 /// Splits a quad along the diagonal that folds most (keeps sharp creases whose two vertices
 /// lie on the crease); returns the 2 triangles as index triples into `quad`.

@@ -13,6 +13,7 @@
 #include "geometry/lattice.h"
 #include "geometry/memo.h"
 #include "geometry/qef.h"
+#include "geometry/root.h"
 #include "geometry/stopwatch.h"
 #include "geometry/vec3.h"
 #include "octree/cell.h"
@@ -138,31 +139,13 @@ class ImplicitSampler {
     return g;
   }
 
-  /// The point where f changes sign between a (value fa) and b (value fb), by false position
-  /// with the Illinois step, to a millionth of the edge.
+  /// The point where f changes sign between a (value fa) and b (value fb), to a millionth of
+  /// the edge.
   Vec3 crossing(const Vec3& a, double fa, const Vec3& b, double fb) {
-    double lo = 0, hi = 1;
-    int last = 0;
-    for (int it = 0; it < 40 && hi - lo > 1e-6; ++it) {
-      const double t = std::clamp(lo + (hi - lo) * fa / (fa - fb), lo + (hi - lo) * 1e-3, hi - (hi - lo) * 1e-3);
-      const Vec3 x{a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
-      const double fx = value(x);
-      if (fx == 0) {
-        lo = hi = t;
-        break;
-      }
-      if ((fx < 0) == (fa < 0)) {
-        lo = t, fa = fx;
-        if (last == 1) fb /= 2;
-        last = 1;
-      } else {
-        hi = t, fb = fx;
-        if (last == -1) fa /= 2;
-        last = -1;
-      }
-    }
-    const double t = (lo + hi) / 2;
-    return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
+    auto at = [&](double t) {
+      return Vec3{a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
+    };
+    return at(illinois_root([&](double t) { return value(at(t)); }, fa, fb, 1e-6, 40));
   }
 
   /// The crossing between a (value fa) and b as crossing() finds it, with f's gradient there,
@@ -294,7 +277,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   // Leaves the cap stopped with two surface components get one, as after any sampling.
   settle_sampled(tree, SettleRegion{});
   PIC_CHECK_OCTREE(tree, "sampling a function");
-  if (tree.vertices.empty()) throw InvalidInput("the function's solid does not meet the cube's inside and outside");
+  if (tree.vertices.empty()) throw EmptySolid("the function's solid does not meet the cube's inside and outside");
   if (stats) {
     *stats = SampleStats{};
     stats->max_depth = stats->depth = options.depth;

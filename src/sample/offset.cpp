@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "geometry/mesh_distance.h"
+#include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "pic/contour.h"
@@ -48,10 +50,23 @@ TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
   return contour(sample(mesh, options));
 }
 
+/// Samples f in options.cube and, when asked, contours it with its edge points on f's zero.
+Octree sample_with_mesh(const ImplicitSolid& f, const SampleOptions& options, SampleStats* stats, VolumeMesh* mesh) {
+  Octree tree = sample(f, options, stats);
+  if (mesh) {
+    const auto t0 = detail::Clock::now();
+    ContourOptions co = mesh->options;
+    co.surface = f.value;
+    mesh->mesh = contour(tree, co, &mesh->stats);
+    mesh->seconds = detail::since(t0);
+  }
+  return tree;
+}
+
 /// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1.
 template <class G>
 Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, SampleStats* stats,
-                       G&& g) {
+                       VolumeMesh* mesh, G&& g) {
   const SignedDistance sd(surface);
   // Per thread, the triangle nearest the last point asked: the sampler asks in cell order,
   // so the next point's nearest triangle is usually that one or a neighbour.
@@ -70,7 +85,7 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
   };
   SampleOptions o = options;
   o.cube = cube;
-  return sample(solid, o, stats);
+  return sample_with_mesh(solid, o, stats, mesh);
 }
 
 /// A round convex body about its centroid: support h(u) = max (v - c).u.
@@ -128,7 +143,7 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
 bool is_round_body(const std::vector<Vec3>& points) { return round_body_if_round(points).has_value(); }
 
 Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, const SampleOptions& options,
-                       SampleStats* stats) {
+                       SampleStats* stats, VolumeMesh* mesh) {
   const std::optional<RoundBody> found = round_body_if_round(round);
   if (!found)
     throw InvalidInput("the Minkowski sum takes a round body here: a faceted sphere, every vertex and facet "
@@ -161,48 +176,69 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   f.lipschitz = 2;
   SampleOptions o = options;
   o.cube = cube;
-  return sample(f, o, stats);
+  return sample_with_mesh(f, o, stats, mesh);
 }
 
-Octree offset(const TriMesh& solid, double distance, const SampleOptions& options, SampleStats* stats) {
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options, SampleStats* stats,
+              VolumeMesh* mesh) {
   check_finite(distance, "the offset distance");
   const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, distance, options);
-  return sample_distance(surface, cube, options, stats, [&](double d) { return std::pair{d - distance, 1.0}; });
+  try {
+    return sample_distance(surface, cube, options, stats, mesh,
+                           [&](double d) { return std::pair{d - distance, 1.0}; });
+  } catch (const EmptySolid&) {
+    if (distance >= 0) throw;
+    char what[160];
+    std::snprintf(what, sizeof what, "shrinking by %g leaves nothing: no point of the solid lies deeper than that",
+                  -distance);
+    throw EmptySolid(what);
+  }
 }
 
-Octree offset(const Octree& solid, double distance, const SampleOptions& options, SampleStats* stats) {
+Octree offset(const Octree& solid, double distance, const SampleOptions& options, SampleStats* stats,
+              VolumeMesh* mesh) {
   SampleOptions o = options;
   if (!o.cube && distance <= 0) o.cube = solid.cube;
-  return offset(contour(solid), distance, o, stats);
+  return offset(contour(solid), distance, o, stats, mesh);
 }
 
-Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options,
-             SampleStats* stats) {
+Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options, SampleStats* stats,
+             VolumeMesh* mesh) {
   check_finite(thickness, "the shell thickness");
   if (!(thickness > 0)) throw InvalidInput("the shell thickness must be positive");
   const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, outward ? thickness : 0, options);
   // Inward: inside the solid and farther than T from its surface's inside; outward: within T
   // outside it. max of two distances of slope 1 is a distance bound of slope 1.
-  return sample_distance(surface, cube, options, stats, [&](double d) {
+  return sample_distance(surface, cube, options, stats, mesh, [&](double d) {
     const double a = outward ? d - thickness : d, b = outward ? -d : -d - thickness;
     return a >= b ? std::pair{a, 1.0} : std::pair{b, -1.0};
   });
 }
 
 Octree round_edges(const TriMesh& solid, double radius, bool convex, const SampleOptions& options,
-                   SampleStats* stats) {
+                   SampleStats* stats, VolumeMesh* mesh) {
   check_finite(radius, "the rounding radius");
   if (!(radius > 0)) throw InvalidInput("the rounding radius must be positive");
   const TriMesh surface = closed_surface(solid, options);
   SampleOptions o = options;
   o.cube = cube_around(surface, convex ? 0 : radius, options);
-  const Octree first = offset(surface, convex ? -radius : radius, o);
-  return offset(contour(first), convex ? radius : -radius, o, stats);
+  // The first offset's surface with its edge points on the exact offset, for the second.
+  VolumeMesh first;
+  try {
+    offset(surface, convex ? -radius : radius, o, nullptr, &first);
+  } catch (const EmptySolid&) {
+    char what[160];
+    std::snprintf(what, sizeof what, "rounding with radius %g leaves nothing: no point of the solid lies deeper than that",
+                  radius);
+    throw EmptySolid(what);
+  }
+  return offset(first.mesh, convex ? radius : -radius, o, stats, mesh);
 }
 
-Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options, SampleStats* stats) {
+Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options, SampleStats* stats,
+               VolumeMesh* mesh) {
   check_finite(thickness, "the thickness");
   if (!(thickness > 0)) throw InvalidInput("the thickness must be positive");
   if (surface.triangles.empty()) throw InvalidInput("nothing to thicken: the mesh has no triangles");
@@ -215,9 +251,14 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
     const detail::Nearest n = distance.nearest(p, &hints.local());
     return n.distance > 0 ? detail::scale3(detail::sub3(p, n.point), 1 / n.distance) : Vec3{0, 0, 1};
   };
+  solid.value_gradient = [&](const Vec3& p, Vec3& grad) {
+    const detail::Nearest n = distance.nearest(p, &hints.local());
+    grad = n.distance > 0 ? detail::scale3(detail::sub3(p, n.point), 1 / n.distance) : Vec3{0, 0, 1};
+    return n.distance - half;
+  };
   SampleOptions o = options;
   o.cube = cube_around(surface, half, options);
-  return sample(solid, o, stats);
+  return sample_with_mesh(solid, o, stats, mesh);
 }
 
 }  // namespace pic
