@@ -128,7 +128,7 @@ std::unique_ptr<PyOctree> volume_op(py::handle x, int depth, double error, py::h
 }
 
 /// An implicit solid from a Python function of an (n, 3) array of points returning n values
-/// (and optionally their (n, 3) gradients). Called one point at a time, with the GIL.
+/// (and optionally their (n, 3) gradients), called on each batch of the sampler's points.
 std::unique_ptr<PyOctree> sample_function(py::object f, py::handle cube, int depth, double error, py::object gradient,
                                           double lipschitz) {
   pic::SampleOptions o;
@@ -137,26 +137,28 @@ std::unique_ptr<PyOctree> sample_function(py::object f, py::handle cube, int dep
   o.cube = to_cube(cube);
   if (!o.cube) throw py::value_error("sample_function needs a cube (x, y, z, size)");
   o.parallel = false;  // one Python function: calls are serial anyway
-  auto as_row = [](const pic::Vec3& p) {
-    py::array_t<double> a({py::ssize_t{1}, py::ssize_t{3}});
+  auto as_rows = [](const std::vector<pic::Vec3>& p) {
+    py::array_t<double> a({py::ssize_t(p.size()), py::ssize_t{3}});
     auto r = a.mutable_unchecked<2>();
-    for (int k = 0; k < 3; ++k) r(0, k) = p[k];
+    for (size_t i = 0; i < p.size(); ++i)
+      for (int k = 0; k < 3; ++k) r(py::ssize_t(i), k) = p[i][k];
     return a;
   };
   pic::ImplicitSolid s;
   s.lipschitz = lipschitz;
-  s.value = [&](const pic::Vec3& p) {
+  s.values = [&](const std::vector<pic::Vec3>& p, std::vector<double>& out) {
     py::gil_scoped_acquire gil;
-    const py::array_t<double, py::array::c_style | py::array::forcecast> v = f(as_row(p));
-    if (v.size() != 1) throw pic::InvalidInput("sample_function: f must return one value per point");
-    return *v.data();
+    const py::array_t<double, py::array::c_style | py::array::forcecast> v = f(as_rows(p));
+    if (size_t(v.size()) != p.size()) throw pic::InvalidInput("sample_function: f must return one value per point");
+    out.assign(v.data(), v.data() + v.size());
   };
   if (!gradient.is_none())
-    s.gradient = [&](const pic::Vec3& p) {
+    s.gradients = [&](const std::vector<pic::Vec3>& p, std::vector<pic::Vec3>& out) {
       py::gil_scoped_acquire gil;
-      const py::array_t<double, py::array::c_style | py::array::forcecast> g = gradient(as_row(p));
-      if (g.size() != 3) throw pic::InvalidInput("sample_function: the gradient must be an (n, 3) array");
-      return pic::Vec3{g.data()[0], g.data()[1], g.data()[2]};
+      const py::array_t<double, py::array::c_style | py::array::forcecast> g = gradient(as_rows(p));
+      if (size_t(g.size()) != 3 * p.size()) throw pic::InvalidInput("sample_function: the gradient must be an (n, 3) array");
+      out.resize(p.size());
+      for (size_t i = 0; i < p.size(); ++i) out[i] = {g.data()[3 * i], g.data()[3 * i + 1], g.data()[3 * i + 2]};
     };
   pic::SampleStats st;
   pic::Octree tree;

@@ -87,6 +87,12 @@ struct ImplicitSolid {
   /// f and its gradient from one evaluation (optional; a distance's nearest point gives both):
   /// edge crossings are then found by Newton steps, about two evaluations per edge.
   std::function<double(const Vec3&, Vec3&)> value_gradient;
+  /// f at many points at once (optional, and then `value` is not needed): the sampler asks
+  /// each level's questions in batches -- a vectorised function (numpy) is called a few dozen
+  /// times per level instead of once per point.
+  std::function<void(const std::vector<Vec3>& points, std::vector<double>& values)> values;
+  /// The gradients at many points at once (optional).
+  std::function<void(const std::vector<Vec3>& points, std::vector<Vec3>& gradients)> gradients;
   double lipschitz = 1;
 };
 /// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs

@@ -3,15 +3,15 @@
 // per point holds by construction; a cell whose corners agree is subdivided unless f's
 // Lipschitz bound proves the surface out of reach, so no sign change hides in a coarse uniform
 // leaf above the cap (no cracks for the settling to mend).
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <optional>
+#include <vector>
 
 #include "geometry/lattice.h"
-#include "geometry/memo.h"
 #include "geometry/qef.h"
 #include "geometry/root.h"
 #include "geometry/stopwatch.h"
@@ -34,220 +34,341 @@ Vec3 lattice_unit(const Lat& l) {
   return {double(l[0]) * k, double(l[1]) * k, double(l[2]) * k};
 }
 
-/// f at a lattice point: up to 8 cells of a level ask for each of their corners, and a
-/// child grid's face and edge points are shared with the neighbours' grids.
-struct PointValue {
-  Lat p;
-  bool filled = false;
-  double f = 0;
-};
-/// The surface point on a cell edge and f's gradient there: up to 4 cells share the edge.
-struct EdgeHermite {
-  Lat a;
-  int64_t span = 0;
-  int axis = 0;
-  bool filled = false;
-  Vec3 x, g;
+/// A lattice point as one number, its coordinates' bits interleaved (21 bits each: kMaxLevel
+/// is 20): sorted so, a batch of points goes along a space-filling curve, and each query of a
+/// distance starts near the last one's answer.
+uint64_t spread(uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffull;
+  x = (x | x << 16) & 0x1f0000ff0000ffull;
+  x = (x | x << 8) & 0x100f00f00f00f00full;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+uint64_t gather(uint64_t x) {
+  x &= 0x1249249249249249ull;
+  x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
+  x = (x | x >> 4) & 0x100f00f00f00f00full;
+  x = (x | x >> 8) & 0x1f0000ff0000ffull;
+  x = (x | x >> 16) & 0x1f00000000ffffull;
+  x = (x | x >> 32) & 0x1fffff;
+  return x;
+}
+uint64_t pack(const Lat& l) { return spread(uint64_t(l[0])) | spread(uint64_t(l[1])) << 1 | spread(uint64_t(l[2])) << 2; }
+Lat unpack(uint64_t k) { return {int64_t(gather(k)), int64_t(gather(k >> 1)), int64_t(gather(k >> 2))}; }
+
+constexpr uint32_t kNone = ~uint32_t{0};
+
+/// Numbers the distinct keys of `refs` (key, owner) by their first owner: each owner's
+/// number goes to `id` (indexed by owner; owners not in `refs` keep kNone). Returns the
+/// count. Numbering by first owner keeps a batch in the order the cells asked, near points
+/// after near points (a distance query starts from the last one's answer).
+size_t number_keys(std::vector<std::pair<uint64_t, uint32_t>>& refs, std::vector<uint32_t>& id, bool parallel) {
+  std::fill(id.begin(), id.end(), kNone);
+  if (parallel) tbb::parallel_sort(refs.begin(), refs.end());
+  else std::sort(refs.begin(), refs.end());
+  size_t n = 0;
+  for (size_t i = 0; i < refs.size(); ++i) {
+    if (i > 0 && refs[i].first != refs[i - 1].first) ++n;
+    id[refs[i].second] = uint32_t(n);
+  }
+  const size_t count = refs.empty() ? 0 : n + 1;
+  std::vector<uint32_t> renumber(count, kNone);
+  uint32_t next = 0;
+  for (uint32_t& x : id)
+    if (x != kNone) {
+      if (renumber[x] == kNone) renumber[x] = next++;
+      x = renumber[x];
+    }
+  return count;
+}
+
+/// A cell waiting at its level, with f at its corners.
+struct Job {
+  Cell cell;
+  uint32_t slot;
+  std::array<double, 8> v;
 };
 
-class ImplicitSampler {
+/// A sign-changing cell edge, once per level (up to 4 cells share it): its ends in unit
+/// space, f there, and the surface point on it with f's gradient.
+struct Edge {
+  Vec3 a, b;
+  double fa = 0, fb = 0, size = 0;
+  Vec3 x{}, g{};
+};
+
+class LevelSampler {
  public:
-  ImplicitSampler(const ImplicitSolid& f, const Cube& cube, const SampleOptions& o)
-      : f_(f), cube_(cube), max_depth_(o.depth), error_(o.error), parallel_levels_(o.parallel ? 3 : 0) {}
+  LevelSampler(const ImplicitSolid& f, const Cube& cube, const SampleOptions& o)
+      : f_(f), cube_(cube), max_depth_(o.depth), error_(o.error), parallel_(o.parallel) {}
 
-  double value(const Vec3& unit) {
-    ++evaluations;
-    return f_.value(world(unit));
-  }
-
-  /// Samples `cell` (its corners' values `v`) into `out` at `slot`.
-  void sample(const Cell& cell, const std::array<double, 8>& v, Builder& out, uint32_t slot, size_t& capped) {
-    uint8_t signs = 0;
-    for (int k = 0; k < 8; ++k) signs |= uint8_t(v[k] < 0) << k;
-    const bool uniform = signs == 0 || signs == 0xff;
-    const bool at_cap = cell.level >= max_depth_;
-    if (uniform && (at_cap || out_of_reach(cell, v))) {
-      out.set_uniform(slot, signs != 0);
-      return;
+  /// f at unit-space points, as one batch.
+  std::vector<double> values(const std::vector<Vec3>& unit) {
+    std::vector<double> out(unit.size());
+    if (unit.empty()) return out;
+    evaluations += unit.size();
+    if (f_.values) {
+      std::vector<Vec3> w(unit.size());
+      for (size_t i = 0; i < unit.size(); ++i) w[i] = world(unit[i]);
+      f_.values(w, out);
+      if (out.size() != unit.size()) throw InvalidInput("the function must give one value per point");
+    } else {
+      for_each(unit.size(), [&](size_t i) { out[i] = f_.value(world(unit[i])); });
     }
-    if (!uniform && (at_cap || one_component(signs))) {
-      Qef q;
-      hermite_planes(cell, v, signs, q);
-      const Qef::Solution sol = cell_vertex(q, cell, signs);
-      // Edge crossings only see the surface where it meets the cell's edges: a rounded corner
-      // between them looks like the sharp one. The vertex must lie on the surface, within the
-      // error's distance (f is a distance bound in world units).
-      const double off = std::abs(value(sol.position)) / (f_.lipschitz * cube_.size);
-      const bool ok = sol.error < error_ && off * off < error_ && inside_cell(sol.position, cell) && one_component(signs);
-      if (ok || at_cap) {
-        if (!ok) ++capped;
-        out.set_gray(slot, cell, signs, sol.position, ok ? 0 : kFlagCapped);
-        return;
-      }
+    return out;
+  }
+
+  /// Samples the cube level by level from the root's corner values.
+  Builder run(const std::array<double, 8>& root, size_t& capped) {
+    Builder out;
+    out.nodes.resize(1);
+    std::vector<Job> jobs{{Cell{}, 0, root}};
+    while (!jobs.empty()) {
+      std::vector<Job> split;
+      settle_uniform(jobs, out, split);
+      place_vertices(jobs, out, split, capped);
+      jobs = subdivide(split, out);
     }
-    subdivide(cell, v, out, slot, capped);
+    return out;
   }
 
-  /// f at lattice point p (memoized).
-  double value_at(const Lat& p) {
-    PointValue& e = values_.slot(memo_slot(p, 0, decltype(values_)::kBits));
-    if (!e.filled || e.p != p) e = {p, true, value(lattice_unit(p))};
-    return e.f;
-  }
-
-  std::atomic<size_t> evaluations{0};
+  size_t evaluations = 0;
 
  private:
-  ThreadMemo<PointValue, 16> values_;
-  ThreadMemo<EdgeHermite, 14> edges_;
   const ImplicitSolid& f_;
   Cube cube_;
   int max_depth_;
   double error_;
-  int parallel_levels_;
+  bool parallel_;
+
+  template <class F>
+  void for_each(size_t n, F&& f) const {
+    if (parallel_ && n > 256) {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) f(i);
+      });
+    } else {
+      for (size_t i = 0; i < n; ++i) f(i);
+    }
+  }
 
   Vec3 world(const Vec3& unit) const {
     return {cube_.origin[0] + unit[0] * cube_.size, cube_.origin[1] + unit[1] * cube_.size,
             cube_.origin[2] + unit[2] * cube_.size};
   }
 
-  /// Whether f's bound keeps the surface out of the whole cell: |f| at the centre beyond the
-  /// half diagonal, or at a corner beyond the diagonal (world units).
-  bool out_of_reach(const Cell& cell, const std::array<double, 8>& v) {
-    const double diagonal = f_.lipschitz * cell.size() * cube_.size * std::sqrt(3.0);
-    for (double x : v)
-      if (std::abs(x) > diagonal) return true;
-    const Vec3 m = cell.min_unit();
-    const double h = cell.size() / 2;
-    return std::abs(value({m[0] + h, m[1] + h, m[2] + h})) > diagonal / 2;
+  static uint8_t signs_of(const std::array<double, 8>& v) {
+    uint8_t signs = 0;
+    for (int k = 0; k < 8; ++k) signs |= uint8_t(v[k] < 0) << k;
+    return signs;
   }
+  /// f's reach over a cell's diagonal, in world units.
+  double diagonal(const Cell& cell) const { return f_.lipschitz * cell.size() * cube_.size * std::sqrt(3.0); }
 
-  /// f's gradient at a unit-space point (its direction is the same in unit space).
-  Vec3 gradient(const Vec3& unit, double cell_size) {
-    if (f_.gradient) {
-      ++evaluations;
-      return f_.gradient(world(unit));
-    }
-    const double h = cell_size * 1e-3;
-    Vec3 g;
-    for (int k = 0; k < 3; ++k) {
-      Vec3 a = unit, b = unit;
-      a[k] -= h;
-      b[k] += h;
-      g[k] = (value(b) - value(a)) / (2 * h * cube_.size);
-    }
-    return g;
-  }
-
-  /// The point where f changes sign between a (value fa) and b (value fb), to a millionth of
-  /// the edge.
-  Vec3 crossing(const Vec3& a, double fa, const Vec3& b, double fb) {
-    auto at = [&](double t) {
-      return Vec3{a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
-    };
-    return at(illinois_root([&](double t) { return value(at(t)); }, fa, fb, 1e-6, 40));
-  }
-
-  /// The crossing between a (value fa) and b as crossing() finds it, with f's gradient there,
-  /// by Newton steps on f and its gradient from one evaluation, kept inside the bracket that
-  /// the values shrink (bisection where a step would leave it).
-  std::pair<Vec3, Vec3> newton_crossing(const Vec3& a, double fa, const Vec3& b, double fb) {
-    const Vec3 ab = sub3(b, a);
-    auto at = [&](double t) { return add3(a, scale3(ab, t)); };
-    double lo = 0, hi = 1, t = std::clamp(fa / (fa - fb), 0.0, 1.0);
-    Vec3 g{0, 0, 0};
-    for (int it = 0; it < 40; ++it) {
-      ++evaluations;
-      const double fx = f_.value_gradient(world(at(t)), g);
-      if (fx == 0) break;
-      ((fx < 0) == (fa < 0) ? lo : hi) = t;
-      const double slope = dot3(g, ab) * cube_.size;
-      double next = t - fx / slope;
-      if (!(next > lo && next < hi)) next = (lo + hi) / 2;
-      const bool done = std::abs(next - t) < 1e-6;
-      t = next;
-      if (done || hi - lo < 1e-6) break;
-    }
-    return {at(t), g};
-  }
-
-  /// A plane per sign-changing edge: through f's zero on it, normal to f's gradient there.
-  void hermite_planes(const Cell& cell, const std::array<double, 8>& v, uint8_t signs, Qef& q) {
-    const Vec3 m = cell.min_unit();
-    const double s = cell.size();
-    auto corner = [&](int k) { return Vec3{m[0] + (k & 1) * s, m[1] + ((k >> 1) & 1) * s, m[2] + ((k >> 2) & 1) * s}; };
-    for (int e = 0; e < 12; ++e) {
-      const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
-      if (((signs >> c0) & 1) == ((signs >> c1) & 1)) continue;
-      const Lat a = cell.corner(c0);
-      EdgeHermite& h = edges_.slot(edge_memo_slot(a, edge_axis(e), cell.span(), decltype(edges_)::kBits));
-      if (!h.filled || h.a != a || h.axis != edge_axis(e) || h.span != cell.span()) {
-        if (f_.value_gradient) {
-          const auto [x, g] = newton_crossing(corner(c0), v[c0], corner(c1), v[c1]);
-          h = {a, cell.span(), edge_axis(e), true, x, g};
-        } else {
-          const Vec3 x = crossing(corner(c0), v[c0], corner(c1), v[c1]);
-          h = {a, cell.span(), edge_axis(e), true, x, gradient(x, s)};
-        }
+  /// Uniform cells become leaves at the cap or where f's bound keeps the surface out of the
+  /// whole cell: |f| at a corner beyond the diagonal, else at the centre beyond half of it
+  /// (those centres asked in one batch). The rest go to `split`.
+  void settle_uniform(const std::vector<Job>& jobs, Builder& out, std::vector<Job>& split) {
+    std::vector<size_t> open;
+    std::vector<Vec3> centres;
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      const Job& j = jobs[i];
+      const uint8_t signs = signs_of(j.v);
+      if (signs != 0 && signs != 0xff) continue;
+      bool away = j.cell.level >= max_depth_;
+      for (double x : j.v) away = away || std::abs(x) > diagonal(j.cell);
+      if (away) {
+        out.set_uniform(j.slot, signs != 0);
+        continue;
       }
-      const Vec3 &x = h.x, &g = h.g;
-      const double len = norm3(g);
-      if (!(len > 0)) continue;
-      const Vec3 n = scale3(g, 1 / len);
-      q.add_plane(n, dot3(n, x), 1);
+      const Vec3 m = j.cell.min_unit();
+      const double h = j.cell.size() / 2;
+      open.push_back(i);
+      centres.push_back({m[0] + h, m[1] + h, m[2] + h});
+    }
+    const std::vector<double> fc = values(centres);
+    for (size_t k = 0; k < open.size(); ++k) {
+      const Job& j = jobs[open[k]];
+      if (std::abs(fc[k]) > diagonal(j.cell) / 2) out.set_uniform(j.slot, signs_of(j.v) != 0);
+      else split.push_back(j);
     }
   }
 
-  void subdivide(const Cell& cell, const std::array<double, 8>& v, Builder& out, uint32_t slot, size_t& capped) {
-    // The 27-point child grid: the parent's corners known, the other 19 evaluated when a child
-    // needs them (a child that a parent corner's value proves away from the surface does not).
-    std::array<double, 27> g{};
-    std::array<bool, 27> known{};
-    const int64_t h = cell.span() / 2;
-    for (int i = 0; i < 27; ++i) {
-      const int a = i % 3, b = (i / 3) % 3, c = i / 9;
-      if (a != 1 && b != 1 && c != 1) g[i] = v[(a / 2) | ((b / 2) << 1) | ((c / 2) << 2)], known[i] = true;
+  /// Gray cells at the cap or with one surface component get their QEF vertex from the
+  /// crossings of their edges (each edge's found once, all in step); a vertex is kept when
+  /// the planes fit, it lies in its cell and on the surface within the error (edge crossings
+  /// alone take a rounded corner for the sharp one), or at the cap. The rest go to `split`.
+  void place_vertices(const std::vector<Job>& jobs, Builder& out, std::vector<Job>& split, size_t& capped) {
+    std::vector<size_t> cand;
+    std::vector<std::array<uint32_t, 12>> cell_edges;  // first into `refs`, then into `edges`
+    std::vector<Edge> found;                            // per ref
+    std::vector<std::pair<uint64_t, uint32_t>> refs;    // (edge key, ref)
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      const Job& j = jobs[i];
+      const uint8_t signs = signs_of(j.v);
+      if (signs == 0 || signs == 0xff) continue;
+      if (j.cell.level < max_depth_ && !one_component(signs)) {
+        split.push_back(j);
+        continue;
+      }
+      cand.push_back(i);
+      std::array<uint32_t, 12> ids;
+      ids.fill(kNone);
+      const Vec3 m = j.cell.min_unit();
+      const double s = j.cell.size();
+      auto corner = [&](int k) { return Vec3{m[0] + (k & 1) * s, m[1] + ((k >> 1) & 1) * s, m[2] + ((k >> 2) & 1) * s}; };
+      for (int e = 0; e < 12; ++e) {
+        const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
+        if (((signs >> c0) & 1) == ((signs >> c1) & 1)) continue;
+        // An edge's key: its first corner and its axis (a level's edges share one length).
+        refs.push_back({pack(j.cell.corner(c0)) * 3 + uint64_t(edge_axis(e)), uint32_t(found.size())});
+        ids[e] = uint32_t(found.size());
+        found.push_back({corner(c0), corner(c1), j.v[c0], j.v[c1], s});
+      }
+      cell_edges.push_back(ids);
     }
-    auto grid = [&](int i) {
-      if (!known[i]) {
-        const int a = i % 3, b = (i / 3) % 3, c = i / 9;
-        g[i] = value_at({cell.lat[0] + a * h, cell.lat[1] + b * h, cell.lat[2] + c * h});
-        known[i] = true;
+    std::vector<uint32_t> edge_of(found.size());
+    std::vector<Edge> edges(number_keys(refs, edge_of, parallel_));
+    for (size_t r = 0; r < found.size(); ++r) edges[edge_of[r]] = found[r];
+    for (auto& ids : cell_edges)
+      for (uint32_t& id : ids)
+        if (id != kNone) id = edge_of[id];
+    crossings(edges);
+    std::vector<Qef::Solution> sol(cand.size());
+    std::vector<Vec3> at(cand.size());
+    for_each(cand.size(), [&](size_t k) {
+      const Job& j = jobs[cand[k]];
+      Qef q;
+      for (uint32_t id : cell_edges[k]) {
+        if (id == kNone) continue;
+        const double len = norm3(edges[id].g);
+        if (!(len > 0)) continue;
+        const Vec3 n = scale3(edges[id].g, 1 / len);
+        q.add_plane(n, dot3(n, edges[id].x), 1);
       }
-      return g[i];
-    };
-    auto child_values = [&](int c) {
-      std::array<double, 8> cv;
-      for (int k = 0; k < 8; ++k) {
-        const int a = (c & 1) + (k & 1), b = ((c >> 1) & 1) + ((k >> 1) & 1), d = ((c >> 2) & 1) + ((k >> 2) & 1);
-        cv[k] = grid(a + 3 * b + 9 * d);
+      sol[k] = cell_vertex(q, j.cell, signs_of(j.v));
+      at[k] = sol[k].position;
+    });
+    const std::vector<double> fv = values(at);
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const Job& j = jobs[cand[k]];
+      const uint8_t signs = signs_of(j.v);
+      const double off = std::abs(fv[k]) / (f_.lipschitz * cube_.size);
+      const bool ok = sol[k].error < error_ && off * off < error_ && inside_cell(sol[k].position, j.cell) &&
+                      one_component(signs);
+      if (ok || j.cell.level >= max_depth_) {
+        if (!ok) ++capped;
+        out.set_gray(j.slot, j.cell, signs, sol[k].position, ok ? 0 : kFlagCapped);
+      } else {
+        split.push_back(j);
       }
-      return cv;
-    };
-    // The child at corner c is out of reach when |f| there exceeds its diagonal: sample() would
-    // find it so from that one value.
-    const double child_diagonal = f_.lipschitz * cell.size() / 2 * cube_.size * std::sqrt(3.0);
-    auto away = [&](int c) { return std::abs(v[c]) > child_diagonal; };
-    const uint32_t first = out.alloc_children();
-    out.nodes[slot] = Node{first, CellKind::Internal, 0, 0, 0};
-    if (cell.level < parallel_levels_) {
-      for (int i = 0; i < 27; ++i) grid(i);
-      std::array<Builder, 8> subs;
-      std::array<size_t, 8> caps{};
-      tbb::parallel_for(0, 8, [&](int c) {
-        subs[c].nodes.resize(1);
-        sample(cell.child(c), child_values(c), subs[c], 0, caps[c]);
-      });
-      for (int c = 0; c < 8; ++c) {
-        out.splice(first + c, subs[c]);
-        capped += caps[c];
+    }
+  }
+
+  /// The surface point on every edge and f's gradient there, the edges' root finders run in
+  /// step: Newton steps where f gives its gradient with its value, else false position (then
+  /// the gradients in one more batch: f's own, or central differences).
+  void crossings(std::vector<Edge>& edges) {
+    if (edges.empty()) return;
+    auto point = [&](const Edge& e, double t) { return add3(e.a, scale3(sub3(e.b, e.a), t)); };
+    std::vector<size_t> active(edges.size());
+    for (size_t i = 0; i < edges.size(); ++i) active[i] = i;
+    if (f_.value_gradient) {
+      std::vector<NewtonRoot> r;
+      for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, 1e-6, 40);
+      while (!active.empty()) {
+        evaluations += active.size();
+        for_each(active.size(), [&](size_t k) {
+          Edge& e = edges[active[k]];
+          NewtonRoot& n = r[active[k]];
+          Vec3 g;
+          const double fx = f_.value_gradient(world(point(e, n.next())), g);
+          e.g = g;
+          n.take(fx, dot3(g, sub3(e.b, e.a)) * cube_.size);
+        });
+        std::erase_if(active, [&](size_t i) { return r[i].done(); });
       }
+      for (size_t i = 0; i < edges.size(); ++i) edges[i].x = point(edges[i], r[i].root());
       return;
     }
-    for (int c = 0; c < 8; ++c) {
-      if (away(c)) out.set_uniform(first + c, v[c] < 0);
-      else sample(cell.child(c), child_values(c), out, first + c, capped);
+    std::vector<IllinoisRoot> r;
+    for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, 1e-6, 40);
+    std::erase_if(active, [&](size_t i) { return r[i].done(); });
+    while (!active.empty()) {
+      std::vector<Vec3> at(active.size());
+      for (size_t k = 0; k < active.size(); ++k) at[k] = point(edges[active[k]], r[active[k]].next());
+      const std::vector<double> fx = values(at);
+      for (size_t k = 0; k < active.size(); ++k) r[active[k]].take(fx[k]);
+      std::erase_if(active, [&](size_t i) { return r[i].done(); });
     }
+    for (size_t i = 0; i < edges.size(); ++i) edges[i].x = point(edges[i], r[i].root());
+    gradients(edges);
+  }
+
+  /// f's gradient at every edge's crossing (its direction is the same in unit space).
+  void gradients(std::vector<Edge>& edges) {
+    if (f_.gradients || f_.gradient) {
+      std::vector<Vec3> w(edges.size()), g(edges.size());
+      for (size_t i = 0; i < edges.size(); ++i) w[i] = world(edges[i].x);
+      evaluations += edges.size();
+      if (f_.gradients) f_.gradients(w, g);
+      else for_each(edges.size(), [&](size_t i) { g[i] = f_.gradient(w[i]); });
+      for (size_t i = 0; i < edges.size(); ++i) edges[i].g = g[i];
+      return;
+    }
+    std::vector<Vec3> at;
+    at.reserve(6 * edges.size());
+    for (const Edge& e : edges) {
+      const double h = e.size * 1e-3;
+      for (int k = 0; k < 3; ++k)
+        for (const double sign : {-1.0, 1.0}) {
+          Vec3 p = e.x;
+          p[k] += sign * h;
+          at.push_back(p);
+        }
+    }
+    const std::vector<double> fx = values(at);
+    for (size_t i = 0; i < edges.size(); ++i) {
+      const double h = edges[i].size * 1e-3;
+      for (int k = 0; k < 3; ++k) edges[i].g[k] = (fx[6 * i + 2 * k + 1] - fx[6 * i + 2 * k]) / (2 * h * cube_.size);
+    }
+  }
+
+  /// Splits every cell in `split` into its children: a child that a corner of its parent
+  /// proves away from the surface (|f| there beyond the child's diagonal) becomes a leaf at
+  /// once; the others' new corners -- the parents' 27-point grids, shared between neighbours
+  /// -- are asked in one batch. Returns the children to look at on the next level.
+  std::vector<Job> subdivide(const std::vector<Job>& split, Builder& out) {
+    std::vector<Job> next;
+    std::vector<std::pair<uint64_t, uint32_t>> refs;  // (lattice point, 8 * child + corner)
+    for (const Job& j : split) {
+      const uint32_t first = out.alloc_children();
+      out.nodes[j.slot] = Node{first, CellKind::Internal, 0, 0, 0};
+      const double child_diagonal = diagonal(j.cell) / 2;
+      for (int c = 0; c < 8; ++c) {
+        if (std::abs(j.v[c]) > child_diagonal) {
+          out.set_uniform(first + c, j.v[c] < 0);
+          continue;
+        }
+        const Cell child = j.cell.child(c);
+        Job n{child, first + c, {}};
+        for (int k = 0; k < 8; ++k) {
+          const int a = (c & 1) + (k & 1), b = ((c >> 1) & 1) + ((k >> 1) & 1), d = ((c >> 2) & 1) + ((k >> 2) & 1);
+          if (a != 1 && b != 1 && d != 1) n.v[k] = j.v[(a / 2) | ((b / 2) << 1) | ((d / 2) << 2)];
+          else refs.push_back({pack(child.corner(k)), uint32_t(8 * next.size() + k)});
+        }
+        next.push_back(n);
+      }
+    }
+    std::vector<uint32_t> id(8 * next.size());
+    std::vector<Vec3> points(number_keys(refs, id, parallel_));
+    for (const auto& [key, at] : refs) points[id[at]] = lattice_unit(unpack(key));
+    const std::vector<double> fx = values(points);
+    for (size_t at = 0; at < id.size(); ++at)
+      if (id[at] != kNone) next[at / 8].v[at % 8] = fx[id[at]];
+    return next;
   }
 };
 
@@ -255,20 +376,21 @@ class ImplicitSampler {
 
 Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats) {
   const auto t0 = Clock::now();
-  if (!solid.value) throw InvalidInput("an implicit solid needs a function");
+  if (!solid.value && !solid.values) throw InvalidInput("an implicit solid needs a function");
   if (!options.cube) throw InvalidInput("sampling a function needs a root cube (--cube)");
   if (options.depth < 1 || options.depth > kMaxLevel)
     throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
   if (!(solid.lipschitz > 0) || !std::isfinite(solid.lipschitz)) throw InvalidInput("lipschitz must be positive");
-  ImplicitSampler sampler(solid, *options.cube, options);
+  LevelSampler sampler(solid, *options.cube, options);
+  std::vector<Vec3> corners(8);
+  for (int k = 0; k < 8; ++k) corners[k] = lattice_unit(Cell{}.corner(k));
+  const std::vector<double> v = sampler.values(corners);
   std::array<double, 8> root{};
-  for (int k = 0; k < 8; ++k) root[k] = sampler.value_at(Cell{}.corner(k));
+  for (int k = 0; k < 8; ++k) root[k] = v[k];
   for (double x : root)
     if (!std::isfinite(x)) throw InvalidInput("the function is not finite at a corner of the cube");
-  Builder b;
-  b.nodes.resize(1);
   size_t capped = 0;
-  sampler.sample(Cell{}, root, b, 0, capped);
+  Builder b = sampler.run(root, capped);
   Octree tree;
   tree.cube = *options.cube;
   tree.max_depth = options.depth;

@@ -558,3 +558,21 @@ def test_sample_function_box_with_cavity_matches_boolean():
     assert d.max() < 1e-6
     with pytest.raises(ValueError):
         pic.sample_function(f, None)
+
+
+def test_sample_function_asks_in_batches():
+    calls, points = [], 0
+
+    def f(p):
+        nonlocal points
+        calls.append(len(p))
+        points += len(p)
+        return np.linalg.norm(p, axis=1) - 0.5
+
+    t = pic.sample_function(f, (-1, -1, -1, 2), depth=7)
+    assert t.stats["pics"] > 1000
+    # Each level's points in a few batches: far fewer calls than points.
+    assert max(calls) > 1000
+    assert len(calls) < points / 100
+    v, _ = pic.contour(t)
+    assert np.abs(np.linalg.norm(v, axis=1) - 0.5).max() < 2 / 128
