@@ -101,8 +101,8 @@ struct Edge {
 
 class LevelSampler {
  public:
-  LevelSampler(const ImplicitSolid& f, const Cube& cube, const SampleOptions& o)
-      : f_(f), cube_(cube), max_depth_(o.depth), error_(o.error), parallel_(o.parallel) {}
+  LevelSampler(const ImplicitSolid& f, const Cube& cube, int max_depth, double error, bool parallel)
+      : f_(f), cube_(cube), max_depth_(max_depth), error_(error), parallel_(parallel) {}
 
   /// f at unit-space points, as one batch.
   std::vector<double> values(const std::vector<Vec3>& unit) {
@@ -120,12 +120,19 @@ class LevelSampler {
     return out;
   }
 
-  /// Samples the cube level by level from the root's corner values.
-  Builder run(const std::array<double, 8>& root, size_t& capped) {
+  /// Samples `cell` (f at its corners: `v`) level by level into a tree rooted at node 0. A
+  /// C++ function in parallel: the first levels over the whole cell, then each cell of level
+  /// kSubtreeLevel on its own, the cells in parallel -- each one's batches stay small, near
+  /// in memory as in space. A batched function sees each level whole.
+  Builder run(const Cell& cell, const std::array<double, 8>& v, size_t& capped) {
     Builder out;
     out.nodes.resize(1);
-    std::vector<Job> jobs{{Cell{}, 0, root}};
+    std::vector<Job> jobs{{cell, 0, v}};
     while (!jobs.empty()) {
+      if (parallel_ && !f_.values && jobs.front().cell.level == kSubtreeLevel) {
+        run_apart(jobs, out, capped);
+        break;
+      }
       std::vector<Job> split;
       settle_uniform(jobs, out, split);
       place_vertices(jobs, out, split, capped);
@@ -142,6 +149,23 @@ class LevelSampler {
   int max_depth_;
   double error_;
   bool parallel_;
+
+  static constexpr int kSubtreeLevel = 2;
+
+  void run_apart(const std::vector<Job>& jobs, Builder& out, size_t& capped) {
+    std::vector<Builder> subs(jobs.size());
+    std::vector<size_t> caps(jobs.size()), evals(jobs.size());
+    tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) {
+      LevelSampler one(f_, cube_, max_depth_, error_, false);
+      subs[i] = one.run(jobs[i].cell, jobs[i].v, caps[i]);
+      evals[i] = one.evaluations;
+    });
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      out.splice(jobs[i].slot, subs[i]);
+      capped += caps[i];
+      evaluations += evals[i];
+    }
+  }
 
   template <class F>
   void for_each(size_t n, F&& f) const {
@@ -381,7 +405,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   if (options.depth < 1 || options.depth > kMaxLevel)
     throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
   if (!(solid.lipschitz > 0) || !std::isfinite(solid.lipschitz)) throw InvalidInput("lipschitz must be positive");
-  LevelSampler sampler(solid, *options.cube, options);
+  LevelSampler sampler(solid, *options.cube, options.depth, options.error, options.parallel);
   std::vector<Vec3> corners(8);
   for (int k = 0; k < 8; ++k) corners[k] = lattice_unit(Cell{}.corner(k));
   const std::vector<double> v = sampler.values(corners);
@@ -390,7 +414,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   for (double x : root)
     if (!std::isfinite(x)) throw InvalidInput("the function is not finite at a corner of the cube");
   size_t capped = 0;
-  Builder b = sampler.run(root, capped);
+  Builder b = sampler.run(Cell{}, root, capped);
   Octree tree;
   tree.cube = *options.cube;
   tree.max_depth = options.depth;
