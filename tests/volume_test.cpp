@@ -270,6 +270,17 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
               plain.worst_vertex / cell);
 }
 
+TEST(Offset, EveryLatticePointHasOneSignWhereTheDistanceBreaksItsBound) {
+  // Suzanne's surface (taken through its PIC contour: sheets that touch are split a hair
+  // apart) nearly touches itself, and the sign of a distance there can flip across a pinch;
+  // shrunk by two finest cells at depth 9, the result must still be a consistent PIC object
+  // (a loaded file is checked for one sign per lattice point) with a valid contour.
+  const TriMesh suzanne = read_mesh(std::string(PIC_DATA_DIR) + "/suzanne.obj");
+  const Octree t = offset(suzanne, -0.01201629638671875, at_depth(9));
+  EXPECT_NO_THROW(deserialize(serialize(t)));
+  expect_valid(contour(t));
+}
+
 TEST(Offset, ShrinkingToNothingSaysSo) {
   try {
     offset(make_box({0, 0, 0}, {1, 1, 1}), -0.6, at_depth(6));

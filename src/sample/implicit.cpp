@@ -360,22 +360,18 @@ class LevelSampler {
     }
   }
 
-  /// Splits every cell in `split` into its children: a child that a corner of its parent
-  /// proves away from the surface (|f| there beyond the child's diagonal) becomes a leaf at
-  /// once; the others' new corners -- the parents' 27-point grids, shared between neighbours
-  /// -- are asked in one batch. Returns the children to look at on the next level.
+  /// Splits every cell in `split` into its children, their new corners -- the parents'
+  /// 27-point grids, shared between neighbours -- asked in one batch. No child is settled
+  /// from its parent's corner alone: a distance to a surface that nearly touches itself can
+  /// break the Lipschitz bound by a sign, and a child's corner must have the sign its
+  /// neighbours see. Returns the children to look at on the next level.
   std::vector<Job> subdivide(const std::vector<Job>& split, Builder& out) {
     std::vector<Job> next;
     std::vector<std::pair<uint64_t, uint32_t>> refs;  // (lattice point, 8 * child + corner)
     for (const Job& j : split) {
       const uint32_t first = out.alloc_children();
       out.nodes[j.slot] = Node{first, CellKind::Internal, 0, 0, 0};
-      const double child_diagonal = diagonal(j.cell) / 2;
       for (int c = 0; c < 8; ++c) {
-        if (std::abs(j.v[c]) > child_diagonal) {
-          out.set_uniform(first + c, j.v[c] < 0);
-          continue;
-        }
         const Cell child = j.cell.child(c);
         Job n{child, first + c, {}};
         for (int k = 0; k < 8; ++k) {
