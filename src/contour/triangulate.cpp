@@ -269,14 +269,14 @@ double edge_parameter(const PlainSurface& s, size_t i) {
     const auto at = [&](double t) { return add3(p.e0, scale3(sub3(p.e1, p.e0), t)); };
     const auto f = [&](double t) { return s.level(at(t)); };
     const double f0 = f(0), f1 = f(1);
-    if ((f0 < 0) != (f1 < 0)) return illinois_root(f, f0, f1, 1e-6, 40);
+    if ((f0 < 0) != (f1 < 0)) return illinois_root(f, f0, f1, kEdgeRoot, kEdgeRootSteps);
     constexpr int kSamples = 32;
     double best = 0, least = std::abs(f0), prev = f0;
     for (int k = 1; k <= kSamples; ++k) {
       const double t = double(k) / kSamples, ft = k == kSamples ? f1 : f(t);
       if ((ft < 0) != (prev < 0)) {
         const double t0 = double(k - 1) / kSamples;
-        return t0 + illinois_root([&](double u) { return f(t0 + u / kSamples); }, prev, ft, 1e-5, 40) / kSamples;
+        return t0 + illinois_root([&](double u) { return f(t0 + u / kSamples); }, prev, ft, kEdgeRoot * kSamples, kEdgeRootSteps) / kSamples;
       }
       if (std::abs(ft) < least) least = std::abs(ft), best = t;
       prev = ft;
@@ -348,7 +348,7 @@ void onto_level_in_face(const SurfaceFunction& level, const Face& face, double i
   double size = 0;
   for (int d = 0; d < 3; ++d)
     if (d != face.axis) size = std::max(size, face.hi[d] - face.lo[d]);
-  const double h = size * 1e-4, enough = size * 1e-4;
+  const double h = size * kFaceStep, enough = size * kFaceStep;
   double v = level(f);
   for (int it = 0; it < 4 && std::abs(v) > enough; ++it) {
     Vec3 g{0, 0, 0};

@@ -149,7 +149,7 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
     best = nearest_on_triangle2(p, t.a, t.b, t.c);
     best.triangle = t.id;
     // A hair more: the search must still find the hint's own triangle when it is the answer.
-    if (std::isfinite(best.distance)) best2 = best.distance * (1 + 1e-12) + kTinyDivisor;
+    if (std::isfinite(best.distance)) best2 = best.distance * (1 + kHintSlack) + kTinyDivisor;
   }
   // Ties go to the lowest triangle index, so the answer (its feature, and so the sign) is the
   // same whatever the hint: a point asked twice gets one value.

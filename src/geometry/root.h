@@ -6,6 +6,8 @@
 
 #include <algorithm>
 
+#include "geometry/tolerances.h"
+
 namespace pic::detail {
 
 /// The parameter t in [0, 1] where f changes sign, given f(0) = f0 and f(1) = f1 of opposite
@@ -18,7 +20,7 @@ class IllinoisRoot {
   bool done() const { return exact_ || it_ >= iterations_ || !(hi_ - lo_ > tolerance_); }
   /// Where to ask f next.
   double next() const {
-    return std::clamp(lo_ + (hi_ - lo_) * f0_ / (f0_ - f1_), lo_ + (hi_ - lo_) * 1e-3, hi_ - (hi_ - lo_) * 1e-3);
+    return std::clamp(lo_ + (hi_ - lo_) * f0_ / (f0_ - f1_), lo_ + (hi_ - lo_) * kBracketInset, hi_ - (hi_ - lo_) * kBracketInset);
   }
   /// f's value at next().
   void take(double ft) {

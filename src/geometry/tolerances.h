@@ -98,6 +98,19 @@ inline constexpr double kFlatNeighbourCosine = 1e-8;
 /// A point this close to a face's plane, as a fraction of the solid's extent, is on it (convex
 /// tests and the clipping of convex pieces).
 inline constexpr double kOnPlane = 1e-9;
+/// A root of a function along a cell edge is found to this fraction of the edge, in at most
+/// kEdgeRootSteps values.
+inline constexpr double kEdgeRoot = 1e-6;
+inline constexpr int kEdgeRootSteps = 40;
+/// False position keeps its next value this fraction of the bracket off the bracket's ends.
+inline constexpr double kBracketInset = 1e-3;
+/// Central differences of a function step this fraction of the cell's side ...
+inline constexpr double kGradientStep = 1e-3;
+/// ... and, within a face, this fraction of the face's side, where a point moved onto a
+/// function's zero stops when |f| is below the same fraction of the side.
+inline constexpr double kFaceStep = 1e-4;
+/// The search of a nearest triangle bounded by a hint's distance allows it this relative slack.
+inline constexpr double kHintSlack = 1e-12;
 /// A point nearer a mesh than this fraction of the mesh's size is on it: the direction to its
 /// nearest point is rounding noise there, so the nearest face's normal stands for the gradient.
 inline constexpr double kOnSurface = 1e-10;

@@ -15,6 +15,7 @@
 #include "geometry/qef.h"
 #include "geometry/root.h"
 #include "geometry/stopwatch.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "octree/cell.h"
 #include "octree/cell_vertex.h"
@@ -301,7 +302,7 @@ class LevelSampler {
     for (size_t i = 0; i < edges.size(); ++i) active[i] = i;
     if (f_.value_gradient) {
       std::vector<NewtonRoot> r;
-      for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, 1e-6, 40);
+      for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
       while (!active.empty()) {
         evaluations += active.size();
         for_each(active.size(), [&](size_t k) {
@@ -318,7 +319,7 @@ class LevelSampler {
       return;
     }
     std::vector<IllinoisRoot> r;
-    for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, 1e-6, 40);
+    for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
     std::erase_if(active, [&](size_t i) { return r[i].done(); });
     while (!active.empty()) {
       std::vector<Vec3> at(active.size());
@@ -345,7 +346,7 @@ class LevelSampler {
     std::vector<Vec3> at;
     at.reserve(6 * edges.size());
     for (const Edge& e : edges) {
-      const double h = e.size * 1e-3;
+      const double h = e.size * kGradientStep;
       for (int k = 0; k < 3; ++k)
         for (const double sign : {-1.0, 1.0}) {
           Vec3 p = e.x;
@@ -355,7 +356,7 @@ class LevelSampler {
     }
     const std::vector<double> fx = values(at);
     for (size_t i = 0; i < edges.size(); ++i) {
-      const double h = edges[i].size * 1e-3;
+      const double h = edges[i].size * kGradientStep;
       for (int k = 0; k < 3; ++k) edges[i].g[k] = (fx[6 * i + 2 * k + 1] - fx[6 * i + 2 * k]) / (2 * h * cube_.size);
     }
   }
