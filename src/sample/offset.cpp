@@ -170,7 +170,8 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
     value(p, g);
     return g;
   };
-  f.value_gradient = value;
+  // No value_gradient: the gradient above is the distance's, not that of d - h(u), whose
+  // slope along an edge Newton steps would need.
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
