@@ -115,7 +115,7 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
   stack[top++] = 0;
   while (top > 0) {
     const BNode& nd = nodes_[stack[--top]];
-    if (box_distance2(nd, p) > best2) continue;
+    if (box_distance2(nd, p) >= best2) continue;
     if (nd.count > 0) {
       for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) visit(tris_[i]);
       continue;
@@ -124,11 +124,11 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
     const double dl = box_distance2(l, p), dr = box_distance2(r, p);
     // Push the farther first so the nearer is explored first.
     if (dl < dr) {
-      if (dr <= best2) stack[top++] = nd.first + 1;
-      if (dl <= best2) stack[top++] = nd.first;
+      if (dr < best2) stack[top++] = nd.first + 1;
+      if (dl < best2) stack[top++] = nd.first;
     } else {
-      if (dl <= best2) stack[top++] = nd.first;
-      if (dr <= best2) stack[top++] = nd.first + 1;
+      if (dl < best2) stack[top++] = nd.first;
+      if (dr < best2) stack[top++] = nd.first + 1;
     }
   }
 }
@@ -151,11 +151,13 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
     // A hair more: the search must still find the hint's own triangle when it is the answer.
     if (std::isfinite(best.distance)) best2 = best.distance * (1 + kHintSlack) + kTinyDivisor;
   }
-  // Ties go to the lowest triangle index, so the answer (its feature, and so the sign) is the
-  // same whatever the hint: a point asked twice gets one value.
+  // The same answer whatever the hint, so a point asked twice gets one value (its feature, and
+  // so its sign): the boxes visit in an order the hint does not change, the hint's bound is a
+  // hair above its distance and so prunes no triangle at the least distance, and among those
+  // visited a tie goes to the lowest index.
   uint32_t slot = hint ? *hint : 0;
   search(p, best2, [&](const LeafTriangle& t) {
-    if (box_distance2(t, p) > best2) return;
+    if (box_distance2(t, p) >= best2) return;
     const Nearest n = nearest_on_triangle2(p, t.a, t.b, t.c);
     if (n.distance < best2 || (n.distance == best2 && t.id < best.triangle)) {
       best2 = n.distance;

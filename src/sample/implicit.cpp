@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geometry/lattice.h"
+#include "geometry/memo.h"
 #include "geometry/qef.h"
 #include "geometry/root.h"
 #include "geometry/stopwatch.h"
@@ -85,6 +86,30 @@ size_t number_keys(std::vector<std::pair<uint64_t, uint32_t>>& refs, std::vector
   return count;
 }
 
+/// f at a lattice point, memoized per thread where f is asked one point at a time (up to
+/// eight cells of a level share a point).
+struct PointValue {
+  Lat p;
+  bool filled = false;
+  double f = 0;
+};
+using PointMemo = ThreadMemo<PointValue, 16>;
+/// The surface point on a cell edge and f's gradient there, memoized the same way (up to
+/// four cells share an edge).
+struct EdgeHermite {
+  Lat a;
+  int64_t span = 0;
+  int axis = 0;
+  bool filled = false;
+  Vec3 x, g;
+};
+using EdgeMemo = ThreadMemo<EdgeHermite, 14>;
+/// What a function asked one point at a time is memoized in.
+struct Memos {
+  PointMemo points;
+  EdgeMemo edges;
+};
+
 /// A cell waiting at its level, with f at its corners.
 struct Job {
   Cell cell;
@@ -102,8 +127,9 @@ struct Edge {
 
 class LevelSampler {
  public:
-  LevelSampler(const ImplicitSolid& f, const Cube& cube, int max_depth, double error, bool parallel)
-      : f_(f), cube_(cube), max_depth_(max_depth), error_(error), parallel_(parallel) {}
+  /// `memo`: for a function asked one point at a time (none for a batched one).
+  LevelSampler(const ImplicitSolid& f, const Cube& cube, int max_depth, double error, bool parallel, Memos* memo)
+      : f_(f), cube_(cube), max_depth_(max_depth), error_(error), parallel_(parallel), memo_(memo) {}
 
   /// f at unit-space points, as one batch.
   std::vector<double> values(const std::vector<Vec3>& unit) {
@@ -150,6 +176,16 @@ class LevelSampler {
   int max_depth_;
   double error_;
   bool parallel_;
+  Memos* memo_;
+
+  double value_at(const Lat& p) {
+    PointValue& e = memo_->points.slot(memo_slot(p, 0, PointMemo::kBits));
+    if (!e.filled || e.p != p) {
+      ++evaluations;
+      e = {p, true, f_.value(world(lattice_unit(p)))};
+    }
+    return e.f;
+  }
 
   static constexpr int kSubtreeLevel = 2;
 
@@ -157,7 +193,7 @@ class LevelSampler {
     std::vector<Builder> subs(jobs.size());
     std::vector<size_t> caps(jobs.size()), evals(jobs.size());
     tbb::parallel_for(size_t{0}, jobs.size(), [&](size_t i) {
-      LevelSampler one(f_, cube_, max_depth_, error_, false);
+      LevelSampler one(f_, cube_, max_depth_, error_, false, memo_);
       subs[i] = one.run(jobs[i].cell, jobs[i].v, caps[i]);
       evals[i] = one.evaluations;
     });
@@ -230,6 +266,7 @@ class LevelSampler {
     std::vector<std::array<uint32_t, 12>> cell_edges;  // first into `refs`, then into `edges`
     std::vector<Edge> found;                            // per ref
     std::vector<std::pair<uint64_t, uint32_t>> refs;    // (edge key, ref)
+    std::vector<std::pair<Lat, int>> start;             // per ref: first corner and axis
     for (size_t i = 0; i < jobs.size(); ++i) {
       const Job& j = jobs[i];
       const uint8_t signs = signs_of(j.v);
@@ -251,16 +288,32 @@ class LevelSampler {
         refs.push_back({pack(j.cell.corner(c0)) * 3 + uint64_t(edge_axis(e)), uint32_t(found.size())});
         ids[e] = uint32_t(found.size());
         found.push_back({corner(c0), corner(c1), j.v[c0], j.v[c1], s});
+        start.push_back({j.cell.corner(c0), edge_axis(e)});
       }
       cell_edges.push_back(ids);
     }
-    std::vector<uint32_t> edge_of(found.size());
-    std::vector<Edge> edges(number_keys(refs, edge_of, parallel_));
-    for (size_t r = 0; r < found.size(); ++r) edges[edge_of[r]] = found[r];
-    for (auto& ids : cell_edges)
-      for (uint32_t& id : ids)
-        if (id != kNone) id = edge_of[id];
-    crossings(edges);
+    std::vector<Edge> edges;
+    if (memo_) {
+      // One point at a time: each edge through the memo, in cell order.
+      edges = std::move(found);
+      for (size_t r = 0; r < edges.size(); ++r) {
+        const int64_t span = jobs[0].cell.span();
+        EdgeHermite& h = memo_->edges.slot(edge_memo_slot(start[r].first, start[r].second, span, EdgeMemo::kBits));
+        if (!h.filled || h.a != start[r].first || h.axis != start[r].second || h.span != span) {
+          cross_one(edges[r]);
+          h = {start[r].first, span, start[r].second, true, edges[r].x, edges[r].g};
+        }
+        edges[r].x = h.x, edges[r].g = h.g;
+      }
+    } else {
+      std::vector<uint32_t> edge_of(found.size());
+      edges.resize(number_keys(refs, edge_of, parallel_));
+      for (size_t r = 0; r < found.size(); ++r) edges[edge_of[r]] = found[r];
+      for (auto& ids : cell_edges)
+        for (uint32_t& id : ids)
+          if (id != kNone) id = edge_of[id];
+      crossings(edges);
+    }
     std::vector<Qef::Solution> sol(cand.size());
     std::vector<Vec3> at(cand.size());
     for_each(cand.size(), [&](size_t k) {
@@ -332,6 +385,39 @@ class LevelSampler {
     gradients(edges);
   }
 
+  /// One edge's crossing and gradient as crossings() finds them, f asked point by point.
+  void cross_one(Edge& e) {
+    auto point = [&](double t) { return add3(e.a, scale3(sub3(e.b, e.a), t)); };
+    if (f_.value_gradient) {
+      NewtonRoot r(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
+      while (!r.done()) {
+        ++evaluations;
+        const double fx = f_.value_gradient(world(point(r.next())), e.g);
+        r.take(fx, dot3(e.g, sub3(e.b, e.a)) * cube_.size);
+      }
+      e.x = point(r.root());
+      return;
+    }
+    IllinoisRoot r(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
+    while (!r.done()) {
+      ++evaluations;
+      r.take(f_.value(world(point(r.next()))));
+    }
+    e.x = point(r.root());
+    if (f_.gradient) {
+      ++evaluations;
+      e.g = f_.gradient(world(e.x));
+      return;
+    }
+    const double h = e.size * kGradientStep;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 lo = e.x, hi = e.x;
+      lo[k] -= h, hi[k] += h;
+      evaluations += 2;
+      e.g[k] = (f_.value(world(hi)) - f_.value(world(lo))) / (2 * h * cube_.size);
+    }
+  }
+
   /// f's gradient at every edge's crossing (its direction is the same in unit space).
   void gradients(std::vector<Edge>& edges) {
     if (f_.gradients || f_.gradient) {
@@ -362,7 +448,8 @@ class LevelSampler {
   }
 
   /// Splits every cell in `split` into its children, their new corners -- the parents'
-  /// 27-point grids, shared between neighbours -- asked in one batch. No child is settled
+  /// 27-point grids, shared between neighbours -- asked in one batch of distinct points (a
+  /// function asked one point at a time: in cell order, through the memo). No child is settled
   /// from its parent's corner alone: a distance to a surface that nearly touches itself can
   /// break the Lipschitz bound by a sign, and a child's corner must have the sign its
   /// neighbours see. Returns the children to look at on the next level.
@@ -378,11 +465,13 @@ class LevelSampler {
         for (int k = 0; k < 8; ++k) {
           const int a = (c & 1) + (k & 1), b = ((c >> 1) & 1) + ((k >> 1) & 1), d = ((c >> 2) & 1) + ((k >> 2) & 1);
           if (a != 1 && b != 1 && d != 1) n.v[k] = j.v[(a / 2) | ((b / 2) << 1) | ((d / 2) << 2)];
+          else if (memo_) n.v[k] = value_at(child.corner(k));
           else refs.push_back({pack(child.corner(k)), uint32_t(8 * next.size() + k)});
         }
         next.push_back(n);
       }
     }
+    if (memo_) return next;
     std::vector<uint32_t> id(8 * next.size());
     std::vector<Vec3> points(number_keys(refs, id, parallel_));
     for (const auto& [key, at] : refs) points[id[at]] = lattice_unit(unpack(key));
@@ -402,7 +491,9 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   if (options.depth < 1 || options.depth > kMaxLevel)
     throw InvalidInput("depth must be between 1 and " + std::to_string(kMaxLevel));
   if (!(solid.lipschitz > 0) || !std::isfinite(solid.lipschitz)) throw InvalidInput("lipschitz must be positive");
-  LevelSampler sampler(solid, *options.cube, options.depth, options.error, options.parallel);
+  Memos memo;
+  LevelSampler sampler(solid, *options.cube, options.depth, options.error, options.parallel,
+                       solid.values ? nullptr : &memo);
   std::vector<Vec3> corners(8);
   for (int k = 0; k < 8; ++k) corners[k] = lattice_unit(Cell{}.corner(k));
   const std::vector<double> v = sampler.values(corners);
