@@ -52,7 +52,11 @@ struct ContourStats {
 TriMesh contour(const Octree& tree, const ContourOptions& options = {}, ContourStats* stats = nullptr);
 /// The contour before its sheets are split apart (dual contouring may leave edges and vertices
 /// where the surface touches itself): for resampling a surface, and for looking at it.
-inline TriMesh unsplit_contour(const Octree& tree) { return contour(tree, {true, false}); }
+inline TriMesh unsplit_contour(const Octree& tree) {
+  ContourOptions o;
+  o.split_sheets = false;
+  return contour(tree, o);
+}
 
 /// Makes a closed mesh 2-manifold where it touches itself: an edge with four or more
 /// triangles (sheets meeting along a line) or a vertex whose triangles form several fans

@@ -247,7 +247,7 @@ double SignedDistance::operator()(const Vec3& p, uint32_t* hint) const {
 double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint) const {
   const Nearest n = distance_.nearest(p, hint);
   const auto& t = mesh_.triangles[n.triangle];
-  Vec3 pseudo;
+  Vec3 pseudo{0, 0, 0};
   switch (n.feature) {
     case Feature::V0: pseudo = vertex_normal_[t[0]]; break;
     case Feature::V1: pseudo = vertex_normal_[t[1]]; break;
