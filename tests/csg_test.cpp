@@ -466,6 +466,29 @@ TEST(Csg, UnionOfDisjointPartsIsThePartsThemselves) {
   EXPECT_NEAR(volume(m), volume(unsplit_contour(a)) + volume(unsplit_contour(b)), 1e-9);
 }
 
+// A Boolean's result has been through the clean-up wherever its parts landed, so copying it
+// into another solid with `b_settled` (checked only along the copy's faces) gives the same
+// solid as cleaning the copy whole again: the CSG tree relies on it for its inner nodes.
+TEST(Csg, ASettledOperandNeedsNoSecondCleanUp) {
+  const int depth = 9;
+  const Octree b = csg(sample_in_unit(make_sphere({0.62, 0.5, 0.5}, 0.1, 48), depth),
+                       sample_in_unit(make_torus({0.72, 0.5, 0.5}, 0.09, 0.04, 2, 48), depth), CsgOp::Union);
+  // One solid apart from B (a union copies B whole), one holding part of B (each operation
+  // copies B's cells where A is uniform).
+  const Octree apart = sample_in_unit(make_sphere({0.25, 0.5, 0.5}, 0.12, 48), depth);
+  const Octree over = sample_in_unit(make_box({0.35, 0.2, 0.2}, {0.7, 0.8, 0.8}), depth);
+  CsgOptions settled;
+  settled.b_settled = true;
+  for (CsgOp op : {CsgOp::Union, CsgOp::Subtract, CsgOp::Intersect}) {
+    const Octree y = csg(over, b, op, settled);
+    EXPECT_EQ(serialize(csg(over, b, op)), serialize(y)) << to_string(op);
+    EXPECT_TRUE(IsClosedManifold(unsplit_contour(y))) << to_string(op);
+  }
+  const Octree u = csg(apart, b, CsgOp::Union, settled);
+  EXPECT_EQ(serialize(csg(apart, b, CsgOp::Union)), serialize(u));
+  EXPECT_NEAR(volume(unsplit_contour(u)), volume(unsplit_contour(apart)) + volume(unsplit_contour(b)), 1e-9);
+}
+
 TEST(Csg, CostFollowsTheOverlapNotTheObject) {
   const int depth = 9;
   const Octree big = sample_in_unit(make_sphere({0.5, 0.5, 0.5}, 0.4, 256), depth);

@@ -22,6 +22,10 @@ std::optional<CsgOp> parse_csg_op(const std::string& s);
 struct CsgOptions {
   double error = 1e-8;  ///< QEF residual threshold for new vertices
   bool parallel = true; ///< combine subtrees near the root with TBB (output identical to serial)
+  /// B is itself a Boolean's result, so the clean-up already saw each of its parts where it
+  /// landed: a part of B copied whole into A is checked along its cell's faces only (else a part
+  /// smaller than about 32K nodes is cleaned whole, for a sampled tool's own sign islands).
+  bool b_settled = false;
 };
 
 struct CsgStats {

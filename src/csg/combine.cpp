@@ -122,12 +122,13 @@ class FragmentWriter {
   static Node uniform(bool inside) { return Node{0, inside ? CellKind::Black : CellKind::White, 0, 0, 0}; }
 
   /// Copies a subtree of `src` into the output, complemented if `invert`. In a copy of more
-  /// than kQuietCopy nodes, the nodes whose cells lie on none of the copy's root cell faces are
-  /// marked inside_copy: every neighbour they have is the source's own, as it was there.
-  Node copy_subtree(const Octree& src, uint32_t node, bool invert) {
+  /// than kQuietCopy nodes, or any copy of a `settled` source, the nodes whose cells lie on none
+  /// of the copy's root cell faces are marked inside_copy: every neighbour they have is the
+  /// source's own, as it was there.
+  Node copy_subtree(const Octree& src, uint32_t node, bool invert, bool settled) {
     const size_t from = out_.nodes.size();
     const Node root = copy_nodes(src, node, invert, 0x3f);
-    if (out_.nodes.size() - from <= kQuietCopy)
+    if (!settled && out_.nodes.size() - from <= kQuietCopy)
       std::fill(out_.inside_copy.begin() + std::ptrdiff_t(from), out_.inside_copy.end(), uint8_t{0});
     return root;
   }
@@ -190,10 +191,10 @@ class FragmentWriter {
 /// both are gray, forced subdivision (resampling a leaf's partial contour) where one is finer.
 class Combiner {
  public:
-  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, double error, int max_depth, uint32_t stamp,
+  Combiner(Fragment& out, Operand& a, Operand& b, CsgOp op, const CsgOptions& options, int max_depth, uint32_t stamp,
            int parallel_splits, bool parallel, const FocusCells* focus, CombineCounts& stats)
-      : out_(out), a_(a), b_(b), op_(op), error_(error), max_depth_(max_depth), stamp_(stamp),
-        parallel_splits_(parallel_splits), parallel_(parallel), focus_(focus), stats_(stats) {}
+      : out_(out), a_(a), b_(b), op_(op), options_(options), error_(options.error), max_depth_(max_depth),
+        stamp_(stamp), parallel_splits_(parallel_splits), parallel_(parallel), focus_(focus), stats_(stats) {}
 
   /// The result's root node (its index may be fragment-local).
   Node run() {
@@ -244,11 +245,11 @@ class Combiner {
       case Side::Uniform: return uniform(s.inside != invert);
       case Side::Internal:
         if (is_a && !invert) return x.t.nodes[s.node];  // unchanged subtree of A, in place
-        return out_.copy_subtree(x.t, s.node, invert);
+        return out_.copy_subtree(x.t, s.node, invert, !is_a && options_.b_settled);
       case Side::Gray:
         if (s.real) {
           if (is_a && !invert) return x.t.nodes[s.node];
-          return out_.copy_subtree(x.t, s.node, invert);
+          return out_.copy_subtree(x.t, s.node, invert, !is_a && options_.b_settled);
         }
         return resample(x, cell, s, invert);
     }
@@ -332,7 +333,7 @@ class Combiner {
     std::array<CombineCounts, 8> sub_stats;
     auto task = [&](int c) {
       Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
-      Combiner sub(frags[c], ca, cb, op_, error_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, focus_,
+      Combiner sub(frags[c], ca, cb, op_, options_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, focus_,
                    sub_stats[c]);
       // Both sides internal here: no sign grid is read.
       kids[c] = sub.combine(cell.child(c), child_side(ca, a, cell, c, {}), child_side(cb, b, cell, c, {}));
@@ -417,6 +418,7 @@ class Combiner {
   Operand& a_;
   Operand& b_;
   CsgOp op_;
+  const CsgOptions& options_;
   double error_;
   int max_depth_;
   uint32_t stamp_;
@@ -517,7 +519,7 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   const auto run = [&](const FocusCells* focus, Fragment& f) {
     Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
     CombineCounts counts;
-    Combiner comb(f, oa, ob, op, options.error, depth, stamp, kParallelSplits, options.parallel, focus, counts);
+    Combiner comb(f, oa, ob, op, options, depth, stamp, kParallelSplits, options.parallel, focus, counts);
     const Node root = comb.run();
     stats.cells_visited += counts.cells_visited;
     stats.gray_pairs += counts.gray_pairs;
@@ -542,7 +544,7 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   {
     Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
     CombineCounts counts;
-    Combiner comb(again, oa, ob, op, options.error, depth, stamp, 0, false, &focus, counts);
+    Combiner comb(again, oa, ob, op, options, depth, stamp, 0, false, &focus, counts);
     for (const LeafRef& l : coarse) roots.push_back(comb.run_at(l.cell));
     stats.cells_visited += counts.cells_visited;
     stats.gray_pairs += counts.gray_pairs;

@@ -67,23 +67,30 @@ class TreeEvaluator {
   TreeEvaluator(const CsgChainOptions& options, const SampleOptions& sampling, const Octree* empty_like)
       : options_(options), sampling_(sampling), empty_like_(empty_like) {}
 
+  /// A subtree's solid, and whether a Boolean made it (then every part of it has been through
+  /// the clean-up: copies of it need no second one inside).
+  struct Part {
+    Octree tree;
+    bool settled = false;
+  };
+
   /// The solid of `t`, or nothing for an empty one.
-  std::optional<Octree> eval(const CsgTree& t) {
+  std::optional<Part> eval(const CsgTree& t) {
     switch (t.kind) {
       case CsgTree::Kind::Empty: return std::nullopt;
-      case CsgTree::Kind::Octree: return *t.tree;
+      case CsgTree::Kind::Octree: return Part{*t.tree};
       case CsgTree::Kind::Mesh: {
         if (!t.name.empty()) say("sampling " + t.name);
-        Octree o = sample(*t.mesh, sampling_);
+        Part p{sample(*t.mesh, sampling_)};
         if (options_.on_leaf) options_.on_leaf();
-        return o;
+        return p;
       }
       case CsgTree::Kind::Union: return balanced(t.children, 0, t.children.size(), CsgOp::Union);
       case CsgTree::Kind::Intersection: return balanced(t.children, 0, t.children.size(), CsgOp::Intersect);
       case CsgTree::Kind::Difference: {
         if (t.children.empty()) throw InvalidInput("a difference needs the solid to take from");
         if (t.children.size() == 1) return eval(t.children[0]);
-        std::optional<Octree> a, b;
+        std::optional<Part> a, b;
         both([&] { a = eval(t.children[0]); }, [&] { b = balanced(t.children, 1, t.children.size(), CsgOp::Union); });
         if (!a || !b) return a;
         boolean(*a, *b, CsgOp::Subtract, t.children.size() == 2 ? t.children[1].name : std::string());
@@ -116,11 +123,11 @@ class TreeEvaluator {
   }
   /// kids[b, e) combined: the first floor(n/2) with the rest, each half the same way. An empty
   /// part leaves a union as the other part and makes an intersection empty.
-  std::optional<Octree> balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) {
+  std::optional<Part> balanced(const std::vector<CsgTree>& kids, size_t b, size_t e, CsgOp op) {
     if (b >= e) return std::nullopt;
     if (e - b == 1) return eval(kids[b]);
     const size_t mid = b + (e - b) / 2;
-    std::optional<Octree> x, y;
+    std::optional<Part> x, y;
     both([&] { x = balanced(kids, b, mid, op); }, [&] { y = balanced(kids, mid, e, op); });
     if (op == CsgOp::Intersect && (!x || !y)) return std::nullopt;
     if (!x) return y;
@@ -129,10 +136,13 @@ class TreeEvaluator {
     return x;
   }
   /// x := x op y, reported (`name`: y's, when it is a named leaf).
-  void boolean(Octree& x, const Octree& y, CsgOp op, const std::string& name) {
+  void boolean(Part& x, const Part& y, CsgOp op, const std::string& name) {
     if (!name.empty()) say(to_string(op) + " " + name);
     CsgStats st;
-    csg_inplace(x, y, op, options_.csg, &st);
+    CsgOptions csg = options_.csg;
+    csg.b_settled = y.settled;
+    csg_inplace(x.tree, y.tree, op, csg, &st);
+    x.settled = true;
     if (!options_.on_step) return;
     const std::lock_guard lock(step_mutex_);
     st.stamp = ++steps_;
@@ -155,9 +165,9 @@ Octree evaluate(const CsgTree& tree, const CsgChainOptions& options) {
     if (!all.positions.empty()) sampling.cube = bounding_cube(all, sampling.margin);
   }
   TreeEvaluator ev(options, sampling, first_octree(tree));
-  std::optional<Octree> result = ev.eval(tree);
+  std::optional<TreeEvaluator::Part> result = ev.eval(tree);
   if (!result) return ev.empty();
-  Octree& r = *result;
+  Octree& r = result->tree;
   if (options.compact && r.nodes.size() > detail::reachable_nodes(r)) detail::compact(r);
   return std::move(r);
 }
