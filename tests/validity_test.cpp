@@ -252,7 +252,7 @@ TEST(Validity, SculptingRunStaysValid) {
   EXPECT_TRUE(IsValidSolid(written(clay)));
 }
 
-// Issue 10's sculpting criterion: 300 strokes, then the written mesh is a valid solid. Strokes
+// A sculpting session: 300 strokes, then the written mesh is a valid solid. Strokes
 // carve (3 in 4) and add (1 in 4) small spheres of random radius, centred on the clay's surface:
 // every 25 strokes the centres are re-picked from the plain contour's vertices, so later
 // strokes land on earlier bites, where coarse old leaves meet fine new ones.

@@ -85,7 +85,8 @@ struct ImplicitSolid {
   /// f's gradient (pointing out of the solid); empty: central differences of `value`.
   std::function<Vec3(const Vec3&)> gradient;
   /// f and its gradient from one evaluation (optional; a distance's nearest point gives both):
-  /// edge crossings are then found by Newton steps, about two evaluations per edge.
+  /// edge crossings are then found by Newton steps, about two evaluations per edge (not used
+  /// when `values` is given: a batched f's crossings are found by false position, in step).
   std::function<double(const Vec3&, Vec3&)> value_gradient;
   /// f at many points at once (optional, and then `value` is not needed): the sampler asks
   /// each level's questions in batches -- a vectorised function (numpy) is called a few dozen

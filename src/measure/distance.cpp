@@ -25,11 +25,6 @@ using detail::dot3;
 using detail::norm3;
 using detail::sub3;
 
-double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  return std::sqrt(detail::point_triangle_distance2(p, a, b, c));
-}
-
-
 /// Deterministic 64-bit generator (SplitMix64) with a portable double in [0, 1).
 class Rng {
  public:

@@ -285,7 +285,7 @@ class LevelSampler {
         const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
         if (((signs >> c0) & 1) == ((signs >> c1) & 1)) continue;
         // An edge's key: its first corner and its axis (a level's edges share one length).
-        refs.push_back({pack(j.cell.corner(c0)) * 3 + uint64_t(edge_axis(e)), uint32_t(found.size())});
+        if (!memo_) refs.push_back({pack(j.cell.corner(c0)) * 3 + uint64_t(edge_axis(e)), uint32_t(found.size())});
         ids[e] = uint32_t(found.size());
         found.push_back({corner(c0), corner(c1), j.v[c0], j.v[c1], s});
         start.push_back({j.cell.corner(c0), edge_axis(e)});
@@ -345,32 +345,14 @@ class LevelSampler {
     }
   }
 
-  /// The surface point on every edge and f's gradient there, the edges' root finders run in
-  /// step: Newton steps where f gives its gradient with its value, else false position (then
-  /// the gradients in one more batch: f's own, or central differences).
+  /// The surface point on every edge and f's gradient there, for a batched f: the edges'
+  /// false-position finders run in step, then the gradients in one more batch (f's own, or
+  /// central differences).
   void crossings(std::vector<Edge>& edges) {
     if (edges.empty()) return;
     auto point = [&](const Edge& e, double t) { return add3(e.a, scale3(sub3(e.b, e.a), t)); };
     std::vector<size_t> active(edges.size());
     for (size_t i = 0; i < edges.size(); ++i) active[i] = i;
-    if (f_.value_gradient) {
-      std::vector<NewtonRoot> r;
-      for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
-      while (!active.empty()) {
-        evaluations += active.size();
-        for_each(active.size(), [&](size_t k) {
-          Edge& e = edges[active[k]];
-          NewtonRoot& n = r[active[k]];
-          Vec3 g;
-          const double fx = f_.value_gradient(world(point(e, n.next())), g);
-          e.g = g;
-          n.take(fx, dot3(g, sub3(e.b, e.a)) * cube_.size);
-        });
-        std::erase_if(active, [&](size_t i) { return r[i].done(); });
-      }
-      for (size_t i = 0; i < edges.size(); ++i) edges[i].x = point(edges[i], r[i].root());
-      return;
-    }
     std::vector<IllinoisRoot> r;
     for (const Edge& e : edges) r.emplace_back(e.fa, e.fb, kEdgeRoot, kEdgeRootSteps);
     std::erase_if(active, [&](size_t i) { return r[i].done(); });
@@ -385,7 +367,8 @@ class LevelSampler {
     gradients(edges);
   }
 
-  /// One edge's crossing and gradient as crossings() finds them, f asked point by point.
+  /// One edge's crossing and gradient, f asked point by point: Newton steps where f gives its
+  /// gradient with its value, else false position and then the gradient.
   void cross_one(Edge& e) {
     auto point = [&](double t) { return add3(e.a, scale3(sub3(e.b, e.a), t)); };
     if (f_.value_gradient) {
