@@ -49,6 +49,32 @@ TEST(Simplify, BoxMinusBallKeepsItsSurfaceWithFewerTriangles) {
               raw.triangles.size(), simple.triangles.size(), d.hausdorff / cell);
 }
 
+// A box minus a faceted ball (OpenSCAD's example004 in small): every crease where a facet
+// leaves a face runs off the lattice axes, and the contour's vertices along it lie a tenth of
+// a cell or two off its line. The simplified mesh still keeps to the raw contour at every
+// vertex both ways, and flat facets and straight creases become a few triangles each.
+TEST(Simplify, CreasesOffTheLatticeAxesCollapseToo) {
+  SampleOptions so;
+  so.depth = 8;
+  so.cube = Cube{{-1, -1, -1}, 2};
+  const Octree t = csg(sample(make_box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}), so), sample(make_sphere({0, 0, 0}, 0.8, 30), so),
+                       CsgOp::Subtract);
+  const double cell = t.cube.size / double(1 << t.max_depth);
+  const TriMesh raw = contour(t);
+  ContourOptions o;
+  o.simplify = 0.25;
+  const TriMesh simple = contour(t, o);
+  ASSERT_TRUE(IsClosedManifold(simple));
+  EXPECT_EQ(count_self_intersections(simple), 0u);
+  const SurfaceDistance at_vertices = surface_distance(raw, simple, 0);
+  EXPECT_LE(at_vertices.a_to_b, 0.25 * cell * (1 + 1e-9)) << "a raw vertex left behind";
+  EXPECT_LE(at_vertices.b_to_a, 0.25 * cell * (1 + 1e-9)) << "a new vertex off the raw contour";
+  EXPECT_LE(surface_distance(raw, simple, 20000).hausdorff, 0.75 * cell);
+  EXPECT_LT(simple.triangles.size() * 8, raw.triangles.size());
+  std::printf("  [measure] box - faceted ball at depth 8: %zu -> %zu triangles\n", raw.triangles.size(),
+              simple.triangles.size());
+}
+
 TEST(Simplify, ZeroToleranceLeavesTheMeshAlone) {
   TriMesh m = contour(box_minus_ball(6));
   const TriMesh before = m;

@@ -96,7 +96,7 @@ void add_csg(CLI::App& app) {
               "With --mesh: write the dual contouring mesh as is (it may touch itself at a few edges or vertices)");
   c->add_option("--error", a->error, "QEF residual threshold for new vertices")->capture_default_str();
   c->add_option("--simplify", a->simplify,
-                "Mesh output: merge flat regions and straight creases, every face within TOL finest cells")
+                "Mesh output: merge flat regions and straight creases, staying within about TOL finest cells of the raw contour")
       ->capture_default_str();
   c->add_flag("--raw", a->raw, "Mesh output: the contour as it is, a vertex per gray cell (no --simplify)");
   c->add_flag("--json", a->json, "Print one JSON object on stdout");

@@ -90,7 +90,7 @@ void add_eval(CLI::App& app) {
   c->add_flag("--serial", a->serial, "Do not use threads");
   c->add_flag("--no-split", a->no_split, "Mesh output: write the dual contouring mesh as is");
   c->add_option("--simplify", a->simplify,
-                "Mesh output: merge flat regions and straight creases, every face within TOL finest cells")
+                "Mesh output: merge flat regions and straight creases, staying within about TOL finest cells of the raw contour")
       ->capture_default_str();
   c->add_flag("--raw", a->raw, "Mesh output: the contour as it is, a vertex per gray cell (no --simplify)");
   c->callback([a] { run(*a); });

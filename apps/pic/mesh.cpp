@@ -63,7 +63,7 @@ void add_mesh(CLI::App& app) {
   c->add_flag("--plain", a->plain,
               "Dual contouring's plain split everywhere, for comparison: slivers may fold through each other");
   c->add_option("--simplify", a->simplify,
-                "Merge flat regions and straight creases, every face within TOL finest cells (0: the raw contour)")
+                "Merge flat regions and straight creases, staying within about TOL finest cells of the raw contour (0: the raw contour)")
       ->capture_default_str();
   c->add_flag("--fans", a->fans,
               "Every dual polygon a fan around a point of its edge, for comparison (about 2.4 times the triangles)");

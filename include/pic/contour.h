@@ -24,7 +24,7 @@ struct ContourOptions {
   /// intersection_free.
   bool fan_all = false;
   /// Merge the contour's vertices where the surface is flat or runs straight along a crease,
-  /// each within this many finest cells of every original plane it replaces (simplify());
+  /// staying within this many finest cells of the raw contour (simplify());
   /// 0: the raw contour, a vertex per gray leaf.
   double simplify = 0;
   /// The sampled solid's function, when known (input coordinates, < 0 inside: the function a
@@ -73,9 +73,9 @@ inline TriMesh unsplit_contour(const Octree& tree) {
 size_t split_nonmanifold(TriMesh& mesh);
 
 /// Collapses edges of a closed 2-manifold mesh, both ends moving to the point nearest their
-/// planes, while every original triangle's plane merged into the vertex passes within
-/// `tolerance` of it: flat regions become a few large triangles, straight creases keep their
-/// line, curved parts stay within tolerance. Each collapse keeps the mesh closed and
+/// planes, while every original vertex stays within `tolerance` of the result and the new
+/// vertex and triangles' centroids within `tolerance` of the original: flat regions become a
+/// few large triangles, straight creases keep their line, curved parts stay within tolerance. Each collapse keeps the mesh closed and
 /// 2-manifold (the link condition) and its triangles' orientation and shape; a result with a
 /// crossing is not taken. Returns the triangles removed.
 size_t simplify(TriMesh& mesh, double tolerance);

@@ -1,11 +1,13 @@
 // Output sized to the geometry: a dual contour has a vertex per gray cell, so a flat face or a
 // straight crease costs one vertex per finest cell along it. Edge collapses merge those
 // vertices: both ends move to the point nearest their planes (on a crease, onto its line),
-// allowed where every distinct plane of the original triangles merged into either end passes
-// within the tolerance of that point. Each collapse is checked locally (the link condition
-// keeps the mesh closed and 2-manifold; the turned triangles keep their orientation and do not
-// become needles), and the whole result is checked for crossings before it replaces the
-// contour.
+// allowed where every vertex of the original contour that the two stars answer for stays within
+// the tolerance of the new star. Original points, not original triangles' planes, are the
+// measure: a triangle spanning a crease between vertices a tenth of a cell off its line has a
+// plane tilted across the crease, which would stop every collapse along it. Each collapse is
+// checked locally (the link condition keeps the mesh closed and 2-manifold; the turned
+// triangles keep their orientation and do not become needles), and the whole result is checked
+// for crossings before it replaces the contour.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -16,6 +18,8 @@
 #include <vector>
 
 
+#include "geometry/lattice.h"
+#include "geometry/mesh_distance.h"
 #include "geometry/qef.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
@@ -82,36 +86,16 @@ double quality(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 
-/// A plane n.x + d = 0, n of unit length.
-struct Plane {
-  Vec3 n;
-  double d;
-};
-/// The most planes one vertex may answer for: a merge beyond is refused (curved parts keep
-/// their vertices long before, flat parts and creases need one to three).
-constexpr size_t kMaxPlanes = 48;
-
-/// Adds p to a set of planes unless one already there is the same plane: normals within about
-/// 1e-5 radians, offsets within `same` (a hundredth of the tolerance).
-void add_plane(std::vector<Plane>& set, const Plane& p, double same) {
-  for (const Plane& q : set)
-    if (dot3(p.n, q.n) > 1 - 1e-10 && std::abs(p.d - q.d) <= same) return;
-  set.push_back(p);
-}
-/// The largest distance from x to the planes.
-double farthest(const std::vector<Plane>& set, const Vec3& x) {
-  double far = 0;
-  for (const Plane& p : set) far = std::max(far, std::abs(dot3(p.n, x) + p.d));
-  return far;
-}
-
 class Simplifier {
  public:
   /// `frozen`: per vertex of `mesh`, whether it must stay where it is (empty: none).
-  Simplifier(const TriMesh& mesh, double tolerance, const std::vector<uint8_t>& frozen)
-      : pos_(mesh.positions), tris_(mesh.triangles), tol_(tolerance), same_(tolerance / 100), quadric_(pos_.size()),
-        planes_(pos_.size()), faces_(pos_.size()), alive_(tris_.size(), 1), merged_into_(pos_.size()),
-        frozen_(frozen) {
+  /// `surface`: the distance to `mesh`.
+  Simplifier(const TriMesh& mesh, const detail::MeshDistance& surface, double tolerance,
+             const std::vector<uint8_t>& frozen)
+      : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
+        quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
+        next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
+        merged_into_(pos_.size()), frozen_(frozen) {
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
@@ -122,11 +106,12 @@ class Simplifier {
       if (!(len > 0)) continue;
       const Vec3 u{n[0] / len, n[1] / len, n[2] / len};
       const double d = -dot3(u, pos_[t[0]]);
-      for (int k = 0; k < 3; ++k) {
-        quadric_[t[k]].add_plane(u, d);
-        add_plane(planes_[t[k]], {u, d}, same_);
-      }
+      for (int k = 0; k < 3; ++k) quadric_[t[k]].add_plane(u, d);
     }
+    // Each original vertex is answered for by one triangle of its star (it is that
+    // triangle's corner: at distance 0).
+    for (uint32_t v = 0; v < pos_.size(); ++v)
+      if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
   }
 
   /// Passes over the vertices, each moving onto the neighbour that keeps the planes closest,
@@ -179,14 +164,21 @@ class Simplifier {
 
  private:
   std::vector<Vec3> pos_;
+  const std::vector<Vec3> original_;
+  const detail::MeshDistance& original_surface_;
   std::vector<std::array<uint32_t, 3>> tris_;
-  double tol_, same_;
-  std::vector<Quadric> quadric_;       // per vertex: its planes summed (where to merge)
-  std::vector<std::vector<Plane>> planes_;  // per vertex: the distinct original planes merged into it
+  double tol_;
+  std::vector<Quadric> quadric_;              // per vertex: its planes summed (where to merge)
   std::vector<std::vector<uint32_t>> faces_;  // per vertex: its live triangles
+  // Per triangle, the original vertices it answers for: a list through next_point_.
+  static constexpr uint32_t kNoPoint = UINT32_MAX;
+  std::vector<uint32_t> first_point_, next_point_;
+  std::vector<double> near_;  // per original point: at most this far from its triangle
   std::vector<uint8_t> alive_;
+  std::vector<double> off_;              // per triangle: how far from the original it was found
+  std::vector<double> new_off_;          // per triangle of star_: the same for the collapse under test
+  uint32_t hint_ = 0;                    // where the last point near the raw contour found it
   std::vector<uint32_t> ring_u_, ring_v_;  // scratch
-  std::vector<Plane> merged_;
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
   struct Candidate {
@@ -195,7 +187,22 @@ class Simplifier {
     Vec3 x;
   };
   std::vector<Candidate> candidates_;
+  // A collapse under test: the star it leaves (triangle, corners) and, per original point of
+  // the two stars, the triangle of that star nearest to it.
+  std::vector<uint32_t> star_;
+  std::vector<std::array<Vec3, 3>> star_corners_;
+  std::vector<double> star_shift_;  // per triangle of star_: how far its moving corner goes
+  struct MovedPoint {
+    uint32_t point, triangle;
+    double near;  // at most this far from it
+  };
+  std::vector<MovedPoint> moved_points_;
 
+
+  void answer_for(uint32_t p, uint32_t f) {
+    next_point_[p] = first_point_[f];
+    first_point_[f] = p;
+  }
 
   void ring(uint32_t v, std::vector<uint32_t>& out) const {
     out.clear();
@@ -207,27 +214,19 @@ class Simplifier {
   }
 
   /// Where u and v merge: the point nearest their planes (least squares, truncated along the
-  /// directions they leave free, from the edge's middle), or else the better end; nothing when
-  /// every choice is farther than the tolerance from one of the original planes merged into u
-  /// or v. `error`: the largest distance to them there.
-  std::optional<Vec3> merged_position(uint32_t u, uint32_t v, double& error) {
+  /// directions they leave free, from the edge's middle) when it stays near the edge, else the
+  /// edge's middle. `error`: the root mean squared distance to the planes there (the order in
+  /// which neighbours are tried).
+  Vec3 merged_position(uint32_t u, uint32_t v, double& error) const {
     Quadric q = quadric_[u];
     q.add(quadric_[v]);
     const Vec3 &a = pos_[u], &b = pos_[v];
     const Vec3 mid{(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2};
-    const Vec3 x = q.minimum_near(mid);
-    // The largest distance is at least the mean: where the mean is over, no need to look.
-    const double tol2 = tol_ * tol_;
-    if (q.mean_at(x) > tol2 && q.mean_at(a) > tol2 && q.mean_at(b) > tol2) return std::nullopt;
-    merged_.assign(planes_[u].begin(), planes_[u].end());
-    for (const Plane& p : planes_[v]) add_plane(merged_, p, same_);
-    if (merged_.size() > kMaxPlanes) return std::nullopt;
+    Vec3 x = q.minimum_near(mid);
     // Keep to the edge's neighbourhood: a far optimum of nearly parallel planes is no merge.
-    if (dist2(x, mid) <= dist2(a, b) && (error = farthest(merged_, x)) <= tol_) return x;
-    const double ea = farthest(merged_, a), eb = farthest(merged_, b);
-    error = std::min(ea, eb);
-    if (error > tol_) return std::nullopt;
-    return ea < eb ? a : b;
+    if (!(dist2(x, mid) <= dist2(a, b))) x = mid;
+    error = std::sqrt(std::max(0.0, q.mean_at(x)));
+    return x;
   }
 
   /// Merges u with the neighbour that keeps the planes closest, among those that may take it.
@@ -237,8 +236,10 @@ class Simplifier {
     candidates_.clear();
     double error = 0;
     for (uint32_t v : ring_u_)
-      if (!frozen_[v])
-        if (const auto x = merged_position(u, v, error)) candidates_.push_back({error, v, *x});
+      if (!frozen_[v]) {
+        const Vec3 x = merged_position(u, v, error);
+        candidates_.push_back({error, v, x});
+      }
     std::sort(candidates_.begin(), candidates_.end(),
               [](const Candidate& a, const Candidate& b) { return a.error < b.error || (a.error == b.error && a.v < b.v); });
     for (const Candidate& c : candidates_)
@@ -250,8 +251,8 @@ class Simplifier {
   }
 
   /// The link condition (the vertices next to both u and v are exactly the two across the
-  /// edge uv), and every triangle of u or v that survives keeps its orientation and its shape
-  /// when both move to x.
+  /// edge uv), every triangle of u or v that survives keeps its orientation and its shape
+  /// when both move to x, and the original points stay within the tolerance.
   bool can_collapse(uint32_t u, uint32_t v, const Vec3& x) {
     int shared = 0;
     std::array<uint32_t, 2> across{};
@@ -271,7 +272,108 @@ class Simplifier {
     if (common != 2) return false;
     // A closed mesh of 4 vertices (a tetrahedron) would fold flat.
     if (ring_u_.size() <= 3 && ring_v_.size() <= 3) return false;
-    return keeps_shape(u, v, x) && keeps_shape(v, u, x);
+    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x) && near_original(u, v, x);
+  }
+
+  /// Whether every original point the stars of u and v answer for lies within the tolerance
+  /// of the star both leave at x; records a triangle there that answers for it (moved_points_).
+  bool keeps_points(uint32_t u, uint32_t v, const Vec3& x) {
+    star_.clear();
+    star_corners_.clear();
+    star_shift_.clear();
+    moved_points_.clear();
+    const double shift_u = std::sqrt(dist2(x, pos_[u])), shift_v = std::sqrt(dist2(x, pos_[v]));
+    for (uint32_t w : {u, v})
+      for (uint32_t f : faces_[w]) {
+        const auto& t = tris_[f];
+        const bool gone = (t[0] == u || t[1] == u || t[2] == u) && (t[0] == v || t[1] == v || t[2] == v);
+        if (gone || (w == v && (t[0] == u || t[1] == u || t[2] == u))) continue;
+        std::array<Vec3, 3> c;
+        for (int k = 0; k < 3; ++k) c[k] = t[k] == u || t[k] == v ? x : pos_[t[k]];
+        star_.push_back(f);
+        star_corners_.push_back(c);
+        star_shift_.push_back(w == u ? shift_u : shift_v);
+      }
+    const double tol2 = tol_ * tol_;
+    auto distance2 = [&](uint32_t p, size_t k) {
+      const auto& c = star_corners_[k];
+      return detail::point_triangle_distance2(original_[p], c[0], c[1], c[2]);
+    };
+    // Any triangle of the new star within the tolerance answers for a point: its own first
+    // (where it stays), then the others. A triangle that one corner leaves by s moves no
+    // point of it farther than s: a point that was near enough before and still is by that
+    // bound (`near_`) needs no new distance.
+    auto check = [&](uint32_t f) {
+      const size_t own = size_t(std::find(star_.begin(), star_.end(), f) - star_.begin());
+      for (uint32_t p = first_point_[f]; p != kNoPoint; p = next_point_[p]) {
+        if (own < star_.size() && near_[p] + star_shift_[own] <= tol_) {
+          moved_points_.push_back({p, f, near_[p] + star_shift_[own]});
+          continue;
+        }
+        size_t at = star_.size();
+        double d2 = 0;
+        if (own < star_.size() && (d2 = distance2(p, own)) <= tol2) at = own;
+        for (size_t k = 0; k < star_.size() && at == star_.size(); ++k)
+          if (k != own && (d2 = distance2(p, k)) <= tol2) at = k;
+        if (at == star_.size()) return false;
+        moved_points_.push_back({p, star_[at], std::sqrt(d2)});
+      }
+      return true;
+    };
+    for (uint32_t f : faces_[u])
+      if (!check(f)) return false;
+    for (uint32_t f : faces_[v]) {
+      const auto& t = tris_[f];
+      if (t[0] != u && t[1] != u && t[2] != u && !check(f)) return false;
+    }
+    return true;
+  }
+
+  /// Whether the new star lies within the tolerance of the original surface (the other way
+  /// round): its vertex, and each triangle's centroid (a long triangle across a fold). A point
+  /// near a triangle of the stars as they are now is as near the original as that triangle
+  /// (`off_`: how far each triangle was found from it, 0 for one no collapse has changed);
+  /// else the original surface is searched. The bounds found go to the new star (new_off_).
+  bool near_original(uint32_t u, uint32_t v, const Vec3& x) {
+    auto bound_by = [&](const Vec3& m, uint32_t f) {
+      const auto& t = tris_[f];
+      return off_[f] + std::sqrt(detail::point_triangle_distance2(m, pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+    };
+    // `own`: the triangle whose new shape the point lies on, tried first (the nearest, mostly).
+    auto bound = [&](const Vec3& m, uint32_t own) {
+      // The first triangle within half the tolerance will do: the bound stays low enough
+      // for the next collapse, at a fraction of the distances.
+      double best = own != kNoPoint ? bound_by(m, own) : detail::kHuge;
+      if (best <= tol_ / 2) return best;
+      for (uint32_t w : {u, v})
+        for (uint32_t f : faces_[w]) {
+          if (f == own || off_[f] >= tol_) continue;
+          best = std::min(best, bound_by(m, f));
+          if (best <= tol_ / 2) return best;
+        }
+      if (best <= tol_) return best;
+      return original_surface_.within(m, tol_, &hint_) ? tol_ : detail::kHuge;
+    };
+    // The vertex itself is asked of the original surface: the bounds above are as good as
+    // the points they were found at.
+    if (!original_surface_.within(x, tol_, &hint_)) return false;
+    const double at_x = bound(x, kNoPoint);
+    new_off_.clear();
+    for (size_t i = 0; i < star_.size(); ++i) {
+      const auto& c = star_corners_[i];
+      const Vec3 m{(c[0][0] + c[1][0] + c[2][0]) / 3, (c[0][1] + c[1][1] + c[2][1]) / 3, (c[0][2] + c[1][2] + c[2][2]) / 3};
+      // And the middle of the side that leaves x towards the next corner (each such side of
+      // the star once): a side across a valley of the original stays in reach of it.
+      const int k = c[0] == x ? 0 : c[1] == x ? 1 : 2;
+      const Vec3& y = c[(k + 1) % 3];
+      const Vec3 e{(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2};
+      const double at_m = bound(m, star_[i]);
+      if (at_m > tol_) return false;
+      const double at_e = bound(e, star_[i]);
+      if (at_e > tol_) return false;
+      new_off_.push_back(std::max({at_x, at_m, at_e}));
+    }
+    return true;
   }
 
   /// Whether the triangles of `a` without `b` keep orientation and shape with `a` at x.
@@ -297,7 +399,15 @@ class Simplifier {
     return true;
   }
 
+  /// Carries out the collapse keeps_points() last accepted (of u into v at x).
   void collapse(uint32_t u, uint32_t v, const Vec3& x) {
+    for (uint32_t w : {u, v})
+      for (uint32_t f : faces_[w]) first_point_[f] = kNoPoint;
+    for (const MovedPoint& m : moved_points_) {
+      answer_for(m.point, m.triangle);
+      near_[m.point] = m.near;
+    }
+    for (size_t k = 0; k < star_.size(); ++k) off_[star_[k]] = new_off_[k];
     pos_[v] = x;
     merged_into_[u] = v;
     for (uint32_t f : faces_[u]) {
@@ -314,8 +424,6 @@ class Simplifier {
     }
     faces_[u].clear();
     quadric_[v].add(quadric_[u]);
-    for (const Plane& p : planes_[u]) add_plane(planes_[v], p, same_);
-    planes_[u].clear();
   }
 };
 
@@ -328,8 +436,9 @@ size_t simplify(TriMesh& mesh, double tolerance) {
   // input vertices merged into the crossing triangles stay as they are, and the rest is
   // simplified again (a few rounds; the raw contour when crossings remain).
   std::vector<uint8_t> frozen(mesh.positions.size(), 0);
+  const detail::MeshDistance surface(mesh);
   for (int round = 0; round < 4; ++round) {
-    Simplifier s(mesh, tolerance, frozen);
+    Simplifier s(mesh, surface, tolerance, frozen);
     s.run();
     std::vector<uint32_t> kept;
     TriMesh out = s.result(kept);

@@ -31,6 +31,9 @@ class MeshDistance {
   explicit MeshDistance(const TriMesh& mesh);
   /// Unsigned distance from p to the mesh (infinity for an empty mesh).
   double distance(const Vec3& p) const;
+  /// Whether some triangle lies within r of p (the search ends at the first one found).
+  /// `hint` (opaque, optional): where a point close by found one; set to this one's.
+  bool within(const Vec3& p, double r, uint32_t* hint = nullptr) const;
   /// The mesh's point nearest p (the mesh must have a triangle). `hint`, when given, names
   /// where the answer for a point close by was found (opaque; start with 0): that triangle's
   /// distance bounds the search from the start. It is set to this answer's.
