@@ -110,8 +110,12 @@ std::vector<pic::CsgTree> to_tree_leaves(py::iterable xs) {
 }
 
 /// A volumetric operation on a PIC object (through its contour) or a mesh, without the GIL.
-std::unique_ptr<PyOctree> volume_op(py::handle x, int depth, double error, py::handle cube, bool parallel,
-                                    const std::function<pic::Octree(const pic::TriMesh&, const pic::SampleOptions&)>& op) {
+/// A volume operation on an Octree (through its contour) or a mesh. With `mesh`, also its
+/// contour with every point on the operation's exact surface (pic::VolumeMesh): a tuple
+/// (Octree, (vertices, faces)).
+using VolumeOp = std::function<pic::Octree(const pic::TriMesh&, const pic::SampleOptions&, pic::VolumeMesh*)>;
+py::object volume_op(py::handle x, int depth, double error, py::handle cube, bool parallel, bool mesh,
+                     const VolumeOp& op) {
   pic::SampleOptions o;
   o.depth = depth;
   o.error = error;
@@ -119,12 +123,14 @@ std::unique_ptr<PyOctree> volume_op(py::handle x, int depth, double error, py::h
   o.parallel = parallel;
   pic::CsgOperand operand = to_operand(x, 0);
   pic::Octree result;
+  pic::VolumeMesh surface;
   {
     py::gil_scoped_release nogil;
-    const pic::TriMesh mesh = operand.tree ? pic::contour(*operand.tree) : std::move(operand.mesh);
-    result = op(mesh, o);
+    const pic::TriMesh input = operand.tree ? pic::contour(*operand.tree) : std::move(operand.mesh);
+    result = op(input, o, mesh ? &surface : nullptr);
   }
-  return wrap(std::move(result));
+  if (!mesh) return py::cast(wrap(std::move(result)));
+  return py::make_tuple(wrap(std::move(result)), from_mesh(surface.mesh));
 }
 
 /// An implicit solid from a Python function of an (n, 3) array of points returning n values
@@ -321,54 +327,63 @@ sampled into one cube around them all at `depth`.)doc");
       py::arg("parallel") = true, "a minus the union of the others: difference(a, [b, c]) = a - (b | c).");
   m.def(
       "offset",
-      [](py::handle x, double distance, int depth, double error, py::object cube, bool parallel) {
-        return volume_op(x, depth, error, cube, parallel,
-                         [&](const pic::TriMesh& m, const pic::SampleOptions& o) { return pic::offset(m, distance, o); });
+      [](py::handle x, double distance, int depth, double error, py::object cube, bool parallel, bool mesh) {
+        return volume_op(x, depth, error, cube, parallel, mesh,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o, pic::VolumeMesh* vm) {
+                           return pic::offset(m, distance, o, nullptr, vm);
+                         });
       },
       py::arg("solid"), py::arg("distance"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
-      py::arg("cube") = py::none(), py::arg("parallel") = true,
-      R"doc(The solid grown by distance (> 0) or shrunk (< 0): pic::offset. solid: an Octree or a mesh.)doc");
+      py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("mesh") = false,
+      R"doc(The solid grown by distance (> 0) or shrunk (< 0): pic::offset. solid: an Octree or a mesh.
+mesh=True: returns (Octree, (vertices, faces)), the mesh's points on the exact offset surface.)doc");
   m.def(
       "shell",
-      [](py::handle x, double thickness, bool outward, int depth, double error, py::object cube, bool parallel) {
-        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
-          return pic::shell(m, thickness, outward, o);
-        });
+      [](py::handle x, double thickness, bool outward, int depth, double error, py::object cube, bool parallel,
+         bool mesh) {
+        return volume_op(x, depth, error, cube, parallel, mesh,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o, pic::VolumeMesh* vm) {
+                           return pic::shell(m, thickness, outward, o, nullptr, vm);
+                         });
       },
       py::arg("solid"), py::arg("thickness"), py::kw_only(), py::arg("outward") = false, py::arg("depth") = 12,
-      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true,
+      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("mesh") = false,
       "The solid hollowed to walls `thickness` thick (outward: a skin around it): pic::shell.");
   m.def(
       "round",
-      [](py::handle x, double radius, bool concave, int depth, double error, py::object cube, bool parallel) {
-        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
-          return pic::round_edges(m, radius, !concave, o);
-        });
+      [](py::handle x, double radius, bool concave, int depth, double error, py::object cube, bool parallel,
+         bool mesh) {
+        return volume_op(x, depth, error, cube, parallel, mesh,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o, pic::VolumeMesh* vm) {
+                           return pic::round_edges(m, radius, !concave, o, nullptr, vm);
+                         });
       },
       py::arg("solid"), py::arg("radius"), py::kw_only(), py::arg("concave") = false, py::arg("depth") = 12,
-      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true,
+      py::arg("error") = 1e-8, py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("mesh") = false,
       "Convex edges rounded to `radius` (concave=True: concave edges filled): pic::round_edges.");
   m.def(
       "minkowski_round",
-      [](py::handle x, py::object body, int depth, double error, py::object cube, bool parallel) {
+      [](py::handle x, py::object body, int depth, double error, py::object cube, bool parallel, bool mesh) {
         const std::vector<pic::Vec3> points = to_points(body, "body");
-        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
-          return pic::minkowski_round(m, points, o);
-        });
+        return volume_op(x, depth, error, cube, parallel, mesh,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o, pic::VolumeMesh* vm) {
+                           return pic::minkowski_round(m, points, o, nullptr, vm);
+                         });
       },
       py::arg("solid"), py::arg("body"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
-      py::arg("cube") = py::none(), py::arg("parallel") = true,
+      py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("mesh") = false,
       R"doc(The Minkowski sum of a solid with a round convex body given by its (n, 3) vertices (a faceted
 sphere): pic::minkowski_round. Faces exact; rounds within the body's facet depth.)doc");
   m.def(
       "thicken",
-      [](py::handle x, double thickness, int depth, double error, py::object cube, bool parallel) {
-        return volume_op(x, depth, error, cube, parallel, [&](const pic::TriMesh& m, const pic::SampleOptions& o) {
-          return pic::thicken(m, thickness, o);
-        });
+      [](py::handle x, double thickness, int depth, double error, py::object cube, bool parallel, bool mesh) {
+        return volume_op(x, depth, error, cube, parallel, mesh,
+                         [&](const pic::TriMesh& m, const pic::SampleOptions& o, pic::VolumeMesh* vm) {
+                           return pic::thicken(m, thickness, o, nullptr, vm);
+                         });
       },
       py::arg("surface"), py::arg("thickness"), py::kw_only(), py::arg("depth") = 12, py::arg("error") = 1e-8,
-      py::arg("cube") = py::none(), py::arg("parallel") = true,
+      py::arg("cube") = py::none(), py::arg("parallel") = true, py::arg("mesh") = false,
       "The solid within thickness / 2 of a surface, open or closed: pic::thicken.");
   m.def("sample_function", &sample_function, py::arg("f"), py::arg("cube"), py::kw_only(), py::arg("depth") = 8,
         py::arg("error") = 1e-8, py::arg("gradient") = py::none(), py::arg("lipschitz") = 1.0,

@@ -142,27 +142,29 @@ def difference(a: Any, solids: Iterable[Any], *, depth: int = 12, error: float =
     ...
 
 def offset(solid: Any, distance: float, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
-           parallel: bool = True) -> Octree:
-    """The solid grown by distance (> 0) or shrunk (< 0); solid: an Octree or a mesh."""
+           parallel: bool = True, mesh: bool = False) -> Any:
+    """The solid grown by distance (> 0) or shrunk (< 0); solid: an Octree or a mesh. With
+    mesh=True: (Octree, (vertices, faces)), the mesh's points on the exact offset surface (as
+    every volume operation below takes it)."""
     ...
 
 def minkowski_round(solid: Any, body: Any, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
-                    parallel: bool = True) -> Octree:
+                    parallel: bool = True, mesh: bool = False) -> Any:
     """The Minkowski sum of a solid with a round convex body (its (n, 3) vertices: a faceted sphere)."""
     ...
 
 def shell(solid: Any, thickness: float, *, outward: bool = False, depth: int = 12, error: float = 1e-8,
-          cube: Any = None, parallel: bool = True) -> Octree:
+          cube: Any = None, parallel: bool = True, mesh: bool = False) -> Any:
     """The solid hollowed to walls `thickness` thick (outward: a skin around it)."""
     ...
 
 def round(solid: Any, radius: float, *, concave: bool = False, depth: int = 12, error: float = 1e-8,
-          cube: Any = None, parallel: bool = True) -> Octree:
+          cube: Any = None, parallel: bool = True, mesh: bool = False) -> Any:
     """Convex edges rounded to `radius` (concave=True: concave edges filled)."""
     ...
 
 def thicken(surface: Any, thickness: float, *, depth: int = 12, error: float = 1e-8, cube: Any = None,
-            parallel: bool = True) -> Octree:
+            parallel: bool = True, mesh: bool = False) -> Any:
     """The solid within thickness / 2 of a surface, open or closed."""
     ...
 

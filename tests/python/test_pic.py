@@ -525,6 +525,22 @@ def test_offset_shell_round_thicken_volumes():
     assert abs(_volume(slab) - exact) < 0.02 * exact
 
 
+def test_volume_mesh_lies_on_the_exact_offset():
+    cube_mesh = pic.make_box((0, 0, 0), (1, 1, 1))
+    tree, (v, f) = pic.offset(cube_mesh, 0.1, depth=7, mesh=True)
+    assert isinstance(tree, pic.Octree)
+    assert edges_closed_manifold(f)
+    # Distance to the unit cube from outside it: every point of the mesh is at 0.1.
+    d = np.linalg.norm(np.maximum(np.abs(v - 0.5) - 0.5, 0), axis=1)
+    cell = tree.cube[3] / 2 ** 7
+    assert np.abs(d - 0.1).max() < 0.25 * cell
+    # The Octree's own contour does not know the function: its edge points are the vertices'.
+    cv, _ = pic.contour(tree)
+    assert np.abs(np.linalg.norm(np.maximum(np.abs(cv - 0.5) - 0.5, 0), axis=1) - 0.1).max() >= np.abs(d - 0.1).max()
+    shelled = pic.shell(cube_mesh, 0.1, depth=6, mesh=True)
+    assert isinstance(shelled, tuple) and edges_closed_manifold(shelled[1][1])
+
+
 def test_minkowski_round_moves_faces_by_the_support():
     ball_v, _ = pic.make_sphere((0, 0, 0), 0.1, segments=64)
     cube_mesh = pic.make_box((0, 0, 0), (1, 1, 1))
