@@ -188,7 +188,7 @@ class Simplifier {
   };
   std::vector<Candidate> candidates_;
   // A collapse under test: the star it leaves (triangle, corners) and, per original point of
-  // the two stars, the triangle of that star nearest to it.
+  // the two stars, a triangle of that star within the tolerance of it.
   std::vector<uint32_t> star_;
   std::vector<std::array<Vec3, 3>> star_corners_;
   std::vector<double> star_shift_;  // per triangle of star_: how far its moving corner goes
@@ -198,7 +198,7 @@ class Simplifier {
   };
   std::vector<MovedPoint> moved_points_;
 
-
+  /// Triangle f answers for original point p from now on.
   void answer_for(uint32_t p, uint32_t f) {
     next_point_[p] = first_point_[f];
     first_point_[f] = p;
