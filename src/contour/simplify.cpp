@@ -172,6 +172,7 @@ class Simplifier {
   std::vector<std::vector<uint32_t>> faces_;  // per vertex: its live triangles
   // Per triangle, the original vertices it answers for: a list through next_point_.
   static constexpr uint32_t kNoPoint = UINT32_MAX;
+  static constexpr uint32_t kNoTriangle = UINT32_MAX;
   std::vector<uint32_t> first_point_, next_point_;
   std::vector<double> near_;  // per original point: at most this far from its triangle
   std::vector<uint8_t> alive_;
@@ -343,7 +344,7 @@ class Simplifier {
     auto bound = [&](const Vec3& m, uint32_t own) {
       // The first triangle within half the tolerance will do: the bound stays low enough
       // for the next collapse, at a fraction of the distances.
-      double best = own != kNoPoint ? bound_by(m, own) : detail::kHuge;
+      double best = own != kNoTriangle ? bound_by(m, own) : detail::kHuge;
       if (best <= tol_ / 2) return best;
       for (uint32_t w : {u, v})
         for (uint32_t f : faces_[w]) {
@@ -357,7 +358,7 @@ class Simplifier {
     // The vertex itself is asked of the original surface: the bounds above are as good as
     // the points they were found at.
     if (!original_surface_.within(x, tol_, &hint_)) return false;
-    const double at_x = bound(x, kNoPoint);
+    const double at_x = bound(x, kNoTriangle);
     new_off_.clear();
     for (size_t i = 0; i < star_.size(); ++i) {
       const auto& c = star_corners_[i];
