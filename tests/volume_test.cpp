@@ -6,6 +6,9 @@
 #include <numbers>
 #include <string>
 
+#include <random>
+
+#include "geometry/mesh_distance.h"
 #include "pic/contour.h"
 #include "pic/csg.h"
 #include "pic/io.h"
@@ -268,6 +271,66 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
   EXPECT_GE(offset_distance(vm.mesh, spot, d + cell, 0).worst_vertex, 0.5 * cell);
   std::printf("worst vertex: %.3f cells with the function, %.3f without\n", exact.worst_vertex / cell,
               plain.worst_vertex / cell);
+}
+
+TEST(MeshDistance, FartherThanNeverMissesATriangle) {
+  // Boxes of 1 to 32 finest cells (depth 10) about spot's surface and radii up to 40 cells:
+  // whenever the test says every triangle is farther than r, no point of the box may be
+  // within r (checked on a 6 x 6 x 6 grid of points in it). Boxes the centre's distance
+  // alone clears must be cleared, and the test must clear more than those.
+  const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  const detail::MeshDistance md(spot);
+  const double cell = 2.0 / 1024;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  int cleared = 0, by_centre = 0, beyond_centre = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3& v = spot.positions[rng() % spot.positions.size()];
+    const double size = cell * std::pow(2.0, std::floor(6 * u(rng))), r = 40 * cell * u(rng);
+    Vec3 lo, hi;
+    for (int k = 0; k < 3; ++k) lo[k] = v[k] + (u(rng) - 0.5) * 2 * (r + 2 * size), hi[k] = lo[k] + size;
+    const bool away = md.farther_than(lo, hi, r);
+    const Vec3 centre{(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+    const bool centre_clears = md.distance(centre) > r + size * std::sqrt(3.0) / 2;
+    if (centre_clears) {
+      ++by_centre;
+      EXPECT_TRUE(away);
+    }
+    if (!away) continue;
+    ++cleared;
+    beyond_centre += !centre_clears;
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b < 6; ++b)
+        for (int c = 0; c < 6; ++c) {
+          const Vec3 p{lo[0] + size * a / 5, lo[1] + size * b / 5, lo[2] + size * c / 5};
+          ASSERT_GT(md.distance(p), r) << "box " << i << " point " << a << b << c;
+        }
+  }
+  EXPECT_GT(by_centre, 100);
+  EXPECT_GT(beyond_centre, 30);
+  std::printf("cleared %d of 3000 boxes, %d the centre alone would not\n", cleared, beyond_centre);
+}
+
+TEST(Offset, CellsBesideTheSurfaceStayCoarse) {
+  // The offset's distance proves uniform cells beside its surface clear (a ball about a
+  // mesh point holds the cell, or every triangle lies beyond the distance), where the
+  // bound from f at the centre cannot: the same surface with far fewer cells. Sampled again
+  // without that proof, the gray leaves and so the contour must be the same, bit for bit.
+  const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  const double d = 0.05;
+  const Octree t = offset(spot, d, at_depth(9));
+  const detail::SignedDistance sd(spot);
+  ImplicitSolid plain;
+  plain.value = [&](const Vec3& p) { return sd(p) - d; };
+  plain.value_gradient = [&](const Vec3& p, Vec3& g) { return sd.with_gradient(p, g) - d; };
+  SampleOptions o = at_depth(9);
+  o.cube = t.cube;
+  const Octree u = sample(plain, o);
+  const TriMesh a = contour(t), b = contour(u);
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_LT(double(t.nodes.size()), 0.7 * double(u.nodes.size()));
+  std::printf("nodes: %zu with the proof, %zu without\n", t.nodes.size(), u.nodes.size());
 }
 
 TEST(Offset, EveryLatticePointHasOneSignWhereTheDistanceBreaksItsBound) {

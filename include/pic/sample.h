@@ -95,6 +95,12 @@ struct ImplicitSolid {
   /// The gradients at many points at once (optional).
   std::function<void(const std::vector<Vec3>& points, std::vector<Vec3>& gradients)> gradients;
   double lipschitz = 1;
+  /// Whether f keeps one sign over the whole box [lo, hi] (world units), proven (optional;
+  /// false when unsure). Asked, in place of f at the centre, of each cell whose corners agree
+  /// and that no corner's value proves clear: it must prove at least what |f(centre)| beyond
+  /// the half-diagonal times `lipschitz` does. Near the surface a distance proves more (it
+  /// knows where its surface lies), so the cells beside a coarse leaf stay coarse.
+  std::function<bool(const Vec3& lo, const Vec3& hi)> clear;
 };
 /// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs
 /// from f (0 counts as outside), edge crossings by root finding, Hermite normals from the

@@ -168,6 +168,81 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint) const {
   return bound2 < 0;
 }
 
+namespace {
+
+/// Squared distance between two boxes (0 when they meet).
+template <class A, class B>
+double box_box_distance2(const A& a, const B& b) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max({double(a.lo[k]) - double(b.hi[k]), 0.0, double(b.lo[k]) - double(a.hi[k])});
+    s += d * d;
+  }
+  return s;
+}
+
+struct Box {
+  Vec3 lo, hi;
+};
+
+/// Whether triangle abc (unit normal n, or zero) lies farther than r from every point of the
+/// box: all eight corners beyond r on one side of its plane, or its distance from the box's
+/// centre beyond r plus the half-diagonal (each point of the box is that close to the centre).
+bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double r) {
+  double lo = kHuge, hi = -kHuge;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 x{k & 1 ? box.hi[0] : box.lo[0], k & 2 ? box.hi[1] : box.lo[1], k & 4 ? box.hi[2] : box.lo[2]};
+    const double h = dot3(n, sub3(x, a));
+    lo = std::min(lo, h), hi = std::max(hi, h);
+  }
+  if (lo > r || hi < -r) return true;
+  const Vec3 centre = scale3(add3(box.lo, box.hi), 0.5);
+  const double reach = r + norm3(sub3(box.hi, box.lo)) / 2;
+  return point_triangle_distance2(centre, a, b, c) > reach * reach;
+}
+
+}  // namespace
+
+bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const {
+  const Box box{lo, hi};
+  const double r2 = r * r;
+  // A triangle the whole box cannot prove away may still be proven from each of its octants.
+  auto away = [&](const LeafTriangle& t) {
+    if (box_box_distance2(t, box) > r2) return true;
+    const Vec3 n = cross3(sub3(t.b, t.a), sub3(t.c, t.a));
+    const double len = norm3(n);
+    const Vec3 u = len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0};
+    if (triangle_farther(box, t.a, t.b, t.c, u, r)) return true;
+    const Vec3 mid = scale3(add3(lo, hi), 0.5);
+    for (int k = 0; k < 8; ++k) {
+      Box o;
+      for (int i = 0; i < 3; ++i) {
+        const bool upper = (k >> i) & 1;
+        o.lo[i] = upper ? mid[i] : lo[i];
+        o.hi[i] = upper ? hi[i] : mid[i];
+      }
+      if (!triangle_farther(o, t.a, t.b, t.c, u, r)) return false;
+    }
+    return true;
+  };
+  if (nodes_.empty()) return true;
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BNode& nd = nodes_[stack[--top]];
+    if (box_box_distance2(nd, box) > r2) continue;
+    if (nd.count == 0) {
+      stack[top++] = nd.first;
+      stack[top++] = nd.first + 1;
+      continue;
+    }
+    for (uint32_t i = nd.first; i < nd.first + nd.count; ++i)
+      if (!away(tris_[i])) return false;
+  }
+  return true;
+}
+
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;

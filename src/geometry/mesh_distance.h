@@ -34,6 +34,10 @@ class MeshDistance {
   /// Whether some triangle lies within r of p (the search ends at the first one found).
   /// `hint` (opaque, optional): where a point close by found one; set to this one's.
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr) const;
+  /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when
+  /// unsure: a triangle's bounds, its plane and its distance from the box's centre or its
+  /// octants' centres each may prove it away).
+  bool farther_than(const Vec3& lo, const Vec3& hi, double r) const;
   /// The mesh's point nearest p (the mesh must have a triangle). `hint`, when given, names
   /// where the answer for a point close by was found (opaque; start with 0): that triangle's
   /// distance bounds the search from the start. It is set to this answer's.
@@ -71,6 +75,7 @@ class SignedDistance {
   /// The signed distance and its gradient (unit length, pointing outward; the nearest
   /// face's normal where p is on the surface). `hint`: see MeshDistance::nearest.
   double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr) const;
+  const MeshDistance& mesh_distance() const { return distance_; }
 
  private:
   const TriMesh& mesh_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "geometry/tolerances.h"
 
@@ -57,11 +58,15 @@ double illinois_root(F&& f, double f0, double f1, double tolerance, int iteratio
 
 /// A root of f along [0, 1] by Newton steps on f and its slope from one evaluation, kept
 /// inside the bracket that the values shrink (bisection where a step would leave it), to
-/// `tolerance`; starts at false position. The slope at the answer is that of the last value.
+/// `tolerance`; starts at false position. Where f is smooth Newton converges quadratically:
+/// after a step shorter than sqrt(tolerance) the next would be shorter than tolerance (times
+/// f''/f'), so that step is the last and f is not asked at its end. The slope at the answer
+/// is that of the last value (its direction within that step of the answer's).
 class NewtonRoot {
  public:
   NewtonRoot(double f0, double f1, double tolerance, int iterations)
-      : f0_(f0), t_(std::clamp(f0 / (f0 - f1), 0.0, 1.0)), tolerance_(tolerance), iterations_(iterations) {}
+      : f0_(f0), t_(std::clamp(f0 / (f0 - f1), 0.0, 1.0)), tolerance_(tolerance), last_step_(std::sqrt(tolerance)),
+        iterations_(iterations) {}
   bool done() const { return done_; }
   double next() const { return t_; }
   /// f and its slope at next().
@@ -73,14 +78,14 @@ class NewtonRoot {
     ((ft < 0) == (f0_ < 0) ? lo_ : hi_) = t_;
     double step = t_ - ft / slope;
     if (!(step > lo_ && step < hi_)) step = (lo_ + hi_) / 2;
-    done_ = std::abs(step - t_) < tolerance_;
+    done_ = std::abs(step - t_) < last_step_;
     t_ = step;
     if (hi_ - lo_ < tolerance_) done_ = true;
   }
   double root() const { return t_; }
 
  private:
-  double lo_ = 0, hi_ = 1, f0_, t_, tolerance_;
+  double lo_ = 0, hi_ = 1, f0_, t_, tolerance_, last_step_;
   int iterations_, it_ = 0;
   bool done_ = false;
 };

@@ -230,7 +230,8 @@ class LevelSampler {
 
   /// Uniform cells become leaves at the cap or where f's bound keeps the surface out of the
   /// whole cell: |f| at a corner beyond the diagonal, else at the centre beyond half of it
-  /// (those centres asked in one batch). The rest go to `split`.
+  /// (those centres asked in one batch) -- or, where f can say so, its box proven clear. The
+  /// rest go to `split`.
   void settle_uniform(const std::vector<Job>& jobs, Builder& out, std::vector<Job>& split) {
     std::vector<size_t> open;
     std::vector<Vec3> centres;
@@ -249,10 +250,20 @@ class LevelSampler {
       open.push_back(i);
       centres.push_back({m[0] + h, m[1] + h, m[2] + h});
     }
-    const std::vector<double> fc = values(centres);
+    std::vector<char> clear(open.size(), 0);
+    if (f_.clear) {
+      evaluations += open.size();
+      for_each(open.size(), [&](size_t k) {
+        const Cell& c = jobs[open[k]].cell;
+        clear[k] = f_.clear(world(c.min_unit()), world(c.max_unit()));
+      });
+    } else {
+      const std::vector<double> fc = values(centres);
+      for (size_t k = 0; k < open.size(); ++k) clear[k] = std::abs(fc[k]) > diagonal(jobs[open[k]].cell) / 2;
+    }
     for (size_t k = 0; k < open.size(); ++k) {
       const Job& j = jobs[open[k]];
-      if (std::abs(fc[k]) > diagonal(j.cell) / 2) out.set_uniform(j.slot, signs_of(j.v) != 0);
+      if (clear[k]) out.set_uniform(j.slot, signs_of(j.v) != 0);
       else split.push_back(j);
     }
   }
@@ -315,7 +326,6 @@ class LevelSampler {
       crossings(edges);
     }
     std::vector<Qef::Solution> sol(cand.size());
-    std::vector<Vec3> at(cand.size());
     for_each(cand.size(), [&](size_t k) {
       const Job& j = jobs[cand[k]];
       Qef q;
@@ -327,15 +337,27 @@ class LevelSampler {
         q.add_plane(n, dot3(n, edges[id].x), 1);
       }
       sol[k] = cell_vertex(q, j.cell, signs_of(j.v));
-      at[k] = sol[k].position;
     });
+    // f at the vertices that pass every other test (one batch): the last test.
+    std::vector<size_t> fitting;
+    std::vector<Vec3> at;
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const Job& j = jobs[cand[k]];
+      if (sol[k].error < error_ && inside_cell(sol[k].position, j.cell) && one_component(signs_of(j.v))) {
+        fitting.push_back(k);
+        at.push_back(sol[k].position);
+      }
+    }
     const std::vector<double> fv = values(at);
+    std::vector<char> on_surface(cand.size(), 0);
+    for (size_t i = 0; i < fitting.size(); ++i) {
+      const double off = std::abs(fv[i]) / (f_.lipschitz * cube_.size);
+      on_surface[fitting[i]] = off * off < error_;
+    }
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
       const uint8_t signs = signs_of(j.v);
-      const double off = std::abs(fv[k]) / (f_.lipschitz * cube_.size);
-      const bool ok = sol[k].error < error_ && off * off < error_ && inside_cell(sol[k].position, j.cell) &&
-                      one_component(signs);
+      const bool ok = on_surface[k];
       if (ok || j.cell.level >= max_depth_) {
         if (!ok) ++capped;
         out.set_gray(j.slot, j.cell, signs, sol[k].position, ok ? 0 : kFlagCapped);

@@ -63,10 +63,52 @@ Octree sample_with_mesh(const ImplicitSolid& f, const SampleOptions& options, Sa
   return tree;
 }
 
-/// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1.
+/// A range of distances [lo, hi] (signed or not) that holds a solid's surface.
+struct Band {
+  double lo, hi;
+};
+
+/// Whether a distance d to `mesh` stays out of each band over the box [lo, hi]; `d_centre`
+/// is d at the box's centre and `nearest` the mesh point there. Towards the mesh from a band
+/// (|d| below the band's near end r, on its side of 0), the box inside one ball of radius r
+/// about a mesh point proves every point nearer than r; away from the mesh, no triangle within
+/// the far end r of the box proves every point farther (and then the box does not meet the
+/// mesh, so d keeps its sign too).
+bool clear_of_bands(const MeshDistance& mesh, const std::vector<Band>& bands, const Vec3& lo, const Vec3& hi,
+                    double d_centre, const Vec3& nearest) {
+  const double half = detail::norm3(detail::sub3(hi, lo)) / 2;
+  for (const Band& band : bands) {
+    if (d_centre < band.lo - half || d_centre > band.hi + half) continue;  // the bound alone
+    if (d_centre >= band.lo && d_centre <= band.hi) return false;
+    const double end = d_centre < band.lo ? band.lo : band.hi;
+    const double reach = std::abs(end) * (1 - detail::kOnSurface);
+    const bool towards_mesh = end != 0 && (d_centre < band.lo) == (end > 0);
+    if (!towards_mesh) {
+      if (!mesh.farther_than(lo, hi, reach)) return false;
+      continue;
+    }
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 x{k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+      if (!(detail::norm3(detail::sub3(x, nearest)) < reach)) return false;
+    }
+  }
+  return true;
+}
+
+/// clear_of_bands for a signed distance, asked at the box's centre.
+bool clear_of_bands(const SignedDistance& sd, const std::vector<Band>& bands, const Vec3& lo, const Vec3& hi,
+                    uint32_t* hint) {
+  const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
+  Vec3 grad;
+  const double d = sd.with_gradient(centre, grad, hint);
+  return clear_of_bands(sd.mesh_distance(), bands, lo, hi, d, detail::sub3(centre, detail::scale3(grad, d)));
+}
+
+/// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1 and zero at the
+/// distances `levels`.
 template <class G>
 Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, SampleStats* stats,
-                       VolumeMesh* mesh, G&& g) {
+                       VolumeMesh* mesh, const std::vector<Band>& levels, G&& g) {
   const SignedDistance sd(surface);
   // Per thread, the triangle nearest the last point asked: the sampler asks in cell order,
   // so the next point's nearest triangle is usually that one or a neighbour.
@@ -83,6 +125,7 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     grad = detail::scale3(grad, slope);
     return v;
   };
+  solid.clear = [&](const Vec3& lo, const Vec3& hi) { return clear_of_bands(sd, levels, lo, hi, &hints.local()); };
   SampleOptions o = options;
   o.cube = cube;
   return sample_with_mesh(solid, o, stats, mesh);
@@ -175,6 +218,10 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
+  // The surface lies where d = h(u), between the body's inner and outer radii.
+  f.clear = [&](const Vec3& lo, const Vec3& hi) {
+    return clear_of_bands(sd, {{body.inner, body.outer}}, lo, hi, &hints.local());
+  };
   SampleOptions o = options;
   o.cube = cube;
   return sample_with_mesh(f, o, stats, mesh);
@@ -186,7 +233,7 @@ Octree offset(const TriMesh& solid, double distance, const SampleOptions& option
   const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, distance, options);
   try {
-    return sample_distance(surface, cube, options, stats, mesh,
+    return sample_distance(surface, cube, options, stats, mesh, {{distance, distance}},
                            [&](double d) { return std::pair{d - distance, 1.0}; });
   } catch (const EmptySolid&) {
     if (distance >= 0) throw;
@@ -212,7 +259,8 @@ Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleO
   const Cube cube = cube_around(surface, outward ? thickness : 0, options);
   // Inward: inside the solid and farther than T from its surface's inside; outward: within T
   // outside it. max of two distances of slope 1 is a distance bound of slope 1.
-  return sample_distance(surface, cube, options, stats, mesh, [&](double d) {
+  const std::vector<Band> levels{{0, 0}, outward ? Band{thickness, thickness} : Band{-thickness, -thickness}};
+  return sample_distance(surface, cube, options, stats, mesh, levels, [&](double d) {
     const double a = outward ? d - thickness : d, b = outward ? -d : -d - thickness;
     return a >= b ? std::pair{a, 1.0} : std::pair{b, -1.0};
   });
@@ -256,6 +304,11 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
     const detail::Nearest n = distance.nearest(p, &hints.local());
     grad = n.distance > 0 ? detail::scale3(detail::sub3(p, n.point), 1 / n.distance) : Vec3{0, 0, 1};
     return n.distance - half;
+  };
+  solid.clear = [&](const Vec3& lo, const Vec3& hi) {
+    const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
+    const detail::Nearest n = distance.nearest(centre, &hints.local());
+    return clear_of_bands(distance, {{half, half}}, lo, hi, n.distance, n.point);
   };
   SampleOptions o = options;
   o.cube = cube_around(surface, half, options);
