@@ -18,6 +18,7 @@
 //                                of its size from its surface (queries/s)
 //   BM_DipoleTreeQuery/near      the same decisions by a dipole tree of all the triangles, one
 //                                query at a time
+//   BM_OffsetSpot/depth:D        spot grown by 0.05 (2.6 % of its size), the octree only
 //   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
 //                                punched (winding), 2 = the Stanford bunny (open base, winding),
 //                                3 = the bunny with its holes closed by fans (parity): the per-PIC
@@ -371,6 +372,20 @@ void BM_SampleAnyInput(benchmark::State& state) {
   state.counters["boundary_edges"] = static_cast<double>(st.defects.boundary_edges);
 }
 BENCHMARK(BM_SampleAnyInput)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_OffsetSpot(benchmark::State& state) {
+  const pic::TriMesh& m = mesh_of("spot.obj");
+  pic::SampleOptions o;
+  o.depth = static_cast<int>(state.range(0));
+  pic::SampleStats st;
+  for (auto _ : state) {
+    auto t = pic::offset(m, 0.05, o, &st);
+    benchmark::DoNotOptimize(t);
+  }
+  state.counters["PICs"] = static_cast<double>(st.pics);
+  state.counters["queries"] = static_cast<double>(st.evaluations);
+}
+BENCHMARK(BM_OffsetSpot)->ArgName("depth")->Arg(10)->Arg(12)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The allocator settings of the command-line tool, so both measure the same thing.
 int main(int argc, char** argv) {
