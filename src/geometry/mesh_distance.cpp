@@ -185,10 +185,15 @@ struct Box {
   Vec3 lo, hi;
 };
 
+/// How many times farther_than halves a box against a triangle it cannot prove away whole.
+constexpr int kOctantDepth = 3;
+
 /// Whether triangle abc (unit normal n, or zero) lies farther than r from every point of the
 /// box: all eight corners beyond r on one side of its plane, or its distance from the box's
-/// centre beyond r plus the half-diagonal (each point of the box is that close to the centre).
-bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double r) {
+/// centre beyond r plus the half-diagonal (each point of the box is that close to the centre);
+/// else the same for each octant, `depth` more times (the centre's slack halves each time).
+bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double r,
+                      int depth) {
   double lo = kHuge, hi = -kHuge;
   for (int k = 0; k < 8; ++k) {
     const Vec3 x{k & 1 ? box.hi[0] : box.lo[0], k & 2 ? box.hi[1] : box.lo[1], k & 4 ? box.hi[2] : box.lo[2]};
@@ -197,8 +202,20 @@ bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& 
   }
   if (lo > r || hi < -r) return true;
   const Vec3 centre = scale3(add3(box.lo, box.hi), 0.5);
-  const double reach = r + norm3(sub3(box.hi, box.lo)) / 2;
-  return point_triangle_distance2(centre, a, b, c) > reach * reach;
+  const double half = norm3(sub3(box.hi, box.lo)) / 2;
+  const double d2 = point_triangle_distance2(centre, a, b, c);
+  if (d2 > (r + half) * (r + half)) return true;
+  if (depth == 0 || d2 <= r * r) return false;  // the centre itself within r: not away
+  for (int k = 0; k < 8; ++k) {
+    Box o;
+    for (int i = 0; i < 3; ++i) {
+      const bool upper = (k >> i) & 1;
+      o.lo[i] = upper ? centre[i] : box.lo[i];
+      o.hi[i] = upper ? box.hi[i] : centre[i];
+    }
+    if (!triangle_farther(o, a, b, c, n, r, depth - 1)) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -206,24 +223,11 @@ bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& 
 bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const {
   const Box box{lo, hi};
   const double r2 = r * r;
-  // A triangle the whole box cannot prove away may still be proven from each of its octants.
   auto away = [&](const LeafTriangle& t) {
     if (box_box_distance2(t, box) > r2) return true;
     const Vec3 n = cross3(sub3(t.b, t.a), sub3(t.c, t.a));
     const double len = norm3(n);
-    const Vec3 u = len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0};
-    if (triangle_farther(box, t.a, t.b, t.c, u, r)) return true;
-    const Vec3 mid = scale3(add3(lo, hi), 0.5);
-    for (int k = 0; k < 8; ++k) {
-      Box o;
-      for (int i = 0; i < 3; ++i) {
-        const bool upper = (k >> i) & 1;
-        o.lo[i] = upper ? mid[i] : lo[i];
-        o.hi[i] = upper ? hi[i] : mid[i];
-      }
-      if (!triangle_farther(o, t.a, t.b, t.c, u, r)) return false;
-    }
-    return true;
+    return triangle_farther(box, t.a, t.b, t.c, len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0}, r, kOctantDepth);
   };
   if (nodes_.empty()) return true;
   uint32_t stack[128];
