@@ -188,8 +188,8 @@ struct Box {
 /// How many times farther_than halves a box against a triangle it cannot prove away whole.
 constexpr int kOctantDepth = 3;
 
-/// Whether triangle abc (unit normal n, or zero) lies farther than r from every point of the
-/// box: all eight corners beyond r on one side of its plane, or its distance from the box's
+/// Whether triangle abc (n: its unit normal, or any unit vector, or zero) lies farther than r
+/// from every point of the box: all eight corners beyond r on one side of its extent along n, or its distance from the box's
 /// centre beyond r plus the half-diagonal (each point of the box is that close to the centre);
 /// else the same for each octant, `depth` more times (the centre's slack halves each time).
 bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double r,
@@ -200,7 +200,10 @@ bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& 
     const double h = dot3(n, sub3(x, a));
     lo = std::min(lo, h), hi = std::max(hi, h);
   }
-  if (lo > r || hi < -r) return true;
+  // The triangle's own extent along n (0 for an exact normal; a nearly flat triangle's
+  // rounded normal may tilt out of its plane): the box must clear it by r on one side.
+  const double hb = dot3(n, sub3(b, a)), hc = dot3(n, sub3(c, a));
+  if (lo > std::max({0.0, hb, hc}) + r || hi < std::min({0.0, hb, hc}) - r) return true;
   const Vec3 centre = scale3(add3(box.lo, box.hi), 0.5);
   const double half = norm3(sub3(box.hi, box.lo)) / 2;
   const double d2 = point_triangle_distance2(centre, a, b, c);
@@ -350,8 +353,9 @@ double SignedDistance::operator()(const Vec3& p, uint32_t* hint) const {
   return with_gradient(p, g, hint);
 }
 
-double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint) const {
+double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint, Vec3* nearest) const {
   const Nearest n = distance_.nearest(p, hint);
+  if (nearest) *nearest = n.point;
   const auto& t = mesh_.triangles[n.triangle];
   Vec3 pseudo{0, 0, 0};
   switch (n.feature) {

@@ -59,8 +59,9 @@ double illinois_root(F&& f, double f0, double f1, double tolerance, int iteratio
 /// A root of f along [0, 1] by Newton steps on f and its slope from one evaluation, kept
 /// inside the bracket that the values shrink (bisection where a step would leave it), to
 /// `tolerance`; starts at false position. Where f is smooth Newton converges quadratically:
-/// after a step shorter than sqrt(tolerance) the next would be shorter than tolerance (times
-/// f''/f'), so that step is the last and f is not asked at its end. The slope at the answer
+/// after a Newton step shorter than sqrt(tolerance) the next would be shorter than tolerance
+/// (times f''/f'), so that step is the last and f is not asked at its end (a bisection step
+/// still has to shrink below the tolerance). The slope at the answer
 /// is that of the last value (its direction within that step of the answer's).
 class NewtonRoot {
  public:
@@ -77,8 +78,9 @@ class NewtonRoot {
     }
     ((ft < 0) == (f0_ < 0) ? lo_ : hi_) = t_;
     double step = t_ - ft / slope;
-    if (!(step > lo_ && step < hi_)) step = (lo_ + hi_) / 2;
-    done_ = std::abs(step - t_) < last_step_;
+    const bool newton = step > lo_ && step < hi_;
+    if (!newton) step = (lo_ + hi_) / 2;
+    done_ = std::abs(step - t_) < (newton ? last_step_ : tolerance_);
     t_ = step;
     if (hi_ - lo_ < tolerance_) done_ = true;
   }

@@ -245,9 +245,10 @@ class LevelSampler {
         out.set_uniform(j.slot, signs != 0);
         continue;
       }
+      open.push_back(i);
+      if (f_.clear) continue;
       const Vec3 m = j.cell.min_unit();
       const double h = j.cell.size() / 2;
-      open.push_back(i);
       centres.push_back({m[0] + h, m[1] + h, m[2] + h});
     }
     std::vector<char> clear(open.size(), 0);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "geometry/convex_hull.h"
 #include "geometry/mesh_distance.h"
 #include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
@@ -81,12 +82,13 @@ bool clear_of_bands(const MeshDistance& mesh, const std::vector<Band>& bands, co
     if (d_centre < band.lo - half || d_centre > band.hi + half) continue;  // the bound alone
     if (d_centre >= band.lo && d_centre <= band.hi) return false;
     const double end = d_centre < band.lo ? band.lo : band.hi;
-    const double reach = std::abs(end) * (1 - detail::kOnSurface);
+    // A hair of margin towards the band either way: distances are rounded.
     const bool towards_mesh = end != 0 && (d_centre < band.lo) == (end > 0);
     if (!towards_mesh) {
-      if (!mesh.farther_than(lo, hi, reach)) return false;
+      if (!mesh.farther_than(lo, hi, std::abs(end) * (1 + detail::kOnSurface))) return false;
       continue;
     }
+    const double reach = std::abs(end) * (1 - detail::kOnSurface);
     for (int k = 0; k < 8; ++k) {
       const Vec3 x{k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
       if (!(detail::norm3(detail::sub3(x, nearest)) < reach)) return false;
@@ -98,10 +100,9 @@ bool clear_of_bands(const MeshDistance& mesh, const std::vector<Band>& bands, co
 /// clear_of_bands for a signed distance, asked at the box's centre.
 bool clear_of_bands(const SignedDistance& sd, const std::vector<Band>& bands, const Vec3& lo, const Vec3& hi,
                     uint32_t* hint) {
-  const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
-  Vec3 grad;
-  const double d = sd.with_gradient(centre, grad, hint);
-  return clear_of_bands(sd.mesh_distance(), bands, lo, hi, d, detail::sub3(centre, detail::scale3(grad, d)));
+  Vec3 grad, nearest;
+  const double d = sd.with_gradient(detail::scale3(detail::add3(lo, hi), 0.5), grad, hint, &nearest);
+  return clear_of_bands(sd.mesh_distance(), bands, lo, hi, d, nearest);
 }
 
 /// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1 and zero at the
@@ -136,7 +137,7 @@ struct RoundBody {
   Vec3 centre{0, 0, 0};
   std::vector<Vec3> rel;  ///< vertices minus the centre
   double outer = 0;       ///< largest |v - c|
-  double inner = 0;       ///< smallest support over many directions (the inradius, nearly)
+  double inner = 0;       ///< smallest support over all directions (the inradius about c)
   double support(const Vec3& u) const {
     double h = -detail::kHuge;
     for (const Vec3& v : rel) h = std::max(h, detail::dot3(v, u));
@@ -148,22 +149,21 @@ RoundBody round_body(const std::vector<Vec3>& points) {
   RoundBody b;
   for (const Vec3& p : points) b.centre = detail::add3(b.centre, p);
   b.centre = detail::scale3(b.centre, 1.0 / double(points.size()));
-  double lo = detail::kHuge;
   for (const Vec3& p : points) {
     b.rel.push_back(detail::sub3(p, b.centre));
-    const double r = detail::norm3(b.rel.back());
-    b.outer = std::max(b.outer, r);
-    lo = std::min(lo, r);
+    b.outer = std::max(b.outer, detail::norm3(b.rel.back()));
   }
-  // The inradius is the support's minimum over directions, found at facet normals: 4,096
-  // directions spread evenly over the sphere find it within (their spacing)^2 / 2 of r.
-  b.inner = lo < 0.98 * b.outer ? 0 : b.outer;
-  constexpr int kDirections = 4096;
-  for (int i = 0; i < kDirections && b.inner > 0; ++i) {
-    const double z = 1 - (2 * i + 1) / double(kDirections), s = std::sqrt(1 - z * z);
-    const double a = i * 2.399963229728653;  // the golden angle
-    b.inner = std::min(b.inner, b.support({s * std::cos(a), s * std::sin(a), z}));
+  // The inradius about the centre is the support's minimum over directions, reached at a
+  // facet's normal: the nearest of the hull's facet planes.
+  const TriMesh hull = detail::convex_hull(points);
+  b.inner = hull.triangles.empty() ? 0 : detail::kHuge;
+  for (const auto& t : hull.triangles) {
+    const Vec3& a = hull.positions[t[0]];
+    const Vec3 n = detail::cross3(detail::sub3(hull.positions[t[1]], a), detail::sub3(hull.positions[t[2]], a));
+    const double len = detail::norm3(n);
+    if (len > 0) b.inner = std::min(b.inner, detail::dot3(n, detail::sub3(a, b.centre)) / len);
   }
+  b.inner = std::max(b.inner, 0.0);
   return b;
 }
 
@@ -218,9 +218,15 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
-  // The surface lies where d = h(u), between the body's inner and outer radii.
+  // The surface lies where d = h(u), between the body's inner and outer radii; f's own
+  // bound at the centre first (what the sampler would ask without this).
   f.clear = [&](const Vec3& lo, const Vec3& hi) {
-    return clear_of_bands(sd, {{body.inner, body.outer}}, lo, hi, &hints.local());
+    const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
+    Vec3 grad, nearest;
+    const double d = sd.with_gradient(centre, grad, &hints.local(), &nearest);
+    const double fc = d > 0 ? d - body.support(grad) : d - body.inner;
+    if (std::abs(fc) > f.lipschitz * detail::norm3(detail::sub3(hi, lo)) / 2) return true;
+    return clear_of_bands(sd.mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest);
   };
   SampleOptions o = options;
   o.cube = cube;

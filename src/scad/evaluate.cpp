@@ -223,7 +223,7 @@ class TreeBuilder {
       const Octree u = evaluate(csg_union(each(kids, 0, kids.size())), chain_options());
       pts = unsplit_contour(u).positions;
     }
-    TriMesh h = detail::scad::convex_hull(pts);
+    TriMesh h = detail::convex_hull(pts);
     if (h.triangles.empty()) return csg_empty();
     return leaf(h);
   }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/convex_hull.h"
 #include "pic/types.h"
 
 namespace pic::detail::scad {
@@ -63,8 +64,6 @@ TriMesh extrude_linear(Ring ring, const LinearExtrude& e);
 /// `fragments` steps, with OpenSCAD's vertex placement (a full turn starts on the -x axis).
 TriMesh extrude_rotate(Ring ring, double angle, int fragments);
 
-/// Convex hull of points, outward triangles; empty mesh if the points span no volume.
-TriMesh convex_hull(const std::vector<Vec3>& points);
 /// Convex hull of 2D points, counter-clockwise, no collinear vertices.
 Ring convex_hull_2d(std::vector<P2> points);
 
