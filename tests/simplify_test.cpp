@@ -70,7 +70,9 @@ TEST(Simplify, CreasesOffTheLatticeAxesCollapseToo) {
   EXPECT_LE(at_vertices.a_to_b, 0.25 * cell * (1 + 1e-9)) << "a raw vertex left behind";
   EXPECT_LE(at_vertices.b_to_a, 0.25 * cell * (1 + 1e-9)) << "a new vertex off the raw contour";
   EXPECT_LE(surface_distance(raw, simple, 20000).hausdorff, 0.75 * cell);
-  EXPECT_LT(simple.triangles.size() * 8, raw.triangles.size());
+  // Below a tenth only with collapses onto a neighbour where it stands as well as onto the
+  // planes' point (4,692 triangles with the latter alone: knots on the ball's flat facets).
+  EXPECT_LT(simple.triangles.size() * 10, raw.triangles.size());
   std::printf("  [measure] box - faceted ball at depth 8: %zu -> %zu triangles\n", raw.triangles.size(),
               simple.triangles.size());
 }

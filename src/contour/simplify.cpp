@@ -230,7 +230,8 @@ class Simplifier {
     return x;
   }
 
-  /// Merges u with the neighbour that keeps the planes closest, among those that may take it.
+  /// Merges u with the neighbour that keeps the planes closest, among those that may take it:
+  /// both at the planes' point, or u onto the neighbour where it stands.
   bool collapse_cheapest(uint32_t u) {
     if (frozen_[u]) return false;
     ring(u, ring_u_);
@@ -240,6 +241,11 @@ class Simplifier {
       if (!frozen_[v]) {
         const Vec3 x = merged_position(u, v, error);
         candidates_.push_back({error, v, x});
+        // u onto v where it stands: on a flat region the planes leave the middle free, and
+        // a fan from v may keep shapes that one from the middle does not.
+        Quadric q = quadric_[u];
+        q.add(quadric_[v]);
+        if (x != pos_[v]) candidates_.push_back({std::sqrt(std::max(0.0, q.mean_at(pos_[v]))), v, pos_[v]});
       }
     std::sort(candidates_.begin(), candidates_.end(),
               [](const Candidate& a, const Candidate& b) { return a.error < b.error || (a.error == b.error && a.v < b.v); });
