@@ -350,15 +350,15 @@ class LevelSampler {
       }
     }
     const std::vector<double> fv = values(at);
-    std::vector<char> on_surface(cand.size(), 0);
+    std::vector<char> fits(cand.size(), 0);
     for (size_t i = 0; i < fitting.size(); ++i) {
       const double off = std::abs(fv[i]) / (f_.lipschitz * cube_.size);
-      on_surface[fitting[i]] = off * off < error_;
+      fits[fitting[i]] = off * off < error_;
     }
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
       const uint8_t signs = signs_of(j.v);
-      const bool ok = on_surface[k];
+      const bool ok = fits[k];
       if (ok || j.cell.level >= max_depth_) {
         if (!ok) ++capped;
         out.set_gray(j.slot, j.cell, signs, sol[k].position, ok ? 0 : kFlagCapped);
