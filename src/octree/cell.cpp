@@ -12,7 +12,10 @@ void Builder::set_gray(uint32_t slot, const Cell& cell, uint8_t signs, const Vec
 Node append_subtree(std::vector<Node>& nodes, std::vector<std::array<float, 3>>& vertices, const Builder& sub) {
   const auto offset = static_cast<uint32_t>(nodes.size()) - 1;  // sub's node k >= 1 lands at offset + k
   const auto vbase = static_cast<uint32_t>(vertices.size());
-  nodes.reserve(nodes.size() + sub.nodes.size());
+  // Room for the subtree, growing geometrically: a reserve of exactly what this call needs
+  // would move the whole array at every call, and refining leaf by leaf calls it per leaf.
+  const size_t need = nodes.size() + sub.nodes.size();
+  if (nodes.capacity() < need) nodes.reserve(std::max(need, 2 * nodes.capacity()));
   Node root{};
   for (size_t k = 0; k < sub.nodes.size(); ++k) {
     Node n = sub.nodes[k];
