@@ -214,13 +214,11 @@ class Simplifier {
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
-  /// Where u and v merge: the point nearest their planes (least squares, truncated along the
-  /// directions they leave free, from the edge's middle) when it stays near the edge, else the
-  /// edge's middle. `error`: the root mean squared distance to the planes there (the order in
-  /// which neighbours are tried).
-  Vec3 merged_position(uint32_t u, uint32_t v, double& error) const {
-    Quadric q = quadric_[u];
-    q.add(quadric_[v]);
+  /// Where u and v merge (q: their planes summed): the point nearest their planes (least
+  /// squares, truncated along the directions they leave free, from the edge's middle) when it
+  /// stays near the edge, else the edge's middle. `error`: the root mean squared distance to
+  /// the planes there (the order in which neighbours are tried).
+  Vec3 merged_position(uint32_t u, uint32_t v, const Quadric& q, double& error) const {
     const Vec3 &a = pos_[u], &b = pos_[v];
     const Vec3 mid{(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2};
     Vec3 x = q.minimum_near(mid);
@@ -239,12 +237,12 @@ class Simplifier {
     double error = 0;
     for (uint32_t v : ring_u_)
       if (!frozen_[v]) {
-        const Vec3 x = merged_position(u, v, error);
+        Quadric q = quadric_[u];
+        q.add(quadric_[v]);
+        const Vec3 x = merged_position(u, v, q, error);
         candidates_.push_back({error, v, x});
         // u onto v where it stands: on a flat region the planes leave the middle free, and
         // a fan from v may keep shapes that one from the middle does not.
-        Quadric q = quadric_[u];
-        q.add(quadric_[v]);
         if (x != pos_[v]) candidates_.push_back({std::sqrt(std::max(0.0, q.mean_at(pos_[v]))), v, pos_[v]});
       }
     std::sort(candidates_.begin(), candidates_.end(),

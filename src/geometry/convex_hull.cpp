@@ -12,15 +12,10 @@
 #include <unordered_set>
 
 #include "geometry/predicates.h"
+#include "geometry/vec3.h"
 
 namespace pic::detail {
 namespace {
-
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // The index of the point of `pts` that maximises `score`.
 template <class F>
@@ -40,14 +35,14 @@ TriMesh convex_hull(const std::vector<Vec3>& pts) {
   // A first tetrahedron of far-apart points (a leftmost one, the farthest from it, the farthest
   // from their line, the farthest from their plane); none when all points are coplanar.
   const size_t i0 = farthest(pts, [](const Vec3& p) { return -p[0]; });
-  const size_t i1 = farthest(pts, [&](const Vec3& p) { return dot(sub(p, pts[i0]), sub(p, pts[i0])); });
-  const Vec3 e = sub(pts[i1], pts[i0]);
+  const size_t i1 = farthest(pts, [&](const Vec3& p) { return dot3(sub3(p, pts[i0]), sub3(p, pts[i0])); });
+  const Vec3 e = sub3(pts[i1], pts[i0]);
   const size_t i2 = farthest(pts, [&](const Vec3& p) {
-    const Vec3 c = cross(e, sub(p, pts[i0]));
-    return dot(c, c);
+    const Vec3 c = cross3(e, sub3(p, pts[i0]));
+    return dot3(c, c);
   });
-  const Vec3 n = cross(e, sub(pts[i2], pts[i0]));
-  size_t i3 = farthest(pts, [&](const Vec3& p) { return std::abs(dot(n, sub(p, pts[i0]))); });
+  const Vec3 n = cross3(e, sub3(pts[i2], pts[i0]));
+  size_t i3 = farthest(pts, [&](const Vec3& p) { return std::abs(dot3(n, sub3(p, pts[i0]))); });
   int side = orient3d(pts[i0], pts[i1], pts[i2], pts[i3]);
   for (size_t i = 0; i < pts.size() && side == 0; ++i) side = orient3d(pts[i0], pts[i1], pts[i2], pts[i3 = i]);
   if (side == 0) return out;  // flat (or fewer than 3 distinct non-collinear points)

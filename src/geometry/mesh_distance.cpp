@@ -189,9 +189,10 @@ struct Box {
 constexpr int kOctantDepth = 3;
 
 /// Whether triangle abc (n: its unit normal, or any unit vector, or zero) lies farther than r
-/// from every point of the box: all eight corners beyond r on one side of its extent along n, or its distance from the box's
-/// centre beyond r plus the half-diagonal (each point of the box is that close to the centre);
-/// else the same for each octant, `depth` more times (the centre's slack halves each time).
+/// from every point of the box: all eight corners beyond r on one side of its extent along n,
+/// or its distance from the box's centre beyond r plus the half-diagonal (each point of the
+/// box is that close to the centre); else the same for each octant, `depth` more times (the
+/// centre's slack halves each time).
 bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double r,
                       int depth) {
   double lo = kHuge, hi = -kHuge;
