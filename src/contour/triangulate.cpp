@@ -71,15 +71,18 @@ Face common_face(const VertexCell& ca, const VertexCell& cb) {
   return f;
 }
 
-// Where segment xa xb meets the face's plane (q); true when that is strictly inside the face.
-bool crosses_inside(const Face& face, const Vec3& xa, const Vec3& xb, Vec3& q) {
+// Where segment xa xb meets the face's plane (q); true when that lies more than `margin` inside
+// the face. The margin keeps a crossing that is on the face's border in exact arithmetic (a
+// vertex clamped onto its cell's edge, in line with a neighbour's vertex) from passing for
+// inside by a rounding error: such a side gets a face point instead.
+bool crosses_inside(const Face& face, const Vec3& xa, const Vec3& xb, Vec3& q, double margin = 0) {
   const int axis = face.axis;
   const double den = xb[axis] - xa[axis];
   const double t = den != 0 ? std::clamp((face.plane - xa[axis]) / den, 0.0, 1.0) : 0.5;
   bool inside = true;
   for (int d = 0; d < 3; ++d) {
     q[d] = xa[d] + t * (xb[d] - xa[d]);
-    if (d != axis) inside = inside && q[d] > face.lo[d] && q[d] < face.hi[d];
+    if (d != axis) inside = inside && q[d] > face.lo[d] + margin && q[d] < face.hi[d] - margin;
   }
   return inside;
 }
@@ -538,7 +541,7 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
       const auto [a, b] = side(i, k);
       const Face f = common_face(cells[a], cells[b]);
       Vec3 c;
-      if (f.axis >= 0 && !crosses_inside(f, x[a], x[b], c)) off_face[i] |= uint8_t(1 << k);
+      if (f.axis >= 0 && !crosses_inside(f, x[a], x[b], c, inset * 0x1p-12)) off_face[i] |= uint8_t(1 << k);
     }
     bool other = false;
     if (how == Triangulation::kConstruct && !off_face[i])
