@@ -274,6 +274,23 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
               plain.worst_vertex / cell);
 }
 
+TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
+  // spot grown by 0.05 at depth 10. Beside a concave ridge of the distance (where the grown
+  // surface folds) f crosses a coarse leaf's edge twice between its corners: the finer leaves
+  // beside it sample the points between with f's sign, and the settling once gave them the
+  // coarse side's instead (a vertex 1.16 cells off). Such a leaf is now sampled again around
+  // them; and a face point Newton leaves stalled at its face's border is bisected onto f's zero.
+  const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  const double d = 0.05;
+  VolumeMesh vm;
+  const Octree t = offset(spot, d, at_depth(10), nullptr, &vm);
+  const double cell = finest_cell(t);
+  expect_valid(vm.mesh);
+  const OffsetDistance exact = offset_distance(vm.mesh, spot, d, 0);
+  std::printf("worst vertex: %.3f cells off the exact offset\n", exact.worst_vertex / cell);
+  EXPECT_LE(exact.worst_vertex, 0.25 * cell);
+}
+
 TEST(MeshDistance, FartherThanNeverMissesATriangle) {
   // Boxes of 1 to 32 finest cells (depth 10) about spot's surface and radii up to 40 cells:
   // whenever the test says every triangle is farther than r, no point of the box may be

@@ -367,9 +367,32 @@ void onto_level_in_face(const SurfaceFunction& level, const Face& face, double i
     for (int d = 0; d < 3; ++d)
       if (d != face.axis) next[d] = std::clamp(next[d], face.lo[d] + inset, face.hi[d] - inset);
     const double w = level(next);
-    if (!(std::abs(w) < std::abs(v))) return;
+    if (!(std::abs(w) < std::abs(v))) break;
     f = next, v = w;
   }
+  if (!(std::abs(v) > size * kFaceStall)) return;
+  // Newton stalls where the zero lies along the face's border (each step across it is
+  // clamped back): bisect towards the nearest of the face's corners (kept inset) where the
+  // function has the other sign. The segment stays in the face, convex.
+  const int u = (face.axis + 1) % 3, w = (face.axis + 2) % 3;
+  Vec3 other = f;
+  double other_v = 0, nearest = kHuge;
+  for (int c = 0; c < 4; ++c) {
+    Vec3 q = f;
+    q[u] = c & 1 ? face.hi[u] - inset : face.lo[u] + inset;
+    q[w] = c & 2 ? face.hi[w] - inset : face.lo[w] + inset;
+    const Vec3 dq = sub3(q, f);
+    const double qv = level(q), d = dot3(dq, dq);
+    if ((qv < 0) != (v < 0) && d < nearest) other = q, other_v = qv, nearest = d;
+  }
+  if (nearest == kHuge) return;
+  for (int it = 0; it < 40 && std::abs(v) > enough; ++it) {
+    const Vec3 mid = scale3(add3(f, other), 0.5);
+    const double m = level(mid);
+    if ((m < 0) == (v < 0)) f = mid, v = m;
+    else other = mid, other_v = m;
+  }
+  if (std::abs(other_v) < std::abs(v)) f = other;
 }
 
 // True when the triangles `tris` (index triples into ring `r`) lie in the ring of tetrahedra

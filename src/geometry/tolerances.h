@@ -109,6 +109,9 @@ inline constexpr double kGradientStep = 1e-3;
 /// ... and, within a face, this fraction of the face's side, where a point moved onto a
 /// function's zero stops when |f| is below the same fraction of the side.
 inline constexpr double kFaceStep = 1e-4;
+/// A face point Newton left farther off the level than this fraction of its face (stalled
+/// at the face's border) is found by bisection towards a corner of the other sign.
+inline constexpr double kFaceStall = 1e-2;
 /// The search of a nearest triangle bounded by a hint's distance allows it this relative slack.
 inline constexpr double kHintSlack = 1e-12;
 /// A point nearer a mesh than this fraction of the mesh's size is on it: the direction to its

@@ -9,6 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "geometry/lattice.h"
@@ -170,7 +173,14 @@ class LevelSampler {
 
   size_t evaluations = 0;
 
+  /// Splits every cell whose closed box holds lattice point p down to the cap, whatever f
+  /// says there: a leaf sampled again around a point the settling would flip (refine_around).
+  void focus_on(const Lat& p) { focus_ = p; }
+
  private:
+  std::optional<Lat> focus_;
+  bool focused(const Cell& cell) const { return focus_ && cell.level < max_depth_ && cell.holds(*focus_); }
+
   const ImplicitSolid& f_;
   Cube cube_;
   int max_depth_;
@@ -239,6 +249,10 @@ class LevelSampler {
       const Job& j = jobs[i];
       const uint8_t signs = signs_of(j.v);
       if (signs != 0 && signs != 0xff) continue;
+      if (focused(j.cell)) {
+        split.push_back(j);
+        continue;
+      }
       bool away = j.cell.level >= max_depth_;
       for (double x : j.v) away = away || std::abs(x) > diagonal(j.cell);
       if (away) {
@@ -283,7 +297,7 @@ class LevelSampler {
       const Job& j = jobs[i];
       const uint8_t signs = signs_of(j.v);
       if (signs == 0 || signs == 0xff) continue;
-      if (j.cell.level < max_depth_ && !one_component(signs)) {
+      if (j.cell.level < max_depth_ && (!one_component(signs) || focused(j.cell))) {
         split.push_back(j);
         continue;
       }
@@ -514,8 +528,45 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
-  // Leaves the cap stopped with two surface components get one, as after any sampling.
-  settle_sampled(tree, SettleRegion{});
+  // A leaf sampled again, down to the cap around lattice point p, with the leaf's own corner
+  // signs (a settled sign may differ from f's: its value then only keeps that sign).
+  const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) {
+    LevelSampler one(solid, *options.cube, options.depth, options.error, false, solid.values ? nullptr : &memo);
+    one.focus_on(p);
+    std::vector<Vec3> at(8);
+    for (int k = 0; k < 8; ++k) at[k] = lattice_unit(l.cell.corner(k));
+    const std::vector<double> fv = one.values(at);
+    const uint8_t signs = signs_of(tree.nodes[l.node]);
+    std::array<double, 8> corner{};
+    for (int k = 0; k < 8; ++k) {
+      const bool inside = (signs >> k) & 1;
+      corner[k] = (fv[k] < 0) == inside ? fv[k] : inside ? -std::numeric_limits<double>::min() : std::numeric_limits<double>::min();
+    }
+    size_t more = 0;
+    Builder sub = one.run(l.cell, corner, more);
+    sampler.evaluations += one.evaluations;
+    return sub;
+  };
+  // Where f crosses a coarse leaf's edge or face twice between its corners, finer neighbours
+  // sampled the points between with f's sign, against the side's: that leaf is sampled again
+  // around them (the settling would flip them, a coarse cell off the surface).
+  // Each round looks again only around the leaves the last one split.
+  std::vector<std::pair<Lat, Lat>> near;
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<Lat> against = points_against_coarse_sides(tree, near);
+    if (against.empty()) break;
+    near.clear();
+    for (const Lat& p : against) {
+      int64_t span = 0;
+      for (int o = 0; o < 8; ++o)
+        if (Lat q; octant_cell(p, o, q)) span = std::max(span, leaf_at(tree, q).cell.span());
+      near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
+      refine_around(tree, p, from_function, [](uint32_t) {});
+    }
+  }
+  // Leaves the cap stopped with two surface components get one, as after any sampling; a
+  // point the settling flips at a coarser leaf is refined around first, as above.
+  settle_sampled(tree, SettleRegion{}, &from_function);
   PIC_CHECK_OCTREE(tree, "sampling a function");
   if (tree.vertices.empty()) throw EmptySolid("the function's solid does not meet the cube's inside and outside");
   if (stats) {

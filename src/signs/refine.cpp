@@ -1,7 +1,10 @@
 // Refining around a lattice point: see refine.h.
 #include "signs/refine.h"
 
+#include <algorithm>
 #include <optional>
+
+#include <tbb/parallel_for.h>
 
 namespace pic::detail {
 
@@ -41,7 +44,86 @@ void agree_on_boundary(Octree& t, uint32_t root, const Cell& cell) {
   for (const auto& [l, k] : flips) flip_corner(t, l.node, k, l.cell);
 }
 
+/// The sign the leaves on the coarse side `cell` imply at boundary point p, when every corner
+/// of the edge or face p lies inside shares one.
+std::optional<bool> side_sign(const Cell& cell, uint8_t signs, const Lat& p) {
+  const int64_t s = cell.span();
+  // Per axis: p at the cell's low side (0), high side (1), or between (-1).
+  int at[3];
+  for (int k = 0; k < 3; ++k) at[k] = p[k] == cell.lat[k] ? 0 : p[k] == cell.lat[k] + s ? 1 : -1;
+  std::optional<bool> sign;
+  for (int c = 0; c < 8; ++c) {
+    bool on = true;
+    for (int k = 0; k < 3; ++k) on = on && (at[k] < 0 || ((c >> k) & 1) == at[k]);
+    if (!on) continue;
+    const bool in = ((signs >> c) & 1) != 0;
+    if (sign && *sign != in) return std::nullopt;
+    sign = in;
+  }
+  return sign;
+}
+
 }  // namespace
+
+std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<std::pair<Lat, Lat>>& near) {
+  // Per node: the level of its deepest leaf (the walk below skips subtrees no finer than the
+  // coarse leaf, most of them).
+  std::vector<uint8_t> deepest(t.nodes.size(), 0);
+  std::vector<LeafRef> coarse;
+  auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> int {
+    const Node& n = t.nodes[node];
+    int d = cell.level;
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) d = std::max(d, self(self, n.index + c, cell.child(c)));
+    } else if (n.kind == CellKind::Gray && cell.level < t.max_depth) {
+      const Lat lo = cell.lat, hi = cell.corner(7);
+      const bool meets = near.empty() || std::any_of(near.begin(), near.end(), [&](const auto& b) {
+        for (int k = 0; k < 3; ++k)
+          if (lo[k] > b.second[k] || hi[k] < b.first[k]) return false;
+        return true;
+      });
+      if (meets) coarse.push_back({node, cell});
+    }
+    deepest[node] = uint8_t(d);
+    return d;
+  };
+  walk(walk, 0, Cell{});
+  // The leaves finer than `level` whose closed cells meet the closed box [lo, hi].
+  auto finer_touching = [&](auto&& self, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi, int level,
+                            std::vector<LeafRef>& out) -> void {
+    if (deepest[node] <= level) return;
+    const int64_t s = cell.span();
+    for (int k = 0; k < 3; ++k)
+      if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
+    const Node& n = t.nodes[node];
+    if (n.kind != CellKind::Internal) {
+      out.push_back({node, cell});
+      return;
+    }
+    for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c), lo, hi, level, out);
+  };
+  std::vector<std::vector<Lat>> found(coarse.size());
+  tbb::parallel_for(size_t{0}, coarse.size(), [&](size_t i) {
+    const LeafRef& l = coarse[i];
+    const uint8_t signs = t.nodes[l.node].signs;
+    std::vector<LeafRef> finer;
+    finer_touching(finer_touching, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level, finer);
+    for (const LeafRef& n : finer) {
+      const uint8_t ns = signs_of(t.nodes[n.node]);
+      for (int c = 0; c < 8; ++c) {
+        const Lat p = n.cell.corner(c);
+        if (!l.cell.holds(p) || l.cell.corner_index(p) >= 0) continue;
+        const std::optional<bool> s = side_sign(l.cell, signs, p);
+        if (s && *s != (((ns >> c) & 1) != 0)) found[i].push_back(p);
+      }
+    }
+  });
+  std::vector<Lat> out;
+  for (const auto& f : found) out.insert(out.end(), f.begin(), f.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
 
 size_t refine_around(Octree& t, const Lat& p, const ResampleLeaf& resample, const std::function<void(uint32_t)>& grown) {
   size_t replaced = 0;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "signs/consistency.h"
 
@@ -23,5 +24,14 @@ using ResampleLeaf = std::function<Builder(const LeafRef& leaf, const std::array
 /// and every node appended (past the tree's old size). Returns how many leaves were replaced.
 size_t refine_around(Octree& t, const std::array<int64_t, 3>& p, const ResampleLeaf& resample,
                      const std::function<void(uint32_t)>& grown);
+
+/// Lattice points that finer leaves give a sign on an edge or face of a coarser gray leaf
+/// whose corners there (the edge's two, the face's four) all have the other sign: the
+/// surface crosses that side twice between the coarse leaf's corners, which the leaf cannot
+/// hold. The settling would give such a point the coarse side's sign, moving the surface by
+/// up to the coarse leaf's size; a sampler that can look again refines around it instead.
+/// `near`: when not empty, only coarse leaves meeting one of these closed lattice boxes.
+std::vector<std::array<int64_t, 3>> points_against_coarse_sides(
+    const Octree& t, const std::vector<std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>>>& near = {});
 
 }  // namespace pic::detail
