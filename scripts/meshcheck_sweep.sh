@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Every kind of mesh PIC writes, checked by an independent checker (MESHCHECK: the shared
-# tools' meshcheck, exact self-intersection test on): the bundled models at depths 8-12, the
-# CSG harness cases, a 300-stroke sculpting run, point clouds of two models, and `pic eval` of
-# the OpenSCAD examples that evaluate. Prints one line per mesh that is not a closed, 2-manifold,
+# tools' meshcheck, exact self-intersection test on): the bundled models at depths 8-14 (as
+# STL, merged by position as a reader does), the CSG harness cases, a 300-stroke sculpting run,
+# point clouds of two models, and `pic eval` of the OpenSCAD examples that evaluate. Prints one line per mesh that is not a closed, 2-manifold,
 # self-intersection-free solid (an empty result, such as an empty intersection, passes), and a
 # count per kind.
 #   MESHCHECK=... scripts/meshcheck_sweep.sh [BUILD_DIR] [OUT_DIR]
@@ -35,14 +35,14 @@ tally() {  # kind, checked, bad
 n=0 bad=0
 for m in data/*.obj; do
   name=$(basename "$m" .obj)
-  for d in 8 9 10 11 12; do
+  for d in 8 9 10 11 12 13 14; do
     "$PIC" sample "$m" -o "$OUT/$name.$d.pic" --depth "$d" > /dev/null
-    "$PIC" mesh "$OUT/$name.$d.pic" -o "$OUT/$name.$d.obj" > /dev/null 2>&1
+    "$PIC" mesh "$OUT/$name.$d.pic" -o "$OUT/$name.$d.stl" > /dev/null 2>&1
     n=$((n + 1))
-    check model "$OUT/$name.$d.obj" || bad=$((bad + 1))
+    check model "$OUT/$name.$d.stl" || bad=$((bad + 1))
   done
 done
-tally "bundled models, depths 8-12" $n $bad
+tally "bundled models, depths 8-14" $n $bad
 
 n=0 bad=0
 "$BUILD/bench/pic_csg_fuzz" --cases "$CASES" --out "$OUT/csg" > "$OUT/csg.txt"
