@@ -8,10 +8,9 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <limits>
-#include <optional>
 #include <vector>
 
 #include "geometry/lattice.h"
@@ -173,13 +172,17 @@ class LevelSampler {
 
   size_t evaluations = 0;
 
-  /// Splits every cell whose closed box holds lattice point p down to the cap, whatever f
-  /// says there: a leaf sampled again around a point the settling would flip (refine_around).
-  void focus_on(const Lat& p) { focus_ = p; }
+  /// Splits every cell whose closed box holds one of the lattice points `p` down to the cap,
+  /// whatever f says there: a leaf sampled again around points the settling would flip
+  /// (refine_around).
+  void focus_on(std::vector<Lat> p) { focus_ = std::move(p); }
 
  private:
-  std::optional<Lat> focus_;
-  bool focused(const Cell& cell) const { return focus_ && cell.level < max_depth_ && cell.holds(*focus_); }
+  std::vector<Lat> focus_;
+  bool focused(const Cell& cell) const {
+    return cell.level < max_depth_ &&
+           std::any_of(focus_.begin(), focus_.end(), [&](const Lat& p) { return cell.holds(p); });
+  }
 
   const ImplicitSolid& f_;
   Cube cube_;
@@ -502,6 +505,62 @@ class LevelSampler {
   }
 };
 
+/// A leaf sampled again from f, down to the cap around p and around the points of `also` it
+/// holds, with the leaf's own corner signs (a settled sign may differ from f's: its value then
+/// only keeps that sign). Safe to call from several threads.
+struct FunctionResample {
+  const ImplicitSolid& solid;
+  const SampleOptions& options;
+  const Octree& tree;
+  Memos* memo;
+  std::vector<Lat> also;
+  std::atomic<size_t> evaluations{0};
+
+  Builder operator()(const LeafRef& l, const Lat& p) {
+    LevelSampler one(solid, *options.cube, options.depth, options.error, false, memo);
+    std::vector<Lat> focus{p};
+    for (const Lat& q : also)
+      if (l.cell.holds(q)) focus.push_back(q);
+    one.focus_on(std::move(focus));
+    std::vector<Vec3> at(8);
+    for (int k = 0; k < 8; ++k) at[k] = lattice_unit(l.cell.corner(k));
+    const std::vector<double> fv = one.values(at);
+    const uint8_t signs = signs_of(tree.nodes[l.node]);
+    constexpr double kHair = std::numeric_limits<double>::min();
+    std::array<double, 8> corner{};
+    for (int k = 0; k < 8; ++k) {
+      const bool inside = (signs >> k) & 1;
+      corner[k] = (fv[k] < 0) == inside ? fv[k] : inside ? -kHair : kHair;
+    }
+    size_t capped = 0;
+    Builder sub = one.run(l.cell, corner, capped);
+    evaluations += one.evaluations;
+    return sub;
+  }
+};
+
+/// Where f crosses a coarse leaf's edge or face twice between its corners, its finer
+/// neighbours sampled the points between with f's sign, against the side's; the settling would
+/// flip them, a coarse cell off the surface. Such leaves are sampled again around those points,
+/// all at once; each further round looks only around what the last one split.
+void refine_coarse_sides(Octree& tree, FunctionResample& resample, const ResampleLeaf& from_function) {
+  std::vector<std::pair<Lat, Lat>> near;
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<Lat> against = points_against_coarse_sides(tree, near);
+    if (against.empty()) break;
+    near.clear();
+    for (const Lat& p : against) {
+      int64_t span = 0;
+      for (int o = 0; o < 8; ++o)
+        if (Lat q; octant_cell(p, o, q)) span = std::max(span, leaf_at(tree, q).cell.span());
+      near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
+    }
+    resample.also = against;
+    refine_all_around(tree, against, from_function);
+  }
+  resample.also.clear();
+}
+
 }  // namespace
 
 Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats) {
@@ -528,45 +587,13 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
-  // A leaf sampled again, down to the cap around lattice point p, with the leaf's own corner
-  // signs (a settled sign may differ from f's: its value then only keeps that sign).
-  const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) {
-    LevelSampler one(solid, *options.cube, options.depth, options.error, false, solid.values ? nullptr : &memo);
-    one.focus_on(p);
-    std::vector<Vec3> at(8);
-    for (int k = 0; k < 8; ++k) at[k] = lattice_unit(l.cell.corner(k));
-    const std::vector<double> fv = one.values(at);
-    const uint8_t signs = signs_of(tree.nodes[l.node]);
-    std::array<double, 8> corner{};
-    for (int k = 0; k < 8; ++k) {
-      const bool inside = (signs >> k) & 1;
-      corner[k] = (fv[k] < 0) == inside ? fv[k] : inside ? -std::numeric_limits<double>::min() : std::numeric_limits<double>::min();
-    }
-    size_t more = 0;
-    Builder sub = one.run(l.cell, corner, more);
-    sampler.evaluations += one.evaluations;
-    return sub;
-  };
-  // Where f crosses a coarse leaf's edge or face twice between its corners, finer neighbours
-  // sampled the points between with f's sign, against the side's: that leaf is sampled again
-  // around them (the settling would flip them, a coarse cell off the surface).
-  // Each round looks again only around the leaves the last one split.
-  std::vector<std::pair<Lat, Lat>> near;
-  for (int round = 0; round < 8; ++round) {
-    const std::vector<Lat> against = points_against_coarse_sides(tree, near);
-    if (against.empty()) break;
-    near.clear();
-    for (const Lat& p : against) {
-      int64_t span = 0;
-      for (int o = 0; o < 8; ++o)
-        if (Lat q; octant_cell(p, o, q)) span = std::max(span, leaf_at(tree, q).cell.span());
-      near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
-      refine_around(tree, p, from_function, [](uint32_t) {});
-    }
-  }
+  FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo};
+  const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) { return resample(l, p); };
+  refine_coarse_sides(tree, resample, from_function);
   // Leaves the cap stopped with two surface components get one, as after any sampling; a
-  // point the settling flips at a coarser leaf is refined around first, as above.
+  // point the settling flips at a coarser leaf is refined around first.
   settle_sampled(tree, SettleRegion{}, &from_function);
+  sampler.evaluations += resample.evaluations;
   PIC_CHECK_OCTREE(tree, "sampling a function");
   if (tree.vertices.empty()) throw EmptySolid("the function's solid does not meet the cube's inside and outside");
   if (stats) {

@@ -125,6 +125,29 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
   return out;
 }
 
+size_t refine_all_around(Octree& t, const std::vector<Lat>& points, const ResampleLeaf& resample) {
+  std::vector<LeafRef> coarse;
+  std::vector<Lat> first;  // per leaf: the first point that asked for it
+  for (const Lat& p : points)
+    for (int o = 0; o < 8; ++o) {
+      Lat q;
+      if (!octant_cell(p, o, q)) continue;
+      const LeafRef l = leaf_at(t, q);
+      if (l.cell.level >= t.max_depth) continue;
+      if (std::none_of(coarse.begin(), coarse.end(), [&](const LeafRef& c) { return c.node == l.node; })) {
+        coarse.push_back(l);
+        first.push_back(p);
+      }
+    }
+  std::vector<Builder> subs(coarse.size());
+  tbb::parallel_for(size_t{0}, coarse.size(), [&](size_t i) { subs[i] = resample(coarse[i], first[i]); });
+  for (size_t i = 0; i < coarse.size(); ++i) {
+    t.nodes[coarse[i].node] = append_subtree(t.nodes, t.vertices, subs[i]);
+    agree_on_boundary(t, coarse[i].node, coarse[i].cell);
+  }
+  return coarse.size();
+}
+
 size_t refine_around(Octree& t, const Lat& p, const ResampleLeaf& resample, const std::function<void(uint32_t)>& grown) {
   size_t replaced = 0;
   for (int o = 0; o < 8; ++o) {
