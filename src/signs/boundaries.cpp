@@ -177,7 +177,8 @@ int64_t point_to_erode(const Boundary& b, const Cell& cell) {
 }  // namespace
 
 size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched) {
+                                  const std::function<void(uint32_t)>* touched,
+                                  const std::function<void(const Lat&)>* flipped) {
   std::vector<LeafRef> coarse;
   auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
     if (active && !(*active)(node)) return;
@@ -208,7 +209,7 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
       needs[i] = b.points.size() > 8 && point_to_erode(b, coarse[i].cell) >= 0;
     }
   });
-  size_t flipped = 0;
+  size_t count = 0;
   for (size_t i = 0; i < coarse.size(); ++i) {
     if (!needs[i]) continue;
     const LeafRef& l = coarse[i];
@@ -218,10 +219,11 @@ size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>
       const int64_t p = point_to_erode(b, l.cell);
       if (p < 0) break;
       set_point_sign(t, b.points[size_t(p)], false, touched);
-      ++flipped;
+      if (flipped) (*flipped)(b.points[size_t(p)]);
+      ++count;
     }
   }
-  return flipped;
+  return count;
 }
 
 }  // namespace pic::detail

@@ -83,14 +83,15 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
 }
 
 size_t erode_to_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                              const std::function<void(uint32_t)>* touched) {
-  size_t flipped = 0;
+                              const std::function<void(uint32_t)>* touched,
+                              const std::function<void(const Lat&)>* flipped) {
+  size_t count = 0;
   for (;;) {
     std::vector<LeafRef> bad;
     for_each_gray_leaf(t, active, [&](uint32_t node, const Cell& cell) {
       if (multi_component(t.nodes[node].signs)) bad.push_back({node, cell});
     });
-    if (bad.empty()) return flipped;
+    if (bad.empty()) return count;
     for (const LeafRef& l : bad) {
       const uint8_t s = t.nodes[l.node].signs;
       if (!multi_component(s)) continue;
@@ -104,7 +105,8 @@ size_t erode_to_one_component(Octree& t, const std::function<bool(uint32_t)>* ac
         if (cost < best_cost) best_cost = cost, best = k;
       }
       set_point_sign(t, l.cell.corner(best), false, touched);
-      ++flipped;
+      if (flipped) (*flipped)(l.cell.corner(best));
+      ++count;
     }
   }
 }

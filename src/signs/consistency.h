@@ -49,8 +49,10 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
 /// Every flip takes a point out of the solid, so it ends (at worst with every point outside),
 /// and it ends only when no leaf has two components: a guarantee where enforce_one_component's
 /// cheaper flips can cycle. Returns how many points changed.
+/// `flipped`, when given, is told each point that changed.
 size_t erode_to_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                              const std::function<void(uint32_t)>* touched);
+                              const std::function<void(uint32_t)>* touched,
+                              const std::function<void(const std::array<int64_t, 3>&)>* flipped = nullptr);
 
 /// Flips inside points on the boundaries of leaves coarser than the finest level until, on each,
 /// the signs of its corners and of the finer corners its neighbours put on its faces form one
@@ -58,7 +60,8 @@ size_t erode_to_one_component(Octree& t, const std::function<bool(uint32_t)>* ac
 /// leaf's one vertex to be a manifold point of the contour. Monotone like
 /// erode_to_one_component, so it ends. Returns how many points changed.
 size_t erode_to_simple_boundaries(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched);
+                                  const std::function<void(uint32_t)>* touched,
+                                  const std::function<void(const std::array<int64_t, 3>&)>* flipped = nullptr);
 
 /// What remove_islands carries from one round of a settling loop to the next. Every check reads
 /// only the stored signs of the leaves around it, so a later round need look again only near

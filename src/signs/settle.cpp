@@ -74,12 +74,29 @@ size_t erode_around_capped(Octree& t, const std::function<void(uint32_t)>* touch
 size_t erode_until_valid(Octree& t, const std::function<bool(uint32_t)>* components,
                          const std::function<bool(uint32_t)>* boundaries, const std::function<void(uint32_t)>* touched) {
   // Both erosions only take points out, so together they end, and they end only where every
-  // leaf has one component and every coarse leaf a simple boundary.
+  // leaf has one component and every coarse leaf a simple boundary. A leaf's verdict reads only
+  // the signs on its closed cell, so after the first pass only leaves meeting a point flipped in
+  // the last pass or in this one so far can have changed: the passes look only there, and find
+  // the same leaves, in the same order, as a pass over the whole scope.
+  std::vector<uint8_t> last, now;  // per node: meets a point flipped in the last pass / this one
+  bool whole = true;
+  const auto near = [&](uint32_t n) { return whole || (n < last.size() && last[n]) || (n < now.size() && now[n]); };
+  const std::function<bool(uint32_t)> in_components = [&](uint32_t n) { return near(n) && (!components || (*components)(n)); };
+  const std::function<bool(uint32_t)> in_boundaries = [&](uint32_t n) { return near(n) && (!boundaries || (*boundaries)(n)); };
+  const std::function<void(const std::array<int64_t, 3>&)> flipped_at = [&](const std::array<int64_t, 3>& p) {
+    now.resize(t.nodes.size(), 0);
+    for_each_node_meeting(t, 0, Cell{}, p, p, [&](uint32_t m) { now[m] = 1; });
+  };
   size_t total = 0;
   for (;;) {
-    const size_t flipped = erode_to_one_component(t, components, touched) + erode_to_simple_boundaries(t, boundaries, touched);
+    const size_t flipped =
+        erode_to_one_component(t, whole ? components : &in_components, touched, &flipped_at) +
+        erode_to_simple_boundaries(t, whole ? boundaries : &in_boundaries, touched, &flipped_at);
     if (flipped == 0) return total;
     total += flipped;
+    whole = false;
+    last.swap(now);
+    now.assign(t.nodes.size(), 0);
   }
 }
 
