@@ -556,7 +556,7 @@ void refine_coarse_sides(Octree& tree, FunctionResample& resample, const Resampl
       near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
     }
     resample.also = against;
-    refine_all_around(tree, against, from_function);
+    refine_all_around(tree, against, from_function, resample.options.parallel);
   }
   resample.also.clear();
 }

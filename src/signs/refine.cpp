@@ -125,7 +125,7 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
   return out;
 }
 
-size_t refine_all_around(Octree& t, const std::vector<Lat>& points, const ResampleLeaf& resample) {
+size_t refine_all_around(Octree& t, const std::vector<Lat>& points, const ResampleLeaf& resample, bool parallel) {
   std::vector<LeafRef> coarse;
   std::vector<Lat> first;  // per leaf: the first point that asked for it
   for (const Lat& p : points)
@@ -140,7 +140,9 @@ size_t refine_all_around(Octree& t, const std::vector<Lat>& points, const Resamp
       }
     }
   std::vector<Builder> subs(coarse.size());
-  tbb::parallel_for(size_t{0}, coarse.size(), [&](size_t i) { subs[i] = resample(coarse[i], first[i]); });
+  const auto one = [&](size_t i) { subs[i] = resample(coarse[i], first[i]); };
+  if (parallel) tbb::parallel_for(size_t{0}, coarse.size(), one);
+  else for (size_t i = 0; i < coarse.size(); ++i) one(i);
   for (size_t i = 0; i < coarse.size(); ++i) {
     t.nodes[coarse[i].node] = append_subtree(t.nodes, t.vertices, subs[i]);
     agree_on_boundary(t, coarse[i].node, coarse[i].cell);

@@ -26,9 +26,11 @@ size_t refine_around(Octree& t, const std::array<int64_t, 3>& p, const ResampleL
                      const std::function<void(uint32_t)>& grown);
 
 /// refine_around for many points at once: every leaf coarser than t.max_depth whose closed cell
-/// holds one of them is resampled once (in parallel; `resample` must be safe to call from
-/// several threads) for all the points it holds. Returns how many leaves were replaced.
-size_t refine_all_around(Octree& t, const std::vector<std::array<int64_t, 3>>& points, const ResampleLeaf& resample);
+/// holds one of them is resampled once for all the points it holds (with `parallel`, leaves
+/// side by side: `resample` must then be safe to call from several threads). Returns how many
+/// leaves were replaced.
+size_t refine_all_around(Octree& t, const std::vector<std::array<int64_t, 3>>& points, const ResampleLeaf& resample,
+                         bool parallel);
 
 /// Lattice points that finer leaves give a sign on an edge or face of a coarser gray leaf
 /// whose corners there (the edge's two, the face's four) all have the other sign: the
