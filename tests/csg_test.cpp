@@ -8,9 +8,11 @@
 #include <random>
 #include <set>
 #include <functional>
+#include <numbers>
 #include <vector>
 
 #include "pic/pic.h"
+#include "geometry/mesh_distance.h"
 #include "pic/primitives.h"
 #include "support/mesh_checks.h"
 
@@ -616,6 +618,55 @@ namespace {
 
 // csg(a, b) keeps its bookkeeping (the timestamps of paper 5.2.1) to itself: both operands
 // are left exactly as they were, so they can be shared between threads without a lock.
+/// A wavy star (9 lobes, radius r) extruded to height h with a twist and a taper, as OpenSCAD's
+/// linear_extrude(height, twist, slices, scale) writes it (each slice's quads split in two).
+TriMesh twisted_star(double r, double h, double twist_deg, int slices, double scale) {
+  constexpr int kRing = 36;
+  TriMesh m;
+  for (int j = 0; j <= slices; ++j) {
+    const double t = double(j) / slices, turn = -twist_deg * t * std::numbers::pi / 180, s = 1 + (scale - 1) * t;
+    for (int i = 0; i < kRing; ++i) {
+      const double a = 2 * std::numbers::pi * i / kRing, rr = r * s * (1 + 0.12 * std::cos(9 * a));
+      m.positions.push_back({rr * std::cos(a + turn), rr * std::sin(a + turn), h * t});
+    }
+  }
+  const auto at = [&](int j, int i) { return uint32_t(j * kRing + (i % kRing)); };
+  for (int j = 0; j < slices; ++j)
+    for (int i = 0; i < kRing; ++i) {
+      m.triangles.push_back({at(j, i), at(j, i + 1), at(j + 1, i + 1)});
+      m.triangles.push_back({at(j, i), at(j + 1, i + 1), at(j + 1, i)});
+    }
+  const auto bottom = uint32_t(m.positions.size());
+  m.positions.push_back({0, 0, 0});
+  const auto top = uint32_t(m.positions.size());
+  m.positions.push_back({0, 0, h});
+  for (int i = 0; i < kRing; ++i) {
+    m.triangles.push_back({bottom, at(0, i + 1), at(0, i)});
+    m.triangles.push_back({top, at(slices, i), at(slices, i + 1)});
+  }
+  return m;
+}
+
+TEST(Csg, ResampledCoarseLeafKeepsItsVertexOnTheSurface) {
+  // A twisted vase's outer wall minus its inner one, sampled in a cube much larger than the
+  // vase (as a floor's cutting box in the same OpenSCAD file makes it): the outer wall's coarse
+  // leaves are split where the inner wall is finer, and each part resampled from the wall's
+  // partial contour. A part whose sign change no triangle of that contour explains used the
+  // plane of a triangle beside it and put its vertex 12 finest cells inside the wall.
+  const TriMesh outer = twisted_star(20, 60, 120, 60, 1.3), inner = twisted_star(18, 66, 132, 66, 1.33);
+  ASSERT_TRUE(IsClosedManifold(outer));
+  const Cube cube{{-112.5, -112.5, -82}, 225};
+  const Octree r = csg(sample_in_unit(outer, 12, cube), sample_in_unit(inner, 12, cube), CsgOp::Subtract);
+  const TriMesh m = contour(r);
+  ASSERT_TRUE(IsClosedManifold(m));
+  const detail::MeshDistance to_outer(outer), to_inner(inner);
+  double worst = 0;
+  for (const Vec3& p : m.positions) worst = std::max(worst, std::min(to_outer.distance(p), to_inner.distance(p)));
+  const double cell = cube.size / 4096;
+  std::printf("  [measure] worst vertex %.2f finest cells from both walls\n", worst / cell);
+  EXPECT_LT(worst, 1.5 * cell);
+}
+
 TEST(Csg, LeavesItsOperandsUntouched) {
   const Octree a = sample_in_unit(make_box({0.2, 0.2, 0.2}, {0.7, 0.7, 0.7}), 7);
   const Octree b = sample_in_unit(make_sphere({0.6, 0.6, 0.6}, 0.25, 48), 7);

@@ -231,6 +231,7 @@ class Combiner {
     p.error = error_;
     p.invert = invert;
     p.tips_at_corners = true;
+    p.partial_contour = true;
     Builder sub;
     sub.nodes.resize(1);
     size_t capped = 0;

@@ -24,6 +24,7 @@ Builder resample_from_contour(const Octree& t, const LeafRef& leaf, const Lat& p
   params.has_focus = true;
   params.focus = p;
   params.tips_at_corners = true;
+  params.partial_contour = true;
   Builder sub;
   sub.nodes.resize(1);
   size_t capped = 0;

@@ -128,7 +128,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   } else if (at_cap || one_component(signs)) {
     // (Two components by the signs always split, below the cap: no QEF needed to know.)
     Qef q;
-    cell_qef(src.tris(), idx, cell, q);
+    if (!p.partial_contour || meets_box(src.tris(), idx, cell.box())) cell_qef(src.tris(), idx, cell, q);
     src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs, p.tips_at_corners);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&

@@ -100,6 +100,12 @@ struct SampleParams {
   bool has_focus = false;
   std::array<int64_t, 3> focus{0, 0, 0};
   bool tips_at_corners = false;  ///< cell_vertex's tip_at_corner (Booleans' touching parts)
+  /// The source is an operand's partial contour, its signs found by parity walks that may
+  /// disagree with the triangles near a cell by the contour's own error: a gray cell none of
+  /// whose triangles meets it has no plane to fit (the planes of triangles beside it, extended
+  /// into it, can put its vertex most of a cell off the surface) and takes cell_vertex's
+  /// vertex beside its minority corners.
+  bool partial_contour = false;
 };
 
 
