@@ -616,8 +616,6 @@ TEST(Csg, SpotUnionTorusFollowsTheExactBoolean) {
 namespace pic {
 namespace {
 
-// csg(a, b) keeps its bookkeeping (the timestamps of paper 5.2.1) to itself: both operands
-// are left exactly as they were, so they can be shared between threads without a lock.
 /// A wavy star (9 lobes, radius r) extruded to height h with a twist and a taper, as OpenSCAD's
 /// linear_extrude(height, twist, slices, scale) writes it (each slice's quads split in two).
 TriMesh twisted_star(double r, double h, double twist_deg, int slices, double scale) {
@@ -667,6 +665,8 @@ TEST(Csg, ResampledCoarseLeafKeepsItsVertexOnTheSurface) {
   EXPECT_LT(worst, 1.5 * cell);
 }
 
+// csg(a, b) keeps its bookkeeping (the timestamps of paper 5.2.1) to itself: both operands
+// are left exactly as they were, so they can be shared between threads without a lock.
 TEST(Csg, LeavesItsOperandsUntouched) {
   const Octree a = sample_in_unit(make_box({0.2, 0.2, 0.2}, {0.7, 0.7, 0.7}), 7);
   const Octree b = sample_in_unit(make_sphere({0.6, 0.6, 0.6}, 0.25, 48), 7);

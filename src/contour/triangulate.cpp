@@ -362,7 +362,7 @@ void onto_level_in_face(const SurfaceFunction& level, const Face& face, double i
       g[d] = (level(b) - level(a)) / (2 * h);
     }
     const double g2 = dot3(g, g);
-    if (!(g2 > 0)) return;
+    if (!(g2 > 0)) break;
     Vec3 next = sub3(f, scale3(g, v / g2));
     for (int d = 0; d < 3; ++d)
       if (d != face.axis) next[d] = std::clamp(next[d], face.lo[d] + inset, face.hi[d] - inset);

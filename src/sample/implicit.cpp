@@ -513,14 +513,15 @@ struct FunctionResample {
   const SampleOptions& options;
   const Octree& tree;
   Memos* memo;
-  std::vector<Lat> also;
-  std::atomic<size_t> evaluations{0};
+  std::vector<Lat> also;  ///< sorted
+  std::atomic<size_t> evaluations{0}, capped{0};
 
   Builder operator()(const LeafRef& l, const Lat& p) {
     LevelSampler one(solid, *options.cube, options.depth, options.error, false, memo);
     std::vector<Lat> focus{p};
-    for (const Lat& q : also)
-      if (l.cell.holds(q)) focus.push_back(q);
+    const Lat lo = l.cell.lat, hi = l.cell.corner(7);
+    for (auto it = std::lower_bound(also.begin(), also.end(), lo); it != also.end() && (*it)[0] <= hi[0]; ++it)
+      if (l.cell.holds(*it)) focus.push_back(*it);
     one.focus_on(std::move(focus));
     std::vector<Vec3> at(8);
     for (int k = 0; k < 8; ++k) at[k] = lattice_unit(l.cell.corner(k));
@@ -532,9 +533,10 @@ struct FunctionResample {
       const bool inside = (signs >> k) & 1;
       corner[k] = (fv[k] < 0) == inside ? fv[k] : inside ? -kHair : kHair;
     }
-    size_t capped = 0;
-    Builder sub = one.run(l.cell, corner, capped);
+    size_t more = 0;
+    Builder sub = one.run(l.cell, corner, more);
     evaluations += one.evaluations;
+    capped += more;
     return sub;
   }
 };
@@ -544,9 +546,11 @@ struct FunctionResample {
 /// flip them, a coarse cell off the surface. Such leaves are sampled again around those points,
 /// all at once; each further round looks only around what the last one split.
 void refine_coarse_sides(Octree& tree, FunctionResample& resample, const ResampleLeaf& from_function) {
+  // A batched function (one call per batch, such as a Python one) sees one batch at a time.
+  const bool parallel = resample.options.parallel && !resample.solid.values;
   std::vector<std::pair<Lat, Lat>> near;
   for (int round = 0; round < 8; ++round) {
-    const std::vector<Lat> against = points_against_coarse_sides(tree, near);
+    const std::vector<Lat> against = points_against_coarse_sides(tree, near, parallel);
     if (against.empty()) break;
     near.clear();
     for (const Lat& p : against) {
@@ -556,7 +560,7 @@ void refine_coarse_sides(Octree& tree, FunctionResample& resample, const Resampl
       near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
     }
     resample.also = against;
-    refine_all_around(tree, against, from_function, resample.options.parallel);
+    refine_all_around(tree, against, from_function, parallel);
   }
   resample.also.clear();
 }
@@ -594,6 +598,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   // point the settling flips at a coarser leaf is refined around first.
   settle_sampled(tree, SettleRegion{}, &from_function);
   sampler.evaluations += resample.evaluations;
+  capped += resample.capped;
   PIC_CHECK_OCTREE(tree, "sampling a function");
   if (tree.vertices.empty()) throw EmptySolid("the function's solid does not meet the cube's inside and outside");
   if (stats) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <unordered_set>
 
 #include <tbb/parallel_for.h>
 
@@ -65,7 +66,8 @@ std::optional<bool> side_sign(const Cell& cell, uint8_t signs, const Lat& p) {
 
 }  // namespace
 
-std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<std::pair<Lat, Lat>>& near) {
+std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<std::pair<Lat, Lat>>& near,
+                                            bool parallel) {
   // Per node: the level of its deepest leaf (the walk below skips subtrees no finer than the
   // coarse leaf, most of them).
   std::vector<uint8_t> deepest(t.nodes.size(), 0);
@@ -103,7 +105,7 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
     for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c), lo, hi, level, out);
   };
   std::vector<std::vector<Lat>> found(coarse.size());
-  tbb::parallel_for(size_t{0}, coarse.size(), [&](size_t i) {
+  const auto look = [&](size_t i) {
     const LeafRef& l = coarse[i];
     const uint8_t signs = t.nodes[l.node].signs;
     std::vector<LeafRef> finer;
@@ -117,7 +119,9 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
         if (s && *s != (((ns >> c) & 1) != 0)) found[i].push_back(p);
       }
     }
-  });
+  };
+  if (parallel) tbb::parallel_for(size_t{0}, coarse.size(), look);
+  else for (size_t i = 0; i < coarse.size(); ++i) look(i);
   std::vector<Lat> out;
   for (const auto& f : found) out.insert(out.end(), f.begin(), f.end());
   std::sort(out.begin(), out.end());
@@ -128,16 +132,15 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
 size_t refine_all_around(Octree& t, const std::vector<Lat>& points, const ResampleLeaf& resample, bool parallel) {
   std::vector<LeafRef> coarse;
   std::vector<Lat> first;  // per leaf: the first point that asked for it
+  std::unordered_set<uint32_t> seen;
   for (const Lat& p : points)
     for (int o = 0; o < 8; ++o) {
       Lat q;
       if (!octant_cell(p, o, q)) continue;
       const LeafRef l = leaf_at(t, q);
-      if (l.cell.level >= t.max_depth) continue;
-      if (std::none_of(coarse.begin(), coarse.end(), [&](const LeafRef& c) { return c.node == l.node; })) {
-        coarse.push_back(l);
-        first.push_back(p);
-      }
+      if (l.cell.level >= t.max_depth || !seen.insert(l.node).second) continue;
+      coarse.push_back(l);
+      first.push_back(p);
     }
   std::vector<Builder> subs(coarse.size());
   const auto one = [&](size_t i) { subs[i] = resample(coarse[i], first[i]); };

@@ -26,9 +26,10 @@ size_t refine_around(Octree& t, const std::array<int64_t, 3>& p, const ResampleL
                      const std::function<void(uint32_t)>& grown);
 
 /// refine_around for many points at once: every leaf coarser than t.max_depth whose closed cell
-/// holds one of them is resampled once for all the points it holds (with `parallel`, leaves
-/// side by side: `resample` must then be safe to call from several threads). Returns how many
-/// leaves were replaced.
+/// holds one of them is resampled once (with `parallel`, leaves side by side: `resample` must
+/// then be safe to call from several threads). `resample` is handed the first of the points the
+/// leaf holds; to split around all of them in one sampling it must know the others itself.
+/// Returns how many leaves were replaced.
 size_t refine_all_around(Octree& t, const std::vector<std::array<int64_t, 3>>& points, const ResampleLeaf& resample,
                          bool parallel);
 
@@ -39,6 +40,7 @@ size_t refine_all_around(Octree& t, const std::vector<std::array<int64_t, 3>>& p
 /// up to the coarse leaf's size; a sampler that can look again refines around it instead.
 /// `near`: when not empty, only coarse leaves meeting one of these closed lattice boxes.
 std::vector<std::array<int64_t, 3>> points_against_coarse_sides(
-    const Octree& t, const std::vector<std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>>>& near = {});
+    const Octree& t, const std::vector<std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>>>& near,
+    bool parallel);
 
 }  // namespace pic::detail
