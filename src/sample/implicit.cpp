@@ -172,16 +172,22 @@ class LevelSampler {
 
   size_t evaluations = 0;
 
-  /// Splits every cell whose closed box holds one of the lattice points `p` down to the cap,
-  /// whatever f says there: a leaf sampled again around points the settling would flip
-  /// (refine_around).
-  void focus_on(std::vector<Lat> p) { focus_ = std::move(p); }
+  /// Splits every cell whose closed box holds one of the lattice points `p` down to the cap
+  /// (with `to_corner`: until each point is a corner of the cells around it), whatever f says
+  /// there: a leaf sampled again around points the settling would flip (refine_around), or
+  /// whose finer neighbours sampled them with f's sign (then f's sign there is all it takes).
+  void focus_on(std::vector<Lat> p, bool to_corner = false) {
+    focus_ = std::move(p);
+    to_corner_ = to_corner;
+  }
 
  private:
   std::vector<Lat> focus_;
+  bool to_corner_ = false;
   bool focused(const Cell& cell) const {
-    return cell.level < max_depth_ &&
-           std::any_of(focus_.begin(), focus_.end(), [&](const Lat& p) { return cell.holds(p); });
+    return cell.level < max_depth_ && std::any_of(focus_.begin(), focus_.end(), [&](const Lat& p) {
+             return cell.holds(p) && (!to_corner_ || cell.corner_index(p) < 0);
+           });
   }
 
   const ImplicitSolid& f_;
@@ -505,15 +511,17 @@ class LevelSampler {
   }
 };
 
-/// A leaf sampled again from f, down to the cap around p and around the points of `also` it
-/// holds, with the leaf's own corner signs (a settled sign may differ from f's: its value then
-/// only keeps that sign). Safe to call from several threads.
+/// A leaf sampled again from f around p and the points of `also` it holds (down to the cap, or
+/// with `to_corner` until each is a corner), with the leaf's own corner signs (a settled sign
+/// may differ from f's: its value then only keeps that sign). Safe to call from several
+/// threads.
 struct FunctionResample {
   const ImplicitSolid& solid;
   const SampleOptions& options;
   const Octree& tree;
   Memos* memo;
   std::vector<Lat> also;  ///< sorted
+  bool to_corner = false;  ///< split only until the points are corners, not down to the cap
   std::atomic<size_t> evaluations{0}, capped{0};
 
   Builder operator()(const LeafRef& l, const Lat& p) {
@@ -522,7 +530,7 @@ struct FunctionResample {
     const Lat lo = l.cell.lat, hi = l.cell.corner(7);
     for (auto it = std::lower_bound(also.begin(), also.end(), lo); it != also.end() && (*it)[0] <= hi[0]; ++it)
       if (l.cell.holds(*it)) focus.push_back(*it);
-    one.focus_on(std::move(focus));
+    one.focus_on(std::move(focus), to_corner);
     std::vector<Vec3> at(8);
     for (int k = 0; k < 8; ++k) at[k] = lattice_unit(l.cell.corner(k));
     const std::vector<double> fv = one.values(at);
@@ -543,8 +551,9 @@ struct FunctionResample {
 
 /// Where f crosses a coarse leaf's edge or face twice between its corners, its finer
 /// neighbours sampled the points between with f's sign, against the side's; the settling would
-/// flip them, a coarse cell off the surface. Such leaves are sampled again around those points,
-/// all at once; each further round looks only around what the last one split.
+/// flip them, a coarse cell off the surface. Such leaves are sampled again until those points
+/// are corners of theirs (f's sign there then agrees on both sides), all at once; each further
+/// round looks only around what the last one split.
 void refine_coarse_sides(Octree& tree, FunctionResample& resample, const ResampleLeaf& from_function) {
   // A batched function (one call per batch, such as a Python one) sees one batch at a time.
   const bool parallel = resample.options.parallel && !resample.solid.values;
@@ -560,9 +569,11 @@ void refine_coarse_sides(Octree& tree, FunctionResample& resample, const Resampl
       near.push_back({{p[0] - span, p[1] - span, p[2] - span}, {p[0] + span, p[1] + span, p[2] + span}});
     }
     resample.also = against;
+    resample.to_corner = true;
     refine_all_around(tree, against, from_function, parallel);
   }
   resample.also.clear();
+  resample.to_corner = false;
 }
 
 }  // namespace
