@@ -10,11 +10,12 @@
 
 namespace pic::detail {
 
-/// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
-/// in depth-first order.
-inline void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const std::array<int64_t, 3>& lo,
-                            const std::array<int64_t, 3>& hi, int max_level, std::vector<LeafRef>& out) {
-  if (cell.level > max_level) return;
+/// Every leaf whose closed cell meets the closed lattice box [lo, hi], in depth-first order,
+/// leaving out the subtrees for which `skip(node, cell)` holds.
+template <class Skip>
+void leaves_touching_if(const Octree& t, uint32_t node, const Cell& cell, const std::array<int64_t, 3>& lo,
+                        const std::array<int64_t, 3>& hi, const Skip& skip, std::vector<LeafRef>& out) {
+  if (skip(node, cell)) return;
   const int64_t s = cell.span();
   for (int k = 0; k < 3; ++k)
     if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
@@ -23,7 +24,14 @@ inline void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, co
     out.push_back({node, cell});
     return;
   }
-  for (int c = 0; c < 8; ++c) leaves_touching(t, n.index + c, cell.child(c), lo, hi, max_level, out);
+  for (int c = 0; c < 8; ++c) leaves_touching_if(t, n.index + c, cell.child(c), lo, hi, skip, out);
+}
+
+/// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
+/// in depth-first order.
+inline void leaves_touching(const Octree& t, uint32_t node, const Cell& cell, const std::array<int64_t, 3>& lo,
+                            const std::array<int64_t, 3>& hi, int max_level, std::vector<LeafRef>& out) {
+  leaves_touching_if(t, node, cell, lo, hi, [&](uint32_t, const Cell& c) { return c.level > max_level; }, out);
 }
 
 /// Calls f(node) for every node whose closed cell meets the closed lattice box [lo, hi], below

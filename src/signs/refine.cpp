@@ -1,6 +1,8 @@
 // Refining around a lattice point: see refine.h.
 #include "signs/refine.h"
 
+#include "signs/leaf_walks.h"
+
 #include <algorithm>
 #include <optional>
 #include <unordered_set>
@@ -90,26 +92,14 @@ std::vector<Lat> points_against_coarse_sides(const Octree& t, const std::vector<
     return d;
   };
   walk(walk, 0, Cell{});
-  // The leaves finer than `level` whose closed cells meet the closed box [lo, hi].
-  auto finer_touching = [&](auto&& self, uint32_t node, const Cell& cell, const Lat& lo, const Lat& hi, int level,
-                            std::vector<LeafRef>& out) -> void {
-    if (deepest[node] <= level) return;
-    const int64_t s = cell.span();
-    for (int k = 0; k < 3; ++k)
-      if (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k]) return;
-    const Node& n = t.nodes[node];
-    if (n.kind != CellKind::Internal) {
-      out.push_back({node, cell});
-      return;
-    }
-    for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c), lo, hi, level, out);
-  };
   std::vector<std::vector<Lat>> found(coarse.size());
   const auto look = [&](size_t i) {
     const LeafRef& l = coarse[i];
     const uint8_t signs = t.nodes[l.node].signs;
+    // The leaves finer than this one touching it (subtrees no deeper than it are skipped).
     std::vector<LeafRef> finer;
-    finer_touching(finer_touching, 0, Cell{}, l.cell.lat, l.cell.corner(7), l.cell.level, finer);
+    leaves_touching_if(t, 0, Cell{}, l.cell.lat, l.cell.corner(7),
+                       [&](uint32_t n, const Cell&) { return deepest[n] <= l.cell.level; }, finer);
     for (const LeafRef& n : finer) {
       const uint8_t ns = signs_of(t.nodes[n.node]);
       for (int c = 0; c < 8; ++c) {
