@@ -649,8 +649,8 @@ TEST(Csg, ResampledCoarseLeafKeepsItsVertexOnTheSurface) {
   // A twisted vase's outer wall minus its inner one, sampled in a cube much larger than the
   // vase (as a floor's cutting box in the same OpenSCAD file makes it): the outer wall's coarse
   // leaves are split where the inner wall is finer, and each part resampled from the wall's
-  // partial contour. A part whose sign change no triangle of that contour explains used the
-  // plane of a triangle beside it and put its vertex 12 finest cells inside the wall.
+  // partial contour. A part whose sign change no triangle of that contour explains must not
+  // take the plane of a triangle beside it: that puts its vertex 12 finest cells inside the wall.
   const TriMesh outer = twisted_star(20, 60, 120, 60, 1.3), inner = twisted_star(18, 66, 132, 66, 1.33);
   ASSERT_TRUE(IsClosedManifold(outer));
   const Cube cube{{-112.5, -112.5, -82}, 225};

@@ -277,9 +277,9 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
 TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
   // spot grown by 0.05 at depth 10. Beside a concave ridge of the distance (where the grown
   // surface folds) f crosses a coarse leaf's edge twice between its corners: the finer leaves
-  // beside it sample the points between with f's sign, and the settling once gave them the
-  // coarse side's instead (a vertex 1.16 cells off). Such a leaf is now sampled again around
-  // them; and a face point Newton leaves stalled at its face's border is bisected onto f's zero.
+  // beside it sample the points between with f's sign; given the coarse side's sign by the
+  // settling, a vertex lands 1.16 cells off. Such a leaf is sampled again around them, and a
+  // face point Newton leaves stalled at its face's border is bisected onto f's zero.
   const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
   const double d = 0.05;
   VolumeMesh vm;
