@@ -16,6 +16,7 @@
 #include "scad/lower.h"
 #include "scad/region.h"
 #include "scad/text.h"
+#include "signs/invariants.h"
 #include "support/mesh_checks.h"
 #include "support/temp_dir.h"
 
@@ -395,9 +396,48 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   const std::string ell =
       "linear_extrude(height = 2) { polygon(points = [[0, 0], [4, 0], [4, 4], [2, 4], [2, 2], [0, 2]]); }";
   EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell + " " + ell + " }", o))), 52 * 4, 208 * 1e-5);
-  // Two non-convex operands without convex pieces (twisted extrusions) are refused.
-  const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 4) { square(size = [2, 2]); }";
-  EXPECT_THROW(eval_csg("minkowski() { " + twisted + " " + twisted + " }", o), InvalidInput);
+  // The same L as one polyhedron with a hexagon cap: a leaf that is not convex, and its caps
+  // reach the sum as fans whose triangles partly face back. Plus a unit cube: (L + square)
+  // (area 21) times 3; a cap taken as the union of its fan's triangles would fill the notch (66).
+  const std::string ell_polyhedron =
+      "polyhedron(points = [[0, 0, 0], [4, 0, 0], [4, 4, 0], [2, 4, 0], [2, 2, 0], [0, 2, 0], [0, 0, 2], [4, 0, 2], "
+      "[4, 4, 2], [2, 4, 2], [2, 2, 2], [0, 2, 2]], faces = [[5, 4, 3, 2, 1, 0], [6, 7, 8, 9, 10, 11], [0, 1, 7, 6], "
+      "[1, 2, 8, 7], [2, 3, 9, 8], [3, 4, 10, 9], [4, 5, 11, 10], [5, 0, 6, 11]]);";
+  EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell_polyhedron + " cube(size = [1, 1, 1]); }", o))), 63,
+              63 * 1e-5);
+  // Two non-convex leaves: each moved by a point of the other, and every pair of their planar
+  // pieces summed (a hull each) -- the L plus itself again, 52 * 4.
+  EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell_polyhedron + " " + ell_polyhedron + " }", o))), 52 * 4,
+              208 * 1e-5);
+  // Two twisted extrusions: 66 planar pieces each (every side triangle its own), 4,356 hulls
+  // -- refused at once with the count.
+  const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 8) { square(size = [2, 2]); }";
+  try {
+    eval_csg("minkowski() { " + twisted + " " + twisted + " }", o);
+    FAIL() << "4,356 hulls were summed";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("convex hulls"), std::string::npos) << e.what();
+  }
+}
+
+// A ball minus a corner cube plus an octahedral ball: three hulls that share faces, united
+// at depth 12. The Booleans resample coarse leaves from the operands' partial contours, where a
+// corner's parity-walk sign may have no crossing inside to explain it; such a cell must not
+// split (its child grid would give its faces' points signs its neighbours do not share, and the
+// contour would have boundary edges).
+TEST(ScadMinkowski, HullsSharingFacesUniteIntoOneValidSolid) {
+  EvalOptions o;
+  o.depth = 12;
+  const Octree t = eval_csg(
+      "minkowski() { difference() { sphere($fn = 0, $fa = 12, $fs = 2, r = 10); "
+      "multmatrix([[1, 0, 0, 5], [0, 1, 0, 5], [0, 0, 1, 5], [0, 0, 0, 1]]) { cube(size = [10, 10, 10], center = true); } } "
+      "sphere($fn = 8, $fa = 12, $fs = 2, r = 1); }",
+      o);
+  EXPECT_NO_THROW(detail::check_octree(t, "minkowski"));
+  const TriMesh m = contour(t);
+  const MeshTopology topo = analyze_topology(m);
+  EXPECT_TRUE(topo.closed()) << topo.boundary_edges << " boundary edges";
+  EXPECT_TRUE(topo.manifold());
 }
 
 // Rounded text, the idiom that used to be refused: an extruded glyph with a hole plus a ball.

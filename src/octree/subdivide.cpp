@@ -128,14 +128,16 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
   } else if (at_cap || one_component(signs)) {
     // (Two components by the signs always split, below the cap: no QEF needed to know.)
     Qef q;
-    // A partial contour's cell with a sign change but no triangle of it: split down to the
-    // cap, where the disagreement is a finest cell at most.
+    // A partial contour's cell with a sign change but no triangle of it: no plane, and no
+    // split either -- its corners' signs are the parity walks', which no crossing inside
+    // explains, so a child grid walked from them would give its faces' points signs its
+    // neighbours do not share. It takes the vertex beside its minority corners.
     const bool planeless = p.partial_contour && !meets_box(src.tris(), idx, cell.box());
     if (!planeless) cell_qef(src.tris(), idx, cell, q);
     src.add_fill_planes(cell, signs, wind, idx, q);
     const Qef::Solution sol = cell_vertex(q, cell, signs, p.tips_at_corners);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
-                    !has_double_crossing(src.tris(), idx, cell, signs, p.edge_memo) && (!planeless || at_cap);
+                    !has_double_crossing(src.tris(), idx, cell, signs, p.edge_memo);
     if (ok || at_cap) {
       if (!ok) ++capped;
       out.set_gray(slot, cell, written, sol.position, ok ? 0 : kFlagCapped);

@@ -103,8 +103,9 @@ struct SampleParams {
   /// The source is an operand's partial contour, its signs found by parity walks that may
   /// disagree with the triangles near a cell by the contour's own error: a gray cell none of
   /// whose triangles meets it has no plane to fit (the planes of triangles beside it, extended
-  /// into it, can put its vertex most of a cell off the surface): it splits down to the cap,
-  /// where it takes cell_vertex's vertex beside its minority corners.
+  /// into it, can put its vertex most of a cell off the surface) and takes cell_vertex's
+  /// vertex beside its minority corners (split, its child grid would disagree with its
+  /// neighbours: no crossing inside explains its corners' signs).
   bool partial_contour = false;
 };
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <unordered_map>
 
@@ -18,7 +19,7 @@
 namespace pic::detail::scad {
 namespace {
 
-// Edge-neighbouring triangles on one plane (within `tol`, world units, with parallel normals:
+// Edge-neighbouring triangles on one plane (within `tol`, world units, with parallel or opposite normals:
 // a sliver along a crease has its vertices on both faces' planes), in groups.
 std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol) {
   const size_t nt = m.triangles.size();
@@ -38,7 +39,8 @@ std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol)
     const auto& t = m.triangles[f];
     for (int e = 0; e < 3; ++e) {
       const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
-      if (it == by_edge.end() || dot3(normal[f], normal[it->second]) < 1 - kFlatNeighbourCosine) continue;
+      // Turned-over neighbours too: a fan over a non-convex face has triangles facing back.
+      if (it == by_edge.end() || std::abs(dot3(normal[f], normal[it->second])) < 1 - kFlatNeighbourCosine) continue;
       bool flat = true;
       for (uint32_t v : m.triangles[it->second])
         flat = flat && std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[t[0]]))) <= tol;
@@ -91,7 +93,8 @@ void group_pieces(const TriMesh& m, const std::vector<uint32_t>& tris, double to
       const Vec3 d = sub3(m.positions[k], o);
       ring.push_back({dot3(d, u), dot3(d, v)});
     }
-    if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
+    // Kept as oriented: a non-convex face triangulated as a fan has triangles turned against
+    // the face that cancel the others' overhang, and the union counts winding.
     shadow.push_back(std::move(ring));
   }
   const Region outline = without_straight_vertices(region_union({shadow}), tol);
@@ -365,6 +368,59 @@ void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& ou
   for (const auto& piece : pieces) out.push_back({convex_hull(sums(piece, c)).positions, {}});
 }
 
+// A point on each connected piece of a closed surface (vertices welded by position: a soup's
+// triangles are one piece where they meet).
+std::vector<Vec3> point_per_shell(const TriMesh& m) {
+  std::unordered_map<uint64_t, uint32_t> first_at;  // welded position -> first vertex there
+  UnionFind shells(m.positions.size());
+  auto bits = [](double x) {
+    uint64_t u;
+    std::memcpy(&u, &x, sizeof u);
+    return u;
+  };
+  for (uint32_t v = 0; v < m.positions.size(); ++v) {
+    const Vec3& p = m.positions[v];
+    const uint64_t key = bits(p[0]) * 0x9e3779b97f4a7c15ull ^ bits(p[1]) * 0xc2b2ae3d27d4eb4full ^ bits(p[2]);
+    const auto [it, fresh] = first_at.emplace(key, v);
+    if (!fresh && m.positions[it->second] == p) shells.join(v, it->second);
+  }
+  for (const auto& t : m.triangles) shells.join(t[0], t[1]), shells.join(t[1], t[2]);
+  std::vector<Vec3> out;
+  std::vector<char> seen(m.positions.size(), 0);
+  for (const auto& t : m.triangles)
+    if (const size_t r = shells.root(t[0]); !seen[r]) {
+      seen[r] = 1;
+      out.push_back(m.positions[t[0]]);
+    }
+  return out;
+}
+
+// Two non-convex solids N and M: for x = n + m of the sum, the surface of x - M either meets
+// N's surface (x is in dN + dM) or a whole shell of it lies inside N (x is in N moved by a
+// point of that shell), or else a whole shell of N lies inside x - M (x is in M moved by a point
+// of that shell) -- a path in N from n to N's surface would otherwise cross x - M's surface
+// inside N. So N + M is N moved by a point of each shell of M, M moved by a point of each shell
+// of N, and every planar piece of dN plus every planar piece of dM (convex hulls).
+void add_sum(const TriMesh& n, const TriMesh& m, std::vector<Part>& out) {
+  for (const auto& [from, by] : {std::pair{&n, &m}, std::pair{&m, &n}})
+    for (const Vec3& c : point_per_shell(*by)) {
+      Part moved{{}, *from};
+      for (Vec3& p : moved.surface.positions) p = add3(p, c);
+      out.push_back(std::move(moved));
+    }
+  auto pieces_of = [](const TriMesh& s) {
+    const auto [lo, hi] = box_of(s.positions);
+    return planar_pieces(s, kFlatFaceTolerance * norm3(sub3(hi, lo)));
+  };
+  const auto pn = pieces_of(n), pm = pieces_of(m);
+  if (pn.size() * pm.size() > kMaxPieces)
+    throw InvalidInput("the sum of two non-convex operands with " + std::to_string(pn.size()) + " and " +
+                       std::to_string(pm.size()) + " planar pieces needs more than " + std::to_string(kMaxPieces) +
+                       " convex hulls: not supported");
+  for (const auto& a : pn)
+    for (const auto& b : pm) out.push_back({convex_hull(sums(a, b)).positions, {}});
+}
+
 // The parts as a solid: their hulls or surfaces, unioned on the octrees.
 Solid part_solid(const std::vector<Part>& parts) {
   Solid out;
@@ -433,7 +489,7 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o, bool e
         if (a.convex() && b.convex()) next.push_back({convex_hull(sums(a.points, b.points)).positions, {}});
         else if (a.convex()) add_sum(b.surface, a.points, next);
         else if (b.convex()) add_sum(a.surface, b.points, next);
-        else throw InvalidInput("the sum of two operands that are not unions of convex parts is not supported");
+        else add_sum(a.surface, b.surface, next);
         if (next.size() > kMaxPieces)
           throw InvalidInput("the sum has more than " + std::to_string(kMaxPieces) + " convex parts");
       }
