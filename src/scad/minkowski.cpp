@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <optional>
 #include <unordered_map>
 
+#include "mesh/clean.h"
 #include "pic/measure.h"
 #include "pic/volume.h"
 #include "scad/lower.h"
@@ -19,8 +19,8 @@
 namespace pic::detail::scad {
 namespace {
 
-// Edge-neighbouring triangles on one plane (within `tol`, world units, with parallel or opposite normals:
-// a sliver along a crease has its vertices on both faces' planes), in groups.
+// Edge-neighbouring triangles on one plane (within `tol`, world units, with parallel or
+// opposite normals: a sliver along a crease has its vertices on both faces' planes), in groups.
 std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol) {
   const size_t nt = m.triangles.size();
   std::vector<Vec3> normal(nt);  // unit, or zero for a degenerate triangle
@@ -119,6 +119,15 @@ std::vector<std::vector<Vec3>> planar_pieces(const TriMesh& m, double tol) {
   std::vector<std::vector<Vec3>> out;
   for (const auto& tris : coplanar_groups(m, tol)) group_pieces(m, tris, tol, out);
   return out;
+}
+
+/// planar_pieces of a surface, flat within 1e-6 of its extent: float contour vertices on a
+/// flat face sit within ~1e-7 of a cell of its plane. (Faces of a tessellated curve are not
+/// recovered at any useful tolerance: the contour's vertices between them are the sampler's,
+/// not the facets'.)
+std::vector<std::vector<Vec3>> surface_pieces(const TriMesh& m) {
+  const auto [lo, hi] = box_of(m.positions);
+  return planar_pieces(m, kFlatFaceTolerance * norm3(sub3(hi, lo)));
 }
 
 // One part of a minkowski operand: a convex point set (its hull), or a closed non-convex
@@ -356,34 +365,18 @@ void add_sum(const TriMesh& n, const std::vector<Vec3>& c, std::vector<Part>& ou
   Part moved{{}, n};
   for (Vec3& p : moved.surface.positions) p = add3(p, c0);
   out.push_back(std::move(moved));
-  const auto [lo, hi] = box_of(n.positions);
-  // Float contour vertices on a flat face sit within ~1e-7 of a cell of its plane: 1e-6 of the
-  // extent. (Faces of a tessellated curve are not recovered at any useful tolerance: the
-  // contour's vertices between them are the sampler's, not the facets'.)
-  const double tol = kFlatFaceTolerance * norm3(sub3(hi, lo));
-  const auto pieces = planar_pieces(n, tol);
+  const auto pieces = surface_pieces(n);
   if (pieces.size() > kMaxPieces)
     throw InvalidInput("a non-convex operand with " + std::to_string(pieces.size()) +
                        " planar pieces (curved faces) is not supported: at most " + std::to_string(kMaxPieces));
   for (const auto& piece : pieces) out.push_back({convex_hull(sums(piece, c)).positions, {}});
 }
 
-// A point on each connected piece of a closed surface (vertices welded by position: a soup's
-// triangles are one piece where they meet).
-std::vector<Vec3> point_per_shell(const TriMesh& m) {
-  std::unordered_map<uint64_t, uint32_t> first_at;  // welded position -> first vertex there
+// A point on each connected piece of a closed surface (a soup's triangles are one piece where
+// they share a position).
+std::vector<Vec3> point_per_shell(const TriMesh& surface) {
+  const TriMesh m = weld(surface);
   UnionFind shells(m.positions.size());
-  auto bits = [](double x) {
-    uint64_t u;
-    std::memcpy(&u, &x, sizeof u);
-    return u;
-  };
-  for (uint32_t v = 0; v < m.positions.size(); ++v) {
-    const Vec3& p = m.positions[v];
-    const uint64_t key = bits(p[0]) * 0x9e3779b97f4a7c15ull ^ bits(p[1]) * 0xc2b2ae3d27d4eb4full ^ bits(p[2]);
-    const auto [it, fresh] = first_at.emplace(key, v);
-    if (!fresh && m.positions[it->second] == p) shells.join(v, it->second);
-  }
   for (const auto& t : m.triangles) shells.join(t[0], t[1]), shells.join(t[1], t[2]);
   std::vector<Vec3> out;
   std::vector<char> seen(m.positions.size(), 0);
@@ -408,11 +401,7 @@ void add_sum(const TriMesh& n, const TriMesh& m, std::vector<Part>& out) {
       for (Vec3& p : moved.surface.positions) p = add3(p, c);
       out.push_back(std::move(moved));
     }
-  auto pieces_of = [](const TriMesh& s) {
-    const auto [lo, hi] = box_of(s.positions);
-    return planar_pieces(s, kFlatFaceTolerance * norm3(sub3(hi, lo)));
-  };
-  const auto pn = pieces_of(n), pm = pieces_of(m);
+  const auto pn = surface_pieces(n), pm = surface_pieces(m);
   if (pn.size() * pm.size() > kMaxPieces)
     throw InvalidInput("the sum of two non-convex operands with " + std::to_string(pn.size()) + " and " +
                        std::to_string(pm.size()) + " planar pieces needs more than " + std::to_string(kMaxPieces) +
