@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/parallel_for.h>
 
 #include "geometry/lattice.h"
 #include "geometry/mesh_distance.h"
@@ -86,6 +87,53 @@ double quality(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 
+/// A candidate for merging a vertex: the neighbour v, where both go, and the planes' error there.
+struct Candidate {
+  double error;
+  uint32_t v;
+  Vec3 x;
+};
+/// An original point handed to a triangle of the star a collapse leaves.
+struct MovedPoint {
+  uint32_t point, triangle;
+  double near;  // at most this far from it
+};
+/// What trying one collapse needs for itself; each worker has its own.
+struct Scratch {
+  std::vector<uint32_t> ring_u, ring_v;
+  std::vector<Candidate> candidates;
+  // The star a collapse under test leaves (triangle, corners, how far its moving corner goes,
+  // how far from the original it was found) and, per original point of the two stars, a
+  // triangle of that star within the tolerance of it.
+  std::vector<uint32_t> star;
+  std::vector<std::array<Vec3, 3>> star_corners;
+  std::vector<double> star_shift, new_off;
+  std::vector<MovedPoint> moved_points;
+  uint32_t hint = 0;  // where the last point near the raw contour found it
+};
+
+/// Blocks of a fixed grid over the mesh's box, each vertex in the one holding it: collapses whose
+/// two stars lie in one block touch nothing another block's collapses do.
+constexpr int kBlocksPerAxis = 4;
+std::vector<uint16_t> block_of_vertices(const std::vector<Vec3>& pos) {
+  Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
+  for (const Vec3& p : pos)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  std::vector<uint16_t> block(pos.size());
+  for (size_t i = 0; i < pos.size(); ++i) {
+    int b = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double t = hi[k] > lo[k] ? (pos[i][k] - lo[k]) / (hi[k] - lo[k]) : 0;
+      b = b * kBlocksPerAxis + std::clamp(int(t * kBlocksPerAxis), 0, kBlocksPerAxis - 1);
+    }
+    block[i] = uint16_t(b);
+  }
+  return block;
+}
+
 class Simplifier {
  public:
   /// `frozen`: per vertex of `mesh`, whether it must stay where it is (empty: none).
@@ -114,22 +162,25 @@ class Simplifier {
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
   }
 
-  /// Passes over the vertices, each moving onto the neighbour that keeps the planes closest,
-  /// until one collapses fewer than a thousandth of them; after the first, only vertices whose
-  /// star changed are tried again.
+  /// First each block of a fixed grid on its own, in parallel, collapsing only where both stars
+  /// lie in the block; then the whole mesh from the vertices next to another block's. The
+  /// blocks do not depend on the thread count, so neither does the result.
   void run() {
-    std::vector<uint8_t> dirty(pos_.size(), 1), next(pos_.size(), 0);
-    for (int pass = 0; pass < 32; ++pass) {
-      size_t done = 0;
-      for (uint32_t u = 0; u < pos_.size(); ++u)
-        if (dirty[u] && !faces_[u].empty() && collapse_cheapest(u)) {
-          for (uint32_t w : ring_u_) next[w] = 1;
-          ++done;
-        }
-      if (done * 1000 < pos_.size()) break;
-      dirty.swap(next);
-      std::fill(next.begin(), next.end(), 0);
-    }
+    block_ = block_of_vertices(pos_);
+    std::vector<std::vector<uint32_t>> members(size_t(kBlocksPerAxis) * kBlocksPerAxis * kBlocksPerAxis);
+    for (uint32_t u = 0; u < pos_.size(); ++u) members[block_[u]].push_back(u);
+    tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+      Scratch s;
+      passes(members[b], std::vector<uint8_t>(members[b].size(), 1), s, int(b));
+    });
+    std::vector<uint32_t> all(pos_.size());
+    std::iota(all.begin(), all.end(), 0u);
+    std::vector<uint8_t> dirty(pos_.size(), 0);
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      for (uint32_t f : faces_[u])
+        for (uint32_t w : tris_[f]) dirty[u] |= block_[w] != block_[u];
+    Scratch s;
+    passes(all, std::move(dirty), s, kAnyBlock);
   }
 
   /// The input vertex that u was merged into, at last (u itself when it was kept).
@@ -177,27 +228,40 @@ class Simplifier {
   std::vector<double> near_;  // per original point: at most this far from its triangle
   std::vector<uint8_t> alive_;
   std::vector<double> off_;              // per triangle: how far from the original it was found
-  std::vector<double> new_off_;          // per triangle of star_: the same for the collapse under test
-  uint32_t hint_ = 0;                    // where the last point near the raw contour found it
-  std::vector<uint32_t> ring_u_, ring_v_;  // scratch
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
-  struct Candidate {
-    double error;
-    uint32_t v;
-    Vec3 x;
-  };
-  std::vector<Candidate> candidates_;
-  // A collapse under test: the star it leaves (triangle, corners) and, per original point of
-  // the two stars, a triangle of that star within the tolerance of it.
-  std::vector<uint32_t> star_;
-  std::vector<std::array<Vec3, 3>> star_corners_;
-  std::vector<double> star_shift_;  // per triangle of star_: how far its moving corner goes
-  struct MovedPoint {
-    uint32_t point, triangle;
-    double near;  // at most this far from it
-  };
-  std::vector<MovedPoint> moved_points_;
+  std::vector<uint16_t> block_;  // per vertex: its block of the grid (see run())
+  static constexpr int kAnyBlock = -1;
+
+  /// Passes over `members` (ascending vertex numbers, `dirty` per member), each vertex moving
+  /// onto the neighbour that keeps the planes closest, until a pass collapses fewer than a
+  /// thousandth of them; after the first, only vertices whose star changed are tried again.
+  /// With a `block`, only collapses whose two stars lie in it.
+  void passes(const std::vector<uint32_t>& members, std::vector<uint8_t> dirty, Scratch& s, int block) {
+    std::vector<uint8_t> next(members.size(), 0);
+    const auto local = [&](uint32_t w) {
+      return block == kAnyBlock ? size_t(w) : size_t(std::lower_bound(members.begin(), members.end(), w) - members.begin());
+    };
+    for (int pass = 0; pass < 32; ++pass) {
+      size_t done = 0;
+      for (size_t i = 0; i < members.size(); ++i)
+        if (dirty[i] && !faces_[members[i]].empty() && collapse_cheapest(members[i], s, block)) {
+          for (uint32_t w : s.ring_u) next[local(w)] = 1;
+          ++done;
+        }
+      if (done * 1000 < members.size()) break;
+      dirty.swap(next);
+      std::fill(next.begin(), next.end(), 0);
+    }
+  }
+
+  /// Whether every vertex of `ring` lies in `block` (always, for kAnyBlock).
+  bool in_block(const std::vector<uint32_t>& ring, int block) const {
+    if (block == kAnyBlock) return true;
+    for (uint32_t w : ring)
+      if (block_[w] != block) return false;
+    return true;
+  }
 
   /// Triangle f answers for original point p from now on.
   void answer_for(uint32_t p, uint32_t f) {
@@ -230,26 +294,27 @@ class Simplifier {
 
   /// Merges u with the neighbour that keeps the planes closest, among those that may take it:
   /// both at the planes' point, or u onto the neighbour where it stands.
-  bool collapse_cheapest(uint32_t u) {
+  bool collapse_cheapest(uint32_t u, Scratch& s, int block) {
     if (frozen_[u]) return false;
-    ring(u, ring_u_);
-    candidates_.clear();
+    ring(u, s.ring_u);
+    if (!in_block(s.ring_u, block)) return false;
+    s.candidates.clear();
     double error = 0;
-    for (uint32_t v : ring_u_)
+    for (uint32_t v : s.ring_u)
       if (!frozen_[v]) {
         Quadric q = quadric_[u];
         q.add(quadric_[v]);
         const Vec3 x = merged_position(u, v, q, error);
-        candidates_.push_back({error, v, x});
+        s.candidates.push_back({error, v, x});
         // u onto v where it stands: on a flat region the planes leave the middle free, and
         // a fan from v may keep shapes that one from the middle does not.
-        if (x != pos_[v]) candidates_.push_back({std::sqrt(std::max(0.0, q.mean_at(pos_[v]))), v, pos_[v]});
+        if (x != pos_[v]) s.candidates.push_back({std::sqrt(std::max(0.0, q.mean_at(pos_[v]))), v, pos_[v]});
       }
-    std::sort(candidates_.begin(), candidates_.end(),
+    std::sort(s.candidates.begin(), s.candidates.end(),
               [](const Candidate& a, const Candidate& b) { return a.error < b.error || (a.error == b.error && a.v < b.v); });
-    for (const Candidate& c : candidates_)
-      if (can_collapse(u, c.v, c.x)) {
-        collapse(u, c.v, c.x);
+    for (const Candidate& c : s.candidates)
+      if (can_collapse(u, c.v, c.x, s, block)) {
+        collapse(u, c.v, c.x, s);
         return true;
       }
     return false;
@@ -258,7 +323,7 @@ class Simplifier {
   /// The link condition (the vertices next to both u and v are exactly the two across the
   /// edge uv), every triangle of u or v that survives keeps its orientation and its shape
   /// when both move to x, and the original points stay within the tolerance.
-  bool can_collapse(uint32_t u, uint32_t v, const Vec3& x) {
+  bool can_collapse(uint32_t u, uint32_t v, const Vec3& x, Scratch& s, int block) {
     int shared = 0;
     std::array<uint32_t, 2> across{};
     for (uint32_t f : faces_[u]) {
@@ -270,23 +335,28 @@ class Simplifier {
       ++shared;
     }
     if (shared != 2 || across[0] == across[1]) return false;
-    ring(v, ring_v_);
+    ring(v, s.ring_v);
+    if (!in_block(s.ring_v, block)) return false;
     size_t common = 0;
-    for (uint32_t w : ring_u_)
-      if (std::binary_search(ring_v_.begin(), ring_v_.end(), w)) ++common;
+    for (uint32_t w : s.ring_u)
+      if (std::binary_search(s.ring_v.begin(), s.ring_v.end(), w)) ++common;
     if (common != 2) return false;
     // A closed mesh of 4 vertices (a tetrahedron) would fold flat.
-    if (ring_u_.size() <= 3 && ring_v_.size() <= 3) return false;
-    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x) && near_original(u, v, x);
+    if (s.ring_u.size() <= 3 && s.ring_v.size() <= 3) return false;
+    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x, s) && near_original(u, v, x, s);
   }
 
   /// Whether every original point the stars of u and v answer for lies within the tolerance
-  /// of the star both leave at x; records a triangle there that answers for it (moved_points_).
-  bool keeps_points(uint32_t u, uint32_t v, const Vec3& x) {
-    star_.clear();
-    star_corners_.clear();
-    star_shift_.clear();
-    moved_points_.clear();
+  /// of the star both leave at x; records a triangle there that answers for it (moved).
+  bool keeps_points(uint32_t u, uint32_t v, const Vec3& x, Scratch& s) {
+    auto& star = s.star;
+    auto& corners = s.star_corners;
+    auto& shift = s.star_shift;
+    auto& moved = s.moved_points;
+    star.clear();
+    corners.clear();
+    shift.clear();
+    moved.clear();
     const double shift_u = std::sqrt(dist2(x, pos_[u])), shift_v = std::sqrt(dist2(x, pos_[v]));
     for (uint32_t w : {u, v})
       for (uint32_t f : faces_[w]) {
@@ -295,13 +365,13 @@ class Simplifier {
         if (gone || (w == v && (t[0] == u || t[1] == u || t[2] == u))) continue;
         std::array<Vec3, 3> c;
         for (int k = 0; k < 3; ++k) c[k] = t[k] == u || t[k] == v ? x : pos_[t[k]];
-        star_.push_back(f);
-        star_corners_.push_back(c);
-        star_shift_.push_back(w == u ? shift_u : shift_v);
+        star.push_back(f);
+        corners.push_back(c);
+        shift.push_back(w == u ? shift_u : shift_v);
       }
     const double tol2 = tol_ * tol_;
     auto distance2 = [&](uint32_t p, size_t k) {
-      const auto& c = star_corners_[k];
+      const auto& c = corners[k];
       return detail::point_triangle_distance2(original_[p], c[0], c[1], c[2]);
     };
     // Any triangle of the new star within the tolerance answers for a point: its own first
@@ -309,19 +379,19 @@ class Simplifier {
     // point of it farther than s: a point that was near enough before and still is by that
     // bound (`near_`) needs no new distance.
     auto check = [&](uint32_t f) {
-      const size_t own = size_t(std::find(star_.begin(), star_.end(), f) - star_.begin());
+      const size_t own = size_t(std::find(star.begin(), star.end(), f) - star.begin());
       for (uint32_t p = first_point_[f]; p != kNoPoint; p = next_point_[p]) {
-        if (own < star_.size() && near_[p] + star_shift_[own] <= tol_) {
-          moved_points_.push_back({p, f, near_[p] + star_shift_[own]});
+        if (own < star.size() && near_[p] + shift[own] <= tol_) {
+          moved.push_back({p, f, near_[p] + shift[own]});
           continue;
         }
-        size_t at = star_.size();
+        size_t at = star.size();
         double d2 = 0;
-        if (own < star_.size() && (d2 = distance2(p, own)) <= tol2) at = own;
-        for (size_t k = 0; k < star_.size() && at == star_.size(); ++k)
+        if (own < star.size() && (d2 = distance2(p, own)) <= tol2) at = own;
+        for (size_t k = 0; k < star.size() && at == star.size(); ++k)
           if (k != own && (d2 = distance2(p, k)) <= tol2) at = k;
-        if (at == star_.size()) return false;
-        moved_points_.push_back({p, star_[at], std::sqrt(d2)});
+        if (at == star.size()) return false;
+        moved.push_back({p, star[at], std::sqrt(d2)});
       }
       return true;
     };
@@ -338,8 +408,12 @@ class Simplifier {
   /// round): its vertex, and each triangle's centroid (a long triangle across a fold). A point
   /// near a triangle of the stars as they are now is as near the original as that triangle
   /// (`off_`: how far each triangle was found from it, 0 for one no collapse has changed);
-  /// else the original surface is searched. The bounds found go to the new star (new_off_).
-  bool near_original(uint32_t u, uint32_t v, const Vec3& x) {
+  /// else the original surface is searched. The bounds found go to the new star (new_off).
+  bool near_original(uint32_t u, uint32_t v, const Vec3& x, Scratch& s) {
+    const auto& star = s.star;
+    const auto& corners = s.star_corners;
+    auto& new_off = s.new_off;
+    uint32_t& hint = s.hint;
     auto bound_by = [&](const Vec3& m, uint32_t f) {
       const auto& t = tris_[f];
       return off_[f] + std::sqrt(detail::point_triangle_distance2(m, pos_[t[0]], pos_[t[1]], pos_[t[2]]));
@@ -357,26 +431,26 @@ class Simplifier {
           if (best <= tol_ / 2) return best;
         }
       if (best <= tol_) return best;
-      return original_surface_.within(m, tol_, &hint_) ? tol_ : detail::kHuge;
+      return original_surface_.within(m, tol_, &hint) ? tol_ : detail::kHuge;
     };
     // The vertex itself is asked of the original surface: the bounds above are as good as
     // the points they were found at.
-    if (!original_surface_.within(x, tol_, &hint_)) return false;
+    if (!original_surface_.within(x, tol_, &hint)) return false;
     const double at_x = bound(x, kNoTriangle);
-    new_off_.clear();
-    for (size_t i = 0; i < star_.size(); ++i) {
-      const auto& c = star_corners_[i];
+    new_off.clear();
+    for (size_t i = 0; i < star.size(); ++i) {
+      const auto& c = corners[i];
       const Vec3 m{(c[0][0] + c[1][0] + c[2][0]) / 3, (c[0][1] + c[1][1] + c[2][1]) / 3, (c[0][2] + c[1][2] + c[2][2]) / 3};
       // And the middle of the side that leaves x towards the next corner (each such side of
       // the star once): a side across a valley of the original stays in reach of it.
       const int k = c[0] == x ? 0 : c[1] == x ? 1 : 2;
       const Vec3& y = c[(k + 1) % 3];
       const Vec3 e{(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2};
-      const double at_m = bound(m, star_[i]);
+      const double at_m = bound(m, star[i]);
       if (at_m > tol_) return false;
-      const double at_e = bound(e, star_[i]);
+      const double at_e = bound(e, star[i]);
       if (at_e > tol_) return false;
-      new_off_.push_back(std::max({at_x, at_m, at_e}));
+      new_off.push_back(std::max({at_x, at_m, at_e}));
     }
     return true;
   }
@@ -405,14 +479,14 @@ class Simplifier {
   }
 
   /// Carries out the collapse keeps_points() last accepted (of u into v at x).
-  void collapse(uint32_t u, uint32_t v, const Vec3& x) {
+  void collapse(uint32_t u, uint32_t v, const Vec3& x, const Scratch& s) {
     for (uint32_t w : {u, v})
       for (uint32_t f : faces_[w]) first_point_[f] = kNoPoint;
-    for (const MovedPoint& m : moved_points_) {
+    for (const MovedPoint& m : s.moved_points) {
       answer_for(m.point, m.triangle);
       near_[m.point] = m.near;
     }
-    for (size_t k = 0; k < star_.size(); ++k) off_[star_[k]] = new_off_[k];
+    for (size_t k = 0; k < s.star.size(); ++k) off_[s.star[k]] = s.new_off[k];
     pos_[v] = x;
     merged_into_[u] = v;
     for (uint32_t f : faces_[u]) {

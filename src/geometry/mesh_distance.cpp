@@ -7,6 +7,9 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include "geometry/lattice.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
@@ -69,30 +72,41 @@ Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   return n;
 }
 
+namespace {
+
+/// Nodes of the hierarchy over n triangles: leaves hold up to 4, inner nodes split the range in
+/// halves. Known ahead, so the two halves of a node can be built at once into their own ids.
+uint32_t node_count(uint32_t n) { return n <= 4 ? 1 : 1 + node_count(n / 2) + node_count(n - n / 2); }
+
+/// Ranges of more triangles than this build their halves as parallel tasks.
+constexpr uint32_t kParallelBuild = 1 << 15;
+
+}  // namespace
+
 MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size()) {
   const size_t n = mesh.triangles.size();
   std::vector<uint32_t> order(n);
   std::iota(order.begin(), order.end(), uint32_t{0});
   std::vector<Vec3> lo(n), hi(n), centre(n);
-  for (size_t i = 0; i < n; ++i) {
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const auto& t = mesh.triangles[i];
     for (int k = 0; k < 3; ++k) {
       lo[i][k] = std::min({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
       hi[i][k] = std::max({mesh.positions[t[0]][k], mesh.positions[t[1]][k], mesh.positions[t[2]][k]});
       centre[i][k] = (lo[i][k] + hi[i][k]) / 2;
     }
-  }
+  });
   if (n == 0) return;
-  nodes_.emplace_back();
-  build(0, 0, static_cast<uint32_t>(n), order, lo, hi, centre);
+  nodes_.resize(node_count(static_cast<uint32_t>(n)));
+  build(0, 1, 0, static_cast<uint32_t>(n), order, lo, hi, centre);
   tris_.resize(n);
-  for (size_t i = 0; i < n; ++i) {
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const auto& t = mesh.triangles[order[i]];
     LeafTriangle& l = tris_[i];
     l.a = mesh.positions[t[0]], l.b = mesh.positions[t[1]], l.c = mesh.positions[t[2]];
     for (int k = 0; k < 3; ++k) l.lo[k] = round_down(lo[order[i]][k]), l.hi[k] = round_up(hi[order[i]][k]);
     l.id = order[i];
-  }
+  });
 }
 
 template <class Box>
@@ -281,7 +295,7 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   return best;
 }
 
-void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
+void MeshDistance::build(uint32_t id, uint32_t next, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
                          const std::vector<Vec3>& lo, const std::vector<Vec3>& hi, const std::vector<Vec3>& centre) {
   Vec3 blo{kHuge, kHuge, kHuge}, bhi{-kHuge, -kHuge, -kHuge};
   for (uint32_t i = first; i < last; ++i)
@@ -303,12 +317,14 @@ void MeshDistance::build(uint32_t id, uint32_t first, uint32_t last, std::vector
   const uint32_t mid = first + (last - first) / 2;
   std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + last,
                    [&](uint32_t a, uint32_t b) { return centre[a][axis] < centre[b][axis]; });
-  nd.first = static_cast<uint32_t>(nodes_.size());
-  nodes_.emplace_back();
-  nodes_.emplace_back();
+  // The children take ids next and next + 1; the left one's descendants follow, then the right's.
+  nd.first = next;
   nodes_[id] = nd;
-  build(nd.first, first, mid, order, lo, hi, centre);
-  build(nd.first + 1, mid, last, order, lo, hi, centre);
+  const uint32_t right_next = next + 2 + node_count(mid - first) - 1;
+  const auto left = [&] { build(next, next + 2, first, mid, order, lo, hi, centre); };
+  const auto right = [&] { build(next + 1, right_next, mid, last, order, lo, hi, centre); };
+  if (last - first > kParallelBuild) tbb::parallel_invoke(left, right);
+  else left(), right();
 }
 
 namespace {

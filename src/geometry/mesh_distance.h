@@ -57,8 +57,9 @@ class MeshDistance {
   };
   template <class Box>
   static double box_distance2(const Box& box, const Vec3& p);
-  void build(uint32_t id, uint32_t first, uint32_t last, std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
-             const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
+  /// Node `id` over order[first, last); its descendants take the ids from `next` on.
+  void build(uint32_t id, uint32_t next, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
+             const std::vector<Vec3>& lo, const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
 
