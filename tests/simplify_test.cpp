@@ -1,6 +1,7 @@
 // Simplified contours: fewer triangles where the surface is flat or runs straight along a
 // crease, the same solid within the tolerance, still closed, 2-manifold and crossing-free.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "pic/contour.h"
 #include "pic/csg.h"
@@ -75,6 +76,22 @@ TEST(Simplify, CreasesOffTheLatticeAxesCollapseToo) {
   EXPECT_LT(simple.triangles.size() * 10, raw.triangles.size());
   std::printf("  [measure] box - faceted ball at depth 8: %zu -> %zu triangles\n", raw.triangles.size(),
               simple.triangles.size());
+}
+
+// The blocks of the grid collapse in parallel: the mesh is the same with one thread.
+TEST(Simplify, TheSameMeshWhateverTheThreadCount) {
+  const Octree t = box_minus_ball(8);
+  ContourOptions o;
+  o.simplify = 0.25;
+  const TriMesh all = contour(t, o);
+  TriMesh one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = contour(t, o);
+  }
+  ASSERT_LT(all.triangles.size() * 4, contour(t).triangles.size());
+  EXPECT_TRUE(one.positions == all.positions);
+  EXPECT_TRUE(one.triangles == all.triangles);
 }
 
 TEST(Simplify, ZeroToleranceLeavesTheMeshAlone) {
