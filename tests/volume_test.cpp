@@ -6,6 +6,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <tuple>
 
 #include <random>
 
@@ -267,11 +268,14 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
   const OffsetDistance plain = offset_distance(contour(t), spot, d, 0);
   EXPECT_LE(exact.worst_vertex, 0.5 * cell);
   EXPECT_LE(exact.worst, cell);
-  EXPECT_GE(plain.worst_vertex, 1.5 * exact.worst_vertex);
+  // Leaves whose polygons would leave the curved offset split (NoCoarseLeafHidesOrInventsSurface),
+  // so few such seams remain: the function's points are as good at worst, better on the whole.
+  EXPECT_LE(exact.worst_vertex, plain.worst_vertex);
+  EXPECT_LT(offset_distance(vm.mesh, spot, d, 0).mean, plain.mean);
   // The measure tells a wrong offset apart.
   EXPECT_GE(offset_distance(vm.mesh, spot, d + cell, 0).worst_vertex, 0.5 * cell);
-  std::printf("worst vertex: %.3f cells with the function, %.3f without\n", exact.worst_vertex / cell,
-              plain.worst_vertex / cell);
+  std::printf("worst vertex: %.3f cells with the function, %.3f without; mean %.4f / %.4f\n", exact.worst_vertex / cell,
+              plain.worst_vertex / cell, offset_distance(vm.mesh, spot, d, 0).mean / cell, plain.mean / cell);
 }
 
 TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
@@ -289,6 +293,90 @@ TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
   const OffsetDistance exact = offset_distance(vm.mesh, spot, d, 0);
   std::printf("worst vertex: %.3f cells off the exact offset\n", exact.worst_vertex / cell);
   EXPECT_LE(exact.worst_vertex, 0.25 * cell);
+}
+
+TEST(OffsetSurfacePoints, LieOnTheExactOffsetOfABoxInTheirShare) {
+  // The unit cube grown by 0.1: six flat faces (area 6), twelve quarter cylinders (12 x 0.05 pi)
+  // and eight eighth spheres (0.04 pi). Every point is at distance 0.1 from the box, and the
+  // flat faces get their share of the points.
+  const TriMesh cube = make_box({0, 0, 0}, {1, 1, 1});
+  const std::vector<Vec3> grown = offset_surface_points(cube, 0.1, 20000);
+  ASSERT_GE(grown.size(), 19000u);  // a convex solid: nearly every point is kept
+  size_t flat = 0;
+  for (const Vec3& p : grown) {
+    EXPECT_NEAR(box_distance(p, {0, 0, 0}, {1, 1, 1}), 0.1, 1e-9);
+    int outside = 0;
+    for (int k = 0; k < 3; ++k) outside += p[k] < 0 || p[k] > 1;
+    flat += outside == 1;
+  }
+  const double faces = 6, total = faces + 12 * 0.05 * pi + 0.04 * pi;
+  EXPECT_NEAR(double(flat) / double(grown.size()), faces / total, 0.01);
+  // Shrunk by 0.1: the cube of side 0.8, its faces all reached.
+  const std::vector<Vec3> shrunk = offset_surface_points(cube, -0.1, 20000);
+  ASSERT_GE(shrunk.size(), 5000u);
+  Vec3 lo{1, 1, 1}, hi{0, 0, 0};
+  for (const Vec3& p : shrunk) {
+    EXPECT_NEAR(box_distance(p, {0.1, 0.1, 0.1}, {0.9, 0.9, 0.9}), 0, 1e-9);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(lo[k], 0.1, 1e-9);
+    EXPECT_NEAR(hi[k], 0.9, 1e-9);
+  }
+}
+
+TEST(Offset, TheOffsetDistanceSeesAMissingPart) {
+  // Two unit cubes apart, and the offset of only one of them: every point of that offset lies
+  // on the pair's exact offset (one way, nothing is wrong), but the other cube's offset surface
+  // is far from it (the way back sees the missing part).
+  const TriMesh a = make_box({0, 0, 0}, {1, 1, 1});
+  TriMesh pair = a;
+  const TriMesh b = make_box({3, 0, 0}, {4, 1, 1});
+  for (const auto& t : b.triangles)
+    pair.triangles.push_back({t[0] + uint32_t(a.positions.size()), t[1] + uint32_t(a.positions.size()),
+                              t[2] + uint32_t(a.positions.size())});
+  pair.positions.insert(pair.positions.end(), b.positions.begin(), b.positions.end());
+  SampleOptions o = at_depth(7);
+  o.cube = Cube{{-0.5, -0.5, -0.5}, 5};
+  const Octree t = offset(a, 0.1, o);
+  const double cell = finest_cell(t);
+  const TriMesh grown = contour(t);
+  const OffsetDistance own = offset_distance(grown, a, 0.1, 20000);
+  EXPECT_LE(own.hausdorff(), cell);
+  const OffsetDistance of_pair = offset_distance(grown, pair, 0.1, 20000);
+  EXPECT_LE(of_pair.worst, cell);
+  EXPECT_GE(of_pair.back_worst, 1.5);
+  std::printf("  [measure] cube grown by 0.1 at depth 7: %.3f / %.3f cells both ways\n", own.worst / cell,
+              own.back_worst / cell);
+}
+
+// A leaf may stand only for the surface its corners, crossings and polygons account for:
+// each case below came out a valid solid but a wrong one, the wrong part decided in one coarse
+// cell, whatever the depth.
+TEST(Offset, NoCoarseLeafHidesOrInventsSurface) {
+  const std::string dir = std::string(PIC_DATA_DIR);
+  // fandisk grown by a hair: its flange passes through cells between their corners and edges
+  // (a grown solid with 2 units^3 less volume than the input, the flange gone).
+  const TriMesh fandisk = read_mesh(dir + "/fandisk.obj");
+  const Octree grown = offset(fandisk, 0.001, at_depth(8));
+  EXPECT_GT(volume(contour(grown)), volume(fandisk));
+  // cad_part (a 0.05 wall between a hole and a face) at depth 9 in a cube of 0.66: shrunk by
+  // 20 cells the wall goes, leaving a slot, and a level-2 cell took the hole's curved offset
+  // and the face's plane for a crease (a diamond 0.13 wide cut through the face); grown by 20
+  // cells, a level-3 cell's polygons cut across the rounded rim of the hole.
+  const TriMesh part = read_mesh(dir + "/cad_part.obj");
+  for (const auto& [cells, origin, size] :
+       {std::tuple{-20.0, Vec3{-0.33, -0.33, -0.23}, 0.66}, std::tuple{20.0, Vec3{-0.361, -0.361, -0.261}, 0.722}}) {
+    SampleOptions o = at_depth(9);
+    o.cube = Cube{origin, size};
+    const double cell = size / 512, d = cells * cell;
+    const TriMesh m = contour(offset(part, d, o));
+    const OffsetDistance e = offset_distance(m, part, d, 50000);
+    EXPECT_LE(e.worst, cell) << cells << " cells";
+    if (cells > 0) EXPECT_LE(e.back_worst, cell) << cells << " cells";
+    std::printf("  [measure] cad_part offset by %g cells: %.3f / %.3f cells both ways\n", cells, e.worst / cell,
+                e.back_worst / cell);
+  }
 }
 
 TEST(MeshDistance, FartherThanNeverMissesATriangle) {

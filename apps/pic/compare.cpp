@@ -18,7 +18,7 @@ struct CompareArgs {
   bool json = false;
 };
 
-/// --offset D: how far A lies from B's surface offset by D (one-sided).
+/// --offset D: how far A lies from B's surface offset by D, and the offset surface from A.
 void run_offset(const TriMesh& a, const TriMesh& b, double offset, double unit, const CompareArgs& args) {
   const OffsetDistance d = offset_distance(a, b, offset, args.samples);
   Json j;
@@ -27,11 +27,18 @@ void run_offset(const TriMesh& a, const TriMesh& b, double offset, double unit, 
       .add("offset_worst_vertex", d.worst_vertex / unit)
       .add("offset_mean", d.mean / unit)
       .raw("offset_where", vec_json(d.where))
+      .add("offset_back_worst", d.back_worst / unit)
+      .add("offset_back_mean", d.back_mean / unit)
+      .raw("offset_back_where", vec_json(d.back_where))
+      .add("offset_back_points", d.back_points)
+      .add("offset_hausdorff", d.hausdorff() / unit)
       .add("unit", unit);
   if (args.json) std::cout << j.str() << "\n";
   else
-    std::printf("from B's offset by %g: worst %.3g (vertices %.3g), mean %.3g in units of %g\n", offset,
-                d.worst / unit, d.worst_vertex / unit, d.mean / unit, unit);
+    std::printf("from B's offset by %g: worst %.3g (vertices %.3g), mean %.3g; back from the offset: worst %.3g, "
+                "mean %.3g; in units of %g\n",
+                offset, d.worst / unit, d.worst_vertex / unit, d.mean / unit, d.back_worst / unit, d.back_mean / unit,
+                unit);
 }
 
 void run(const CompareArgs& args) {
@@ -78,7 +85,7 @@ void add_compare(CLI::App& app) {
   c->add_option("--unit", a->unit, "Divide distances by this length (default: the root cube of the first .pic, else 1)");
   c->add_option("--samples", a->samples, "Area-weighted samples per side, besides all vertices")->capture_default_str();
   c->add_option("--offset", a->offset,
-                 "Instead: how far A lies from B's surface offset by this distance (B closed; one-sided)");
+                 "Instead: how far A lies from B's surface offset by this distance, and back (B closed)");
   c->add_flag("--json", a->json, "Print one JSON object on stdout");
   c->callback([a] { run(*a); });
 }

@@ -1,6 +1,7 @@
 // PIC — what a mesh is: topology, validity as a solid, volume, distances between surfaces.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -84,13 +85,24 @@ struct OffsetDistance {
   double worst = 0, mean = 0;  ///< over every vertex and sample
   double worst_vertex = 0;     ///< over the vertices alone
   Vec3 where{};                ///< the worst point
+  /// The other way: from points of the exact offset surface to `surface`.
+  double back_worst = 0, back_mean = 0;
+  Vec3 back_where{};
+  size_t back_points = 0;  ///< points of the exact offset surface measured
+  double hausdorff() const { return std::max(worst, back_worst); }
 };
-/// How far `surface` lies from `reference`'s surface offset by `offset` (> 0 outward):
-/// |signed distance to reference - offset| at every vertex plus `samples` area-weighted points.
-/// One-sided: the exact offset surface is no mesh. \throws InvalidInput when `reference` is not
-/// closed, 2-manifold and consistently oriented (its sign comes from pseudonormals).
+/// How far `surface` lies from `reference`'s surface offset by `offset` (> 0 outward), both
+/// ways: |signed distance to reference - offset| at every vertex plus `samples` area-weighted
+/// points; and the distance to `surface` from about `samples` points of the exact offset surface
+/// (offset_surface_points). \throws InvalidInput when `reference` is not closed, 2-manifold and
+/// consistently oriented (its sign comes from pseudonormals).
 OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference, double offset,
                                size_t samples = 100000);
+/// Points of the exact offset surface of a closed, outward-oriented mesh: each is a point q of
+/// the mesh moved by |offset| along a direction of q's normal cone (a face's normal, an arc
+/// between an edge's two face normals, a blend of a vertex's face normals), drawn in proportion
+/// to the area each sweeps, and kept only where no other part of the mesh lies nearer.
+std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset, size_t samples, uint64_t seed = 777);
 ///@}
 
 }  // namespace pic

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 
 #include "geometry/lattice.h"
@@ -107,6 +108,119 @@ SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samp
   return r;
 }
 
+namespace {
+
+/// Where offset_surface_points draws from: a face, an edge's arc or a vertex's cap, with the
+/// area its sweep covers.
+struct Sweep {
+  enum Kind : uint8_t { Face, Edge, Vertex } kind;
+  uint32_t index;     // triangle, or vertex
+  uint32_t other;     // an edge's second triangle
+  int corner;         // an edge: corner k of `index` to k + 1
+  double area;
+};
+
+Vec3 unit_normal(const TriMesh& m, uint32_t f) {
+  const auto& t = m.triangles[f];
+  const Vec3 n = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+  const double l = norm3(n);
+  return l > 0 ? scale3(n, 1 / l) : Vec3{0, 0, 0};
+}
+
+/// Spherical interpolation between unit vectors a and b at fraction w of the angle between them.
+Vec3 slerp(const Vec3& a, const Vec3& b, double angle, double w) {
+  if (angle < 1e-12) return a;
+  const double s = std::sin(angle);
+  return add3(scale3(a, std::sin((1 - w) * angle) / s), scale3(b, std::sin(w * angle) / s));
+}
+
+/// Every sweep of the offset surface by `r` (faces, edges' arcs, vertices' caps by their
+/// angle defect, which is the area of the unit normal cone at a convex or concave corner).
+std::vector<Sweep> offset_sweeps(const TriMesh& m, double r) {
+  std::vector<Sweep> sweeps;
+  std::vector<double> angle_sum(m.positions.size(), 0.0);
+  std::vector<std::pair<uint64_t, std::pair<uint32_t, int>>> edges;
+  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    const Vec3 e1 = sub3(m.positions[t[1]], m.positions[t[0]]), e2 = sub3(m.positions[t[2]], m.positions[t[0]]);
+    sweeps.push_back({Sweep::Face, f, 0, 0, norm3(cross3(e1, e2)) / 2});
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 a = sub3(m.positions[t[(k + 1) % 3]], m.positions[t[k]]);
+      const Vec3 b = sub3(m.positions[t[(k + 2) % 3]], m.positions[t[k]]);
+      angle_sum[t[k]] += std::atan2(norm3(cross3(a, b)), dot3(a, b));
+      const uint32_t lo = std::min(t[k], t[(k + 1) % 3]), hi = std::max(t[k], t[(k + 1) % 3]);
+      edges.push_back({uint64_t(lo) << 32 | hi, {f, k}});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 0; i + 1 < edges.size(); ++i) {
+    if (edges[i].first != edges[i + 1].first) continue;
+    const auto [f, k] = edges[i].second;
+    const uint32_t g = edges[i + 1].second.first;
+    const auto& t = m.triangles[f];
+    const double len = norm3(sub3(m.positions[t[(k + 1) % 3]], m.positions[t[k]]));
+    const double angle = std::acos(std::clamp(dot3(unit_normal(m, f), unit_normal(m, g)), -1.0, 1.0));
+    sweeps.push_back({Sweep::Edge, f, g, k, len * r * angle});
+    ++i;
+  }
+  for (uint32_t v = 0; v < m.positions.size(); ++v)
+    if (angle_sum[v] > 0)
+      sweeps.push_back({Sweep::Vertex, v, 0, 0, r * r * std::abs(2 * std::numbers::pi - angle_sum[v])});
+  return sweeps;
+}
+
+}  // namespace
+
+std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset, size_t samples, uint64_t seed) {
+  const double r = std::abs(offset), side = offset < 0 ? -1 : 1;
+  const std::vector<Sweep> sweeps = offset_sweeps(reference, r);
+  std::vector<double> cum(sweeps.size());
+  double total = 0;
+  for (size_t i = 0; i < sweeps.size(); ++i) cum[i] = total += sweeps[i].area;
+  if (!(total > 0) || !(r > 0)) return {};
+  // A vertex's faces, for its caps.
+  std::vector<std::vector<uint32_t>> faces(reference.positions.size());
+  for (uint32_t f = 0; f < reference.triangles.size(); ++f)
+    for (uint32_t v : reference.triangles[f]) faces[v].push_back(f);
+  Rng rng(seed);
+  std::vector<Vec3> candidates;
+  candidates.reserve(samples);
+  for (size_t n = 0; n < samples; ++n) {
+    const Sweep& w = sweeps[size_t(std::upper_bound(cum.begin(), cum.end(), rng.uniform() * total) - cum.begin()) %
+                            sweeps.size()];
+    Vec3 q, u;
+    if (w.kind == Sweep::Face) {
+      const auto& t = reference.triangles[w.index];
+      double a = rng.uniform(), b = rng.uniform();
+      if (a + b > 1) a = 1 - a, b = 1 - b;
+      const Vec3& p0 = reference.positions[t[0]];
+      q = add3(p0, add3(scale3(sub3(reference.positions[t[1]], p0), a), scale3(sub3(reference.positions[t[2]], p0), b)));
+      u = unit_normal(reference, w.index);
+    } else if (w.kind == Sweep::Edge) {
+      const auto& t = reference.triangles[w.index];
+      const Vec3 &a = reference.positions[t[w.corner]], &b = reference.positions[t[(w.corner + 1) % 3]];
+      q = add3(a, scale3(sub3(b, a), rng.uniform()));
+      const Vec3 n1 = unit_normal(reference, w.index), n2 = unit_normal(reference, w.other);
+      u = slerp(n1, n2, std::acos(std::clamp(dot3(n1, n2), -1.0, 1.0)), rng.uniform());
+    } else {
+      q = reference.positions[w.index];
+      Vec3 sum{0, 0, 0};
+      for (uint32_t f : faces[w.index]) sum = add3(sum, scale3(unit_normal(reference, f), -std::log(1 - rng.uniform())));
+      const double l = norm3(sum);
+      if (!(l > 0)) continue;
+      u = scale3(sum, 1 / l);
+    }
+    candidates.push_back(add3(q, scale3(u, side * r)));
+  }
+  // Kept where the mesh is nowhere nearer than r (else the point lies inside the offset's
+  // other parts, or on the wrong side of a concave crease or corner).
+  const std::vector<double> d = distance_to_mesh(reference, candidates);
+  std::vector<Vec3> kept;
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (d[i] >= r * (1 - 1e-9)) kept.push_back(candidates[i]);
+  return kept;
+}
+
 OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference, double offset, size_t samples) {
   const MeshTopology t = analyze_topology(reference);
   if (!t.closed() || !t.manifold() || t.inconsistent_edges != 0)
@@ -125,6 +239,14 @@ OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference,
     r.mean += d[i];
   }
   if (!d.empty()) r.mean /= double(d.size());
+  const std::vector<Vec3> back = offset_surface_points(reference, offset, std::max<size_t>(samples, 1000));
+  const std::vector<double> db = distance_to_mesh(surface, back);
+  r.back_points = back.size();
+  for (size_t i = 0; i < db.size(); ++i) {
+    if (db[i] > r.back_worst) r.back_worst = db[i], r.back_where = back[i];
+    r.back_mean += db[i];
+  }
+  if (!db.empty()) r.back_mean /= double(db.size());
   return r;
 }
 

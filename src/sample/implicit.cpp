@@ -378,6 +378,7 @@ class LevelSampler {
       const double off = std::abs(fv[i]) / (f_.lipschitz * cube_.size);
       fits[fitting[i]] = off * off < error_;
     }
+    keep_only_whole_surfaces(jobs, cand, cell_edges, edges, sol, fits);
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
       const uint8_t signs = signs_of(j.v);
@@ -387,6 +388,69 @@ class LevelSampler {
         out.set_gray(j.slot, j.cell, signs, sol[k].position, ok ? 0 : kFlagCapped);
       } else {
         split.push_back(j);
+      }
+    }
+  }
+
+  /// A leaf above the cap may stand only for surface its planes (the crossings of its edges)
+  /// account for. Its corners and edges can miss a part of the solid passing between them (a
+  /// fandisk flange grown by a hair, inside a cell 30 finest cells wide), and two or three
+  /// crossings always fit a line or a point, so a curved sheet can pass for a crease (a hole's
+  /// offset cylinder meeting a face's offset plane in a cell 64 finest cells wide, its vertex
+  /// on their crease and every test passed). Each octant of such a cell is asked at its centre
+  /// c: c must lie on the side of the nearest plane that f says, unless near both; and |f(c)|,
+  /// which bounds the distance from c to the surface from below, must not say the surface is
+  /// nearer than every plane. Every point of the cell lies within an octant's half-diagonal of
+  /// its centre, so a sheet anywhere in the cell shows in some octant's bound; a sheet the
+  /// bound cannot tell from a plane lies about as near c as the plane does.
+  void keep_only_whole_surfaces(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
+                                const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
+                                const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
+    std::vector<size_t> asked, chord_start;
+    std::vector<Vec3> centres, middles;
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const Cell& cell = jobs[cand[k]].cell;
+      if (!fits[k] || cell.level >= max_depth_) continue;
+      asked.push_back(k);
+      const Vec3 m = cell.min_unit();
+      const double q = cell.size() / 4;
+      for (int o = 0; o < 8; ++o)
+        centres.push_back({m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q});
+      chord_start.push_back(middles.size());
+      for (uint32_t id : cell_edges[k])
+        if (id != kNone) middles.push_back(scale3(add3(sol[k].position, edges[id].x), 0.5));
+    }
+    chord_start.push_back(middles.size());
+    const std::vector<double> fc = values(centres), fm = values(middles);
+    const double to_unit = 1 / (f_.lipschitz * cube_.size);
+    for (size_t i = 0; i < asked.size(); ++i) {
+      const size_t k = asked[i];
+      const Cell& cell = jobs[cand[k]].cell;
+      const double half_diagonal = cell.size() * std::sqrt(3.0) / 4;
+      // The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
+      const double tolerance = 2 * std::sqrt(error_);
+      // The leaf's polygons run from its vertex to its edges' crossings: on a sheet that
+      // curves away from them between (a hole's rounded rim taken for the corner of its
+      // tangent planes, its vertex on the flat part) their middles leave the surface.
+      for (size_t c = chord_start[i]; c < chord_start[i + 1]; ++c)
+        if (std::abs(fm[c]) * to_unit > tolerance) fits[k] = 0;
+      for (int o = 0; o < 8 && fits[k]; ++o) {
+        const Vec3& c = centres[8 * i + size_t(o)];
+        const double value = fc[8 * i + size_t(o)], reach = std::abs(value) * to_unit;
+        // The plane nearest c, and c's side of it.
+        double nearest = detail::kHuge, side = 0;
+        for (uint32_t id : cell_edges[k]) {
+          if (id == kNone) continue;
+          const double len = norm3(edges[id].g);
+          if (!(len > 0)) continue;
+          const double s = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
+          if (std::abs(s) < nearest) nearest = std::abs(s), side = s;
+        }
+        // On the side the planes say, unless near them or near the surface.
+        if (reach > tolerance && nearest > tolerance && (value < 0) != (side < 0)) fits[k] = 0;
+        // Surface within reach of c, the planes as near.
+        if (reach < half_diagonal && nearest > reach + tolerance) fits[k] = 0;
+
       }
     }
   }
