@@ -427,6 +427,7 @@ ImplicitSolid plain_distance(const detail::SignedDistance& sd, std::function<std
     for (double& x : grad) x *= slope;
     return v;
   };
+  f.distance = true;  // the same distance, only without the proof that cells are clear
   return f;
 }
 

@@ -127,6 +127,7 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     return v;
   };
   solid.clear = [&](const Vec3& lo, const Vec3& hi) { return clear_of_bands(sd, levels, lo, hi, &hints.local()); };
+  solid.distance = true;
   SampleOptions o = options;
   o.cube = cube;
   return sample_with_mesh(solid, o, stats, mesh);
