@@ -317,6 +317,7 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
     const detail::Nearest n = distance.nearest(centre, &hints.local());
     return clear_of_bands(distance, {{half, half}}, lo, hi, n.distance, n.point);
   };
+  solid.distance = true;
   SampleOptions o = options;
   o.cube = cube_around(surface, half, options);
   return sample_with_mesh(solid, o, stats, mesh);
