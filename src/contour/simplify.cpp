@@ -160,19 +160,54 @@ class Simplifier {
     // triangle's corner: at distance 0).
     for (uint32_t v = 0; v < pos_.size(); ++v)
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
+    block_ = block_of_vertices(pos_);
+    members_.resize(size_t(kBlocksPerAxis) * kBlocksPerAxis * kBlocksPerAxis);
+    for (uint32_t u = 0; u < pos_.size(); ++u) members_[block_[u]].push_back(u);
   }
 
   /// First each block of a fixed grid on its own, in parallel, collapsing only where both stars
-  /// lie in the block; then the whole mesh from the vertices next to another block's. The
-  /// blocks do not depend on the thread count, so neither does the result.
-  void run() {
-    block_ = block_of_vertices(pos_);
-    std::vector<std::vector<uint32_t>> members(size_t(kBlocksPerAxis) * kBlocksPerAxis * kBlocksPerAxis);
-    for (uint32_t u = 0; u < pos_.size(); ++u) members[block_[u]].push_back(u);
-    tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+  /// lie in the block (simplify_blocks); then the whole mesh from the vertices next to another
+  /// block's (join_blocks). The blocks do not depend on the thread count, so neither does the
+  /// result.
+  size_t blocks() const { return members_.size(); }
+  uint16_t block(uint32_t u) const { return block_[u]; }
+
+  /// Simplifies the blocks `redo` says, in parallel.
+  void simplify_blocks(const std::vector<uint8_t>& redo) {
+    tbb::parallel_for(size_t{0}, members_.size(), [&](size_t b) {
+      if (!redo[b]) return;
       Scratch s;
-      passes(members[b], std::vector<uint8_t>(members[b].size(), 1), s, int(b));
+      passes(members_[b], std::vector<uint8_t>(members_[b].size(), 1), s, int(b));
     });
+  }
+
+  /// Takes the state of each block `keep` says from `done` (the same mesh, its blocks
+  /// simplified): a block's collapses touch only its own vertices, the triangles whose corners
+  /// all lie in it and the original points those answer for, so a block whose frozen vertices
+  /// did not change would come out the same.
+  void adopt_blocks(const Simplifier& done, const std::vector<uint8_t>& keep) {
+    for (uint32_t u = 0; u < pos_.size(); ++u) {
+      if (!keep[block_[u]]) continue;
+      pos_[u] = done.pos_[u];
+      quadric_[u] = done.quadric_[u];
+      faces_[u] = done.faces_[u];
+      merged_into_[u] = done.merged_into_[u];
+      next_point_[u] = done.next_point_[u];
+      near_[u] = done.near_[u];
+    }
+    for (uint32_t f = 0; f < tris_.size(); ++f) {
+      const auto& t = tris_[f];  // as in the input here
+      const uint16_t b = block_[t[0]];
+      if (!keep[b] || block_[t[1]] != b || block_[t[2]] != b) continue;
+      tris_[f] = done.tris_[f];
+      alive_[f] = done.alive_[f];
+      off_[f] = done.off_[f];
+      first_point_[f] = done.first_point_[f];
+    }
+  }
+
+  /// The whole mesh, from the vertices next to another block's.
+  void join_blocks() {
     std::vector<uint32_t> all(pos_.size());
     std::iota(all.begin(), all.end(), 0u);
     std::vector<uint8_t> dirty(pos_.size(), 0);
@@ -230,7 +265,8 @@ class Simplifier {
   std::vector<double> off_;              // per triangle: how far from the original it was found
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
-  std::vector<uint16_t> block_;  // per vertex: its block of the grid (see run())
+  std::vector<uint16_t> block_;                 // per vertex: its block of the grid
+  std::vector<std::vector<uint32_t>> members_;  // per block: its vertices, ascending
   static constexpr int kAnyBlock = -1;
 
   /// Passes over `members` (ascending vertex numbers, `dirty` per member), each vertex moving
@@ -514,11 +550,25 @@ size_t simplify(TriMesh& mesh, double tolerance) {
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
   // simplified again (a few rounds; the raw contour when crossings remain).
-  std::vector<uint8_t> frozen(mesh.positions.size(), 0);
+  std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
   const detail::MeshDistance surface(mesh);
+  // A round's state after its blocks: the next round redoes only the blocks where vertices
+  // were frozen since.
+  std::optional<Simplifier> blocks_done;
   for (int round = 0; round < 4; ++round) {
     Simplifier s(mesh, surface, tolerance, frozen);
-    s.run();
+    std::vector<uint8_t> redo(s.blocks(), 1);
+    if (blocks_done) {
+      std::fill(redo.begin(), redo.end(), 0);
+      for (uint32_t u = 0; u < frozen.size(); ++u) redo[s.block(u)] |= frozen[u] != frozen_before[u];
+      std::vector<uint8_t> keep(redo.size());
+      for (size_t b = 0; b < redo.size(); ++b) keep[b] = !redo[b];
+      s.adopt_blocks(*blocks_done, keep);
+    }
+    s.simplify_blocks(redo);
+    blocks_done.emplace(s);
+    frozen_before = frozen;
+    s.join_blocks();
     std::vector<uint32_t> kept;
     TriMesh out = s.result(kept);
     if (out.triangles.size() == mesh.triangles.size()) return 0;
