@@ -411,60 +411,81 @@ class LevelSampler {
   void keep_only_whole_surfaces(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
                                 const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
                                 const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
-    const double to_unit = 1 / (f_.lipschitz * cube_.size);
-    // The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
-    const double tolerance = 2 * std::sqrt(error_);
-    // The leaf's polygons run from its vertex to its edges' crossings: on a sheet that curves
-    // away from them between (a hole's rounded rim taken for the corner of its tangent planes,
-    // its vertex on the flat part) their middles leave the surface.
-    std::vector<size_t> asked, first;
-    std::vector<Vec3> points;
-    for (size_t k = 0; k < cand.size(); ++k) {
-      if (!fits[k] || jobs[cand[k]].cell.level + kUncheckedLevels >= max_depth_) continue;
-      asked.push_back(k);
-      first.push_back(points.size());
+    std::vector<size_t> asked;
+    for (size_t k = 0; k < cand.size(); ++k)
+      if (fits[k] && jobs[cand[k]].cell.level + kUncheckedLevels < max_depth_) asked.push_back(k);
+    chords_on_surface(asked, cell_edges, edges, sol, fits);
+    std::erase_if(asked, [&](size_t k) { return !fits[k]; });
+    octants_agree(jobs, cand, asked, cell_edges, edges, fits);
+  }
+
+  /// The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
+  double sheet_tolerance() const { return 2 * std::sqrt(error_); }
+
+  /// A leaf's polygons run from its vertex to its edges' crossings: on a sheet that curves away
+  /// from them between (a hole's rounded rim taken for the corner of its tangent planes, its
+  /// vertex on the flat part) the chords' middles leave the surface. Clears `fits` of the
+  /// leaves `asked` where one does.
+  void chords_on_surface(const std::vector<size_t>& asked, const std::vector<std::array<uint32_t, 12>>& cell_edges,
+                         const std::vector<Edge>& edges, const std::vector<Qef::Solution>& sol,
+                         std::vector<char>& fits) {
+    std::vector<size_t> first;
+    std::vector<Vec3> middles;
+    for (size_t k : asked) {
+      first.push_back(middles.size());
       for (uint32_t id : cell_edges[k])
-        if (id != kNone) points.push_back(scale3(add3(sol[k].position, edges[id].x), 0.5));
+        if (id != kNone) middles.push_back(scale3(add3(sol[k].position, edges[id].x), 0.5));
     }
-    first.push_back(points.size());
-    std::vector<double> f = values(points);
+    first.push_back(middles.size());
+    const std::vector<double> f = values(middles);
+    const double to_unit = 1 / (f_.lipschitz * cube_.size);
     for (size_t i = 0; i < asked.size(); ++i)
       for (size_t c = first[i]; c < first[i + 1]; ++c)
-        if (std::abs(f[c]) * to_unit > tolerance) fits[asked[i]] = 0;
-    // The octants of the leaves left, but those their own corner clears (|f| there beyond the
-    // octant's diagonal: no surface in it).
-    std::erase_if(asked, [&](size_t k) { return !fits[k]; });
-    std::vector<std::pair<size_t, int>> octants;  // (leaf, octant)
-    points.clear();
+        if (std::abs(f[c]) * to_unit > sheet_tolerance()) fits[asked[i]] = 0;
+  }
+
+  /// Each octant of the leaves `asked`, at its centre c, but those their own corner clears (|f|
+  /// there beyond the octant's diagonal: no surface in it): c on the side of the nearest plane
+  /// that f says, unless near both; and, where |f| is a distance, the surface no nearer c than
+  /// every plane. Clears `fits` where an octant disagrees.
+  void octants_agree(const std::vector<Job>& jobs, const std::vector<size_t>& cand, const std::vector<size_t>& asked,
+                     const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
+                     std::vector<char>& fits) {
+    const double to_unit = 1 / (f_.lipschitz * cube_.size), tolerance = sheet_tolerance();
+    std::vector<size_t> leaf;  // per centre
+    std::vector<Vec3> centres;
     for (size_t k : asked) {
       const Job& j = jobs[cand[k]];
       const Vec3 m = j.cell.min_unit();
       const double q = j.cell.size() / 4, diagonal = j.cell.size() * std::sqrt(3.0) / 2;
       for (int o = 0; o < 8; ++o) {
         if (std::abs(j.v[o]) * to_unit > diagonal) continue;
-        octants.push_back({k, o});
-        points.push_back({m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q});
+        leaf.push_back(k);
+        centres.push_back({m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q});
       }
     }
-    f = values(points);
-    for (size_t i = 0; i < octants.size(); ++i) {
-      const size_t k = octants[i].first;
-      const Vec3& c = points[i];
+    const std::vector<double> f = values(centres);
+    for (size_t i = 0; i < centres.size(); ++i) {
+      const size_t k = leaf[i];
       const double reach = std::abs(f[i]) * to_unit, half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
-      // The plane nearest c, and c's side of it.
-      double nearest = detail::kHuge, side = 0;
-      for (uint32_t id : cell_edges[k]) {
-        if (id == kNone) continue;
-        const double len = norm3(edges[id].g);
-        if (!(len > 0)) continue;
-        const double d = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
-        if (std::abs(d) < nearest) nearest = std::abs(d), side = d;
-      }
-      // On the side the planes say, unless near them or near the surface.
+      const auto [nearest, side] = nearest_plane(centres[i], cell_edges[k], edges);
       if (reach > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
-      // Surface within reach of c, the planes as near.
       if (f_.distance && reach < half_diagonal && nearest > reach + tolerance) fits[k] = 0;
     }
+  }
+
+  /// The distance from c to the nearest of a leaf's planes, and c's signed distance to it.
+  static std::pair<double, double> nearest_plane(const Vec3& c, const std::array<uint32_t, 12>& ids,
+                                                 const std::vector<Edge>& edges) {
+    double nearest = detail::kHuge, side = 0;
+    for (uint32_t id : ids) {
+      if (id == kNone) continue;
+      const double len = norm3(edges[id].g);
+      if (!(len > 0)) continue;
+      const double d = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
+      if (std::abs(d) < nearest) nearest = std::abs(d), side = d;
+    }
+    return {nearest, side};
   }
 
   /// The surface point on every edge and f's gradient there, for a batched f: the edges'
