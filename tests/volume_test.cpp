@@ -350,20 +350,20 @@ TEST(Offset, TheOffsetDistanceSeesAMissingPart) {
               own.back_worst / cell);
 }
 
-// A leaf may stand only for the surface its corners, crossings and polygons account for:
-// each case below came out a valid solid but a wrong one, the wrong part decided in one coarse
-// cell, whatever the depth.
+// A leaf may stand only for the surface its corners, crossings and polygons account for: in
+// each case below a coarse cell's data alone fit a wrong surface, which would still contour to
+// a valid solid, the wrong part as wide as that cell at any depth.
 TEST(Offset, NoCoarseLeafHidesOrInventsSurface) {
   const std::string dir = std::string(PIC_DATA_DIR);
   // fandisk grown by a hair: its flange passes through cells between their corners and edges
-  // (a grown solid with 2 units^3 less volume than the input, the flange gone).
+  // (missed, the grown solid would have 2 units^3 less volume than the input).
   const TriMesh fandisk = read_mesh(dir + "/fandisk.obj");
   const Octree grown = offset(fandisk, 0.001, at_depth(8));
   EXPECT_GT(volume(contour(grown)), volume(fandisk));
   // cad_part (a 0.05 wall between a hole and a face) at depth 9 in a cube of 0.66: shrunk by
-  // 20 cells the wall goes, leaving a slot, and a level-2 cell took the hole's curved offset
-  // and the face's plane for a crease (a diamond 0.13 wide cut through the face); grown by 20
-  // cells, a level-3 cell's polygons cut across the rounded rim of the hole.
+  // 20 cells the wall goes, leaving a slot, and a level-2 cell's crossings fit the hole's
+  // curved offset and the face's plane as one crease (a diamond 0.13 wide through the face);
+  // grown by 20 cells, a level-3 cell's polygons would cut across the rounded rim of the hole.
   const TriMesh part = read_mesh(dir + "/cad_part.obj");
   for (const auto& [cells, origin, size] :
        {std::tuple{-20.0, Vec3{-0.33, -0.33, -0.23}, 0.66}, std::tuple{20.0, Vec3{-0.361, -0.361, -0.261}, 0.722}}) {

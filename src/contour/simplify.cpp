@@ -181,13 +181,13 @@ class Simplifier {
     });
   }
 
-  /// Takes the state of each block `keep` says from `done` (the same mesh, its blocks
-  /// simplified): a block's collapses touch only its own vertices, the triangles whose corners
-  /// all lie in it and the original points those answer for, so a block whose frozen vertices
-  /// did not change would come out the same.
-  void adopt_blocks(const Simplifier& done, const std::vector<uint8_t>& keep) {
+  /// Takes the state of each block but those `redo` says from `done` (the same mesh, its
+  /// blocks simplified): a block's collapses touch only its own vertices, the triangles whose
+  /// corners all lie in it and the original points those answer for, so a block whose frozen
+  /// vertices did not change would come out the same.
+  void adopt_blocks(const Simplifier& done, const std::vector<uint8_t>& redo) {
     for (uint32_t u = 0; u < pos_.size(); ++u) {
-      if (!keep[block_[u]]) continue;
+      if (redo[block_[u]]) continue;
       pos_[u] = done.pos_[u];
       quadric_[u] = done.quadric_[u];
       faces_[u] = done.faces_[u];
@@ -198,7 +198,7 @@ class Simplifier {
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       const auto& t = tris_[f];  // as in the input here
       const uint16_t b = block_[t[0]];
-      if (!keep[b] || block_[t[1]] != b || block_[t[2]] != b) continue;
+      if (redo[b] || block_[t[1]] != b || block_[t[2]] != b) continue;
       tris_[f] = done.tris_[f];
       alive_[f] = done.alive_[f];
       off_[f] = done.off_[f];
@@ -561,9 +561,7 @@ size_t simplify(TriMesh& mesh, double tolerance) {
     if (blocks_done) {
       std::fill(redo.begin(), redo.end(), 0);
       for (uint32_t u = 0; u < frozen.size(); ++u) redo[s.block(u)] |= frozen[u] != frozen_before[u];
-      std::vector<uint8_t> keep(redo.size());
-      for (size_t b = 0; b < redo.size(); ++b) keep[b] = !redo[b];
-      s.adopt_blocks(*blocks_done, keep);
+      s.adopt_blocks(*blocks_done, redo);
     }
     s.simplify_blocks(redo);
     blocks_done.emplace(s);

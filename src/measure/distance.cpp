@@ -42,6 +42,32 @@ class Rng {
   uint64_t s_;
 };
 
+/// A uniform random point of triangle t of m.
+Vec3 point_in_triangle(const TriMesh& m, const std::array<uint32_t, 3>& t, Rng& rng) {
+  double u = rng.uniform(), v = rng.uniform();
+  if (u + v > 1) {
+    u = 1 - u;
+    v = 1 - v;
+  }
+  const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+  return add3(a, add3(scale3(sub3(b, a), u), scale3(sub3(c, a), v)));
+}
+
+/// The largest of `d` (and the point it was found at) and the mean.
+void worst_and_mean(const std::vector<double>& d, const std::vector<Vec3>& pts, double& worst, double& mean,
+                    Vec3& where) {
+  worst = 0;
+  mean = 0;
+  for (size_t i = 0; i < d.size(); ++i) {
+    if (d[i] > worst) {
+      worst = d[i];
+      where = pts[i];
+    }
+    mean += d[i];
+  }
+  mean = d.empty() ? 0 : mean / double(d.size());
+}
+
 /// All vertices plus `samples` area-weighted random points on the surface (deterministic).
 std::vector<Vec3> surface_points(const TriMesh& m, size_t samples, uint64_t seed = 12345) {
   std::vector<Vec3> pts = m.positions;
@@ -58,14 +84,7 @@ std::vector<Vec3> surface_points(const TriMesh& m, size_t samples, uint64_t seed
     const double x = rng.uniform() * total;
     size_t i = std::upper_bound(cum.begin(), cum.end(), x) - cum.begin();
     i = std::min(i, cum.size() - 1);
-    const auto& t = m.triangles[i];
-    double u = rng.uniform(), v = rng.uniform();
-    if (u + v > 1) {
-      u = 1 - u;
-      v = 1 - v;
-    }
-    const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-    pts.push_back(add3(a, add3(scale3(sub3(b, a), u), scale3(sub3(c, a), v))));
+    pts.push_back(point_in_triangle(m, m.triangles[i], rng));
   }
   return pts;
 }
@@ -90,17 +109,7 @@ SurfaceDistance surface_distance(const TriMesh& a, const TriMesh& b, size_t samp
   SurfaceDistance r;
   auto side = [&](const TriMesh& from, const TriMesh& to, double& worst, double& mean, Vec3& where) {
     const std::vector<Vec3> pts = sample_surface(from, samples, 12345);
-    const auto d = distance_to_mesh(to, pts);
-    worst = 0;
-    mean = 0;
-    for (size_t i = 0; i < d.size(); ++i) {
-      if (d[i] > worst) {
-        worst = d[i];
-        where = pts[i];
-      }
-      mean += d[i];
-    }
-    mean = d.empty() ? 0 : mean / double(d.size());
+    worst_and_mean(distance_to_mesh(to, pts), pts, worst, mean, where);
   };
   side(a, b, r.a_to_b, r.mean_a_to_b, r.worst_a);
   side(b, a, r.b_to_a, r.mean_b_to_a, r.worst_b);
@@ -190,11 +199,7 @@ std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset,
                             sweeps.size()];
     Vec3 q, u;
     if (w.kind == Sweep::Face) {
-      const auto& t = reference.triangles[w.index];
-      double a = rng.uniform(), b = rng.uniform();
-      if (a + b > 1) a = 1 - a, b = 1 - b;
-      const Vec3& p0 = reference.positions[t[0]];
-      q = add3(p0, add3(scale3(sub3(reference.positions[t[1]], p0), a), scale3(sub3(reference.positions[t[2]], p0), b)));
+      q = point_in_triangle(reference, reference.triangles[w.index], rng);
       u = unit_normal(reference, w.index);
     } else if (w.kind == Sweep::Edge) {
       const auto& t = reference.triangles[w.index];
@@ -240,13 +245,8 @@ OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference,
   }
   if (!d.empty()) r.mean /= double(d.size());
   const std::vector<Vec3> back = offset_surface_points(reference, offset, std::max<size_t>(samples, 1000));
-  const std::vector<double> db = distance_to_mesh(surface, back);
+  worst_and_mean(distance_to_mesh(surface, back), back, r.back_worst, r.back_mean, r.back_where);
   r.back_points = back.size();
-  for (size_t i = 0; i < db.size(); ++i) {
-    if (db[i] > r.back_worst) r.back_worst = db[i], r.back_where = back[i];
-    r.back_mean += db[i];
-  }
-  if (!db.empty()) r.back_mean /= double(db.size());
   return r;
 }
 

@@ -375,7 +375,7 @@ class LevelSampler {
     const std::vector<double> fv = values(at);
     std::vector<char> fits(cand.size(), 0);
     for (size_t i = 0; i < fitting.size(); ++i) {
-      const double off = std::abs(fv[i]) / (f_.lipschitz * cube_.size);
+      const double off = reach(fv[i]);
       fits[fitting[i]] = off * off < error_;
     }
     keep_only_whole_surfaces(jobs, cand, cell_edges, edges, sol, fits);
@@ -419,6 +419,9 @@ class LevelSampler {
     octants_agree(jobs, cand, asked, cell_edges, edges, fits);
   }
 
+  /// |f| as a lower bound on the distance to the surface, in unit-cube lengths.
+  double reach(double value) const { return std::abs(value) / (f_.lipschitz * cube_.size); }
+
   /// The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
   double sheet_tolerance() const { return 2 * std::sqrt(error_); }
 
@@ -438,10 +441,9 @@ class LevelSampler {
     }
     first.push_back(middles.size());
     const std::vector<double> f = values(middles);
-    const double to_unit = 1 / (f_.lipschitz * cube_.size);
     for (size_t i = 0; i < asked.size(); ++i)
       for (size_t c = first[i]; c < first[i + 1]; ++c)
-        if (std::abs(f[c]) * to_unit > sheet_tolerance()) fits[asked[i]] = 0;
+        if (reach(f[c]) > sheet_tolerance()) fits[asked[i]] = 0;
   }
 
   /// Each octant of the leaves `asked`, at its centre c, but those their own corner clears (|f|
@@ -451,7 +453,7 @@ class LevelSampler {
   void octants_agree(const std::vector<Job>& jobs, const std::vector<size_t>& cand, const std::vector<size_t>& asked,
                      const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
                      std::vector<char>& fits) {
-    const double to_unit = 1 / (f_.lipschitz * cube_.size), tolerance = sheet_tolerance();
+    const double tolerance = sheet_tolerance();
     std::vector<size_t> leaf;  // per centre
     std::vector<Vec3> centres;
     for (size_t k : asked) {
@@ -459,7 +461,7 @@ class LevelSampler {
       const Vec3 m = j.cell.min_unit();
       const double q = j.cell.size() / 4, diagonal = j.cell.size() * std::sqrt(3.0) / 2;
       for (int o = 0; o < 8; ++o) {
-        if (std::abs(j.v[o]) * to_unit > diagonal) continue;
+        if (reach(j.v[o]) > diagonal) continue;
         leaf.push_back(k);
         centres.push_back({m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q});
       }
@@ -467,10 +469,10 @@ class LevelSampler {
     const std::vector<double> f = values(centres);
     for (size_t i = 0; i < centres.size(); ++i) {
       const size_t k = leaf[i];
-      const double reach = std::abs(f[i]) * to_unit, half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
+      const double r = reach(f[i]), half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
       const auto [nearest, side] = nearest_plane(centres[i], cell_edges[k], edges);
-      if (reach > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
-      if (f_.distance && reach < half_diagonal && nearest > reach + tolerance) fits[k] = 0;
+      if (r > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
+      if (f_.distance && r < half_diagonal && nearest > r + tolerance) fits[k] = 0;
     }
   }
 
