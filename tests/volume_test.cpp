@@ -11,6 +11,7 @@
 #include <random>
 
 #include "geometry/mesh_distance.h"
+#include "sample/round_body.h"
 #include "pic/contour.h"
 #include "pic/csg.h"
 #include "pic/io.h"
@@ -141,6 +142,50 @@ TEST(Minkowski, CubePlusAFacetedSphereHasFlatFacesAtTheSupport) {
   // Volume: the box grown by a ball of about the same radius (facets 0.1 % deep).
   const double exact = grown_box_volume(1, 1, 1, 0.1);
   EXPECT_NEAR(volume(m), exact, 3e-3 * exact);
+}
+
+TEST(Minkowski, GradientIsTheNormalOfTheSumsSurface) {
+  // f = d - h(u): over a box's edges and corners u turns with p, and so does the support h.
+  // The gradient must be f's own (central differences), not the distance's alone (u): the
+  // sampler's planes are tangent to f's zero set only then.
+  const detail::RoundBody body = *detail::round_body_if_round(make_sphere({0, 0, 0}, 0.1, 24).positions);
+  const TriMesh box = make_box({0, 0, 0}, {1, 1, 1});
+  const detail::RoundSum sum(box, body);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> at(-0.12, 1.12);
+  size_t turning = 0, agree = 0, distance_only = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p{at(rng), at(rng), at(rng)};
+    int outside = 0;
+    for (int k = 0; k < 3; ++k) outside += p[k] < 0 || p[k] > 1;
+    if (outside < 2) continue;  // over a face u is fixed
+    Vec3 g, unused;
+    const double f = sum(p, g);
+    if (std::abs(f) > 0.05) continue;  // near the surface
+    const double d = sum.distance()(p);
+    Vec3 fd, u;
+    bool smooth = true;
+    for (int k = 0; k < 3; ++k) {
+      constexpr double h = 1e-7;
+      Vec3 a = p, b = p;
+      a[k] -= h, b[k] += h;
+      const double fa = sum(a, unused), fb = sum(b, unused);
+      smooth = smooth && std::abs((fb - f) - (f - fa)) < 1e-10;  // no kink between
+      fd[k] = (fb - fa) / (2 * h);
+      Vec3 pa = p, pb = p;
+      pa[k] -= h, pb[k] += h;
+      u[k] = (sum.distance()(pb) - sum.distance()(pa)) / (2 * h);
+    }
+    if (!smooth || !(d > 0)) continue;
+    ++turning;
+    const double off = std::hypot(g[0] - fd[0], g[1] - fd[1], g[2] - fd[2]);
+    agree += off < 1e-5;
+    distance_only += std::hypot(u[0] - fd[0], u[1] - fd[1], u[2] - fd[2]) < 1e-5;
+  }
+  ASSERT_GT(turning, 200u);
+  EXPECT_EQ(agree, turning);
+  // And the distance's gradient alone is not it: the test tells the two apart.
+  EXPECT_LT(distance_only, turning / 10);
 }
 
 TEST(Minkowski, LPrismPlusASphereKeepsItsConcaveEdgeSharp) {

@@ -370,9 +370,11 @@ double SignedDistance::operator()(const Vec3& p, uint32_t* hint) const {
   return with_gradient(p, g, hint);
 }
 
-double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint, Vec3* nearest) const {
+double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint, Vec3* nearest,
+                                     Nearest* feature) const {
   const Nearest n = distance_.nearest(p, hint);
   if (nearest) *nearest = n.point;
+  if (feature) *feature = n;
   const auto& t = mesh_.triangles[n.triangle];
   Vec3 pseudo{0, 0, 0};
   switch (n.feature) {

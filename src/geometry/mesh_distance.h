@@ -75,8 +75,10 @@ class SignedDistance {
   double operator()(const Vec3& p, uint32_t* hint = nullptr) const;
   /// The signed distance and its gradient (unit length, pointing outward; the nearest
   /// face's normal where p is on the surface). `hint`: see MeshDistance::nearest.
-  /// `nearest`, when given, gets the mesh point nearest p.
-  double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr, Vec3* nearest = nullptr) const;
+  /// `nearest`, when given, gets the mesh point nearest p; `feature` the whole answer (its
+  /// triangle and which feature of it).
+  double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr, Vec3* nearest = nullptr,
+                       Nearest* feature = nullptr) const;
   const MeshDistance& mesh_distance() const { return distance_; }
 
  private:

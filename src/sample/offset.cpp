@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <optional>
 
-#include "geometry/convex_hull.h"
 #include "geometry/mesh_distance.h"
 #include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
@@ -16,12 +15,15 @@
 #include "pic/contour.h"
 #include "pic/measure.h"
 #include "pic/volume.h"
+#include "sample/round_body.h"
 
 namespace pic {
 
 namespace {
 
 using detail::MeshDistance;
+using detail::RoundBody;
+using detail::RoundSum;
 using detail::SignedDistance;
 
 /// A cube holding the mesh's box grown by `grow` on every side, plus the sampling margin.
@@ -133,62 +135,13 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
   return sample_with_mesh(solid, o, stats, mesh);
 }
 
-/// A round convex body about its centroid: support h(u) = max (v - c).u.
-struct RoundBody {
-  Vec3 centre{0, 0, 0};
-  std::vector<Vec3> rel;  ///< vertices minus the centre
-  double outer = 0;       ///< largest |v - c|
-  double inner = 0;       ///< smallest support over all directions (the inradius about c)
-  double support(const Vec3& u) const {
-    double h = -detail::kHuge;
-    for (const Vec3& v : rel) h = std::max(h, detail::dot3(v, u));
-    return h;
-  }
-};
-
-RoundBody round_body(const std::vector<Vec3>& points) {
-  RoundBody b;
-  for (const Vec3& p : points) b.centre = detail::add3(b.centre, p);
-  b.centre = detail::scale3(b.centre, 1.0 / double(points.size()));
-  for (const Vec3& p : points) {
-    b.rel.push_back(detail::sub3(p, b.centre));
-    b.outer = std::max(b.outer, detail::norm3(b.rel.back()));
-  }
-  // The inradius about the centre is the support's minimum over directions, reached at a
-  // facet's normal: the nearest of the hull's facet planes.
-  const TriMesh hull = detail::convex_hull(points);
-  b.inner = hull.triangles.empty() ? 0 : detail::kHuge;
-  for (const auto& t : hull.triangles) {
-    const Vec3& a = hull.positions[t[0]];
-    const Vec3 n = detail::cross3(detail::sub3(hull.positions[t[1]], a), detail::sub3(hull.positions[t[2]], a));
-    const double len = detail::norm3(n);
-    if (len > 0) b.inner = std::min(b.inner, detail::dot3(n, detail::sub3(a, b.centre)) / len);
-  }
-  b.inner = std::max(b.inner, 0.0);
-  return b;
-}
-
 }  // namespace
 
-namespace {
-
-/// The body about its centroid when it is round (see is_round_body), else nothing.
-std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
-  if (points.size() < 4) return std::nullopt;
-  for (const Vec3& p : points)
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return std::nullopt;
-  RoundBody b = round_body(points);
-  if (!(b.outer > 0 && b.inner >= 0.98 * b.outer)) return std::nullopt;
-  return b;
-}
-
-}  // namespace
-
-bool is_round_body(const std::vector<Vec3>& points) { return round_body_if_round(points).has_value(); }
+bool is_round_body(const std::vector<Vec3>& points) { return detail::round_body_if_round(points).has_value(); }
 
 Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, const SampleOptions& options,
                        SampleStats* stats, VolumeMesh* mesh) {
-  const std::optional<RoundBody> found = round_body_if_round(round);
+  const std::optional<RoundBody> found = detail::round_body_if_round(round);
   if (!found)
     throw InvalidInput("the Minkowski sum takes a round body here: a faceted sphere, every vertex and facet "
                        "within 2 % of one radius from its centre");
@@ -196,26 +149,19 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   TriMesh surface = closed_surface(solid, options);
   for (Vec3& p : surface.positions) p = detail::add3(p, body.centre);
   const Cube cube = cube_around(surface, body.outer, options);
-  const SignedDistance sd(surface);
+  const RoundSum sum(surface, body);
   tbb::enumerable_thread_specific<uint32_t> hints(uint32_t{0});
-  // Outside the solid, the distance along u from the nearest point against the body's
-  // support along u; inside, negative throughout (no sign change across the surface).
-  const auto value = [&](const Vec3& p, Vec3& grad) {
-    const double d = sd.with_gradient(p, grad, &hints.local());
-    return d > 0 ? d - body.support(grad) : d - body.inner;
-  };
   ImplicitSolid f;
+  f.value_gradient = [&](const Vec3& p, Vec3& grad) { return sum(p, grad, &hints.local()); };
   f.value = [&](const Vec3& p) {
     Vec3 g;
-    return value(p, g);
+    return sum(p, g, &hints.local());
   };
   f.gradient = [&](const Vec3& p) {
     Vec3 g;
-    value(p, g);
+    sum(p, g, &hints.local());
     return g;
   };
-  // No value_gradient: the gradient above is the distance's, not that of d - h(u), whose
-  // slope along an edge Newton steps would need.
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
@@ -224,10 +170,10 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   f.clear = [&](const Vec3& lo, const Vec3& hi) {
     const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
     Vec3 grad, nearest;
-    const double d = sd.with_gradient(centre, grad, &hints.local(), &nearest);
+    const double d = sum.distance().with_gradient(centre, grad, &hints.local(), &nearest);
     const double fc = d > 0 ? d - body.support(grad) : d - body.inner;
     if (std::abs(fc) > f.lipschitz * detail::norm3(detail::sub3(hi, lo)) / 2) return true;
-    return clear_of_bands(sd.mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest);
+    return clear_of_bands(sum.distance().mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest);
   };
   SampleOptions o = options;
   o.cube = cube;
