@@ -74,10 +74,6 @@ Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 
 namespace {
 
-/// Nodes of the hierarchy over n triangles: leaves hold up to 4, inner nodes split the range in
-/// halves. Known ahead, so the two halves of a node can be built at once into their own ids.
-uint32_t node_count(uint32_t n) { return n <= 4 ? 1 : 1 + node_count(n / 2) + node_count(n - n / 2); }
-
 /// Ranges of more triangles than this build their halves as parallel tasks.
 constexpr uint32_t kParallelBuild = 1 << 15;
 
@@ -97,8 +93,9 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
     }
   });
   if (n == 0) return;
-  nodes_.resize(node_count(static_cast<uint32_t>(n)));
-  build(0, 1, 0, static_cast<uint32_t>(n), order, lo, hi, centre);
+  nodes_.reserve(2 * (n / kLeafSize) + 3);
+  nodes_.resize(1);
+  build(nodes_, 0, bounds(0, uint32_t(n), order, lo, hi), 0, static_cast<uint32_t>(n), order, lo, hi, centre);
   tris_.resize(n);
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const auto& t = mesh.triangles[order[i]];
@@ -295,36 +292,126 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   return best;
 }
 
-void MeshDistance::build(uint32_t id, uint32_t next, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
-                         const std::vector<Vec3>& lo, const std::vector<Vec3>& hi, const std::vector<Vec3>& centre) {
-  Vec3 blo{kHuge, kHuge, kHuge}, bhi{-kHuge, -kHuge, -kHuge};
+namespace {
+
+/// Surface area of a box (half of it: only ratios are compared).
+double half_area(const Vec3& lo, const Vec3& hi) {
+  const double x = std::max(0.0, hi[0] - lo[0]), y = std::max(0.0, hi[1] - lo[1]), z = std::max(0.0, hi[2] - lo[2]);
+  return x * y + y * z + z * x;
+}
+
+constexpr int kBins = 16;
+
+}  // namespace
+
+MeshDistance::Split MeshDistance::split(uint32_t first, uint32_t last, std::vector<uint32_t>& order,
+                                        const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
+                                        const std::vector<Vec3>& centre) {
+  // The surface area heuristic over kBins slabs of the centres' box on each axis: a query
+  // opens a child about in proportion to its area, and then looks at its triangles.
+  Vec3 clo{kHuge, kHuge, kHuge}, chi{-kHuge, -kHuge, -kHuge};
   for (uint32_t i = first; i < last; ++i)
-    for (int k = 0; k < 3; ++k) {
-      blo[k] = std::min(blo[k], lo[order[i]][k]);
-      bhi[k] = std::max(bhi[k], hi[order[i]][k]);
+    for (int k = 0; k < 3; ++k) clo[k] = std::min(clo[k], centre[order[i]][k]), chi[k] = std::max(chi[k], centre[order[i]][k]);
+  Split best;
+  double best_cost = kHuge;
+  int best_axis = -1, best_bin = 0;
+  // Along the centres' longest axis only: a third of the work, about the same tree.
+  int longest = 0;
+  for (int k = 1; k < 3; ++k)
+    if (chi[k] - clo[k] > chi[longest] - clo[longest]) longest = k;
+  for (int axis = longest; axis == longest; ++axis) {
+    const double extent = chi[axis] - clo[axis];
+    if (!(extent > 0)) continue;
+    const double scale = kBins / extent;
+    std::array<Bounds, kBins> bins;
+    std::array<uint32_t, kBins> count{};
+    for (Bounds& b : bins) b = Bounds{{kHuge, kHuge, kHuge}, {-kHuge, -kHuge, -kHuge}};
+    for (uint32_t i = first; i < last; ++i) {
+      const uint32_t t = order[i];
+      const int b = std::min(kBins - 1, int((centre[t][axis] - clo[axis]) * scale));
+      ++count[b];
+      bins[b].grow(lo[t], hi[t]);
     }
+    // Cost of the split after bin b: the left's area times its count plus the right's.
+    std::array<Bounds, kBins> left{};
+    std::array<uint32_t, kBins> left_count{};
+    Bounds acc{{kHuge, kHuge, kHuge}, {-kHuge, -kHuge, -kHuge}};
+    uint32_t n = 0;
+    for (int b = 0; b < kBins - 1; ++b) {
+      n += count[b];
+      acc.grow(bins[b].lo, bins[b].hi);
+      left[b] = acc, left_count[b] = n;
+    }
+    acc = Bounds{{kHuge, kHuge, kHuge}, {-kHuge, -kHuge, -kHuge}};
+    n = 0;
+    for (int b = kBins - 1; b > 0; --b) {
+      n += count[b];
+      acc.grow(bins[b].lo, bins[b].hi);
+      if (!n || !left_count[b - 1]) continue;
+      const double cost = half_area(left[b - 1].lo, left[b - 1].hi) * left_count[b - 1] + half_area(acc.lo, acc.hi) * n;
+      if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b - 1, best.left = left[b - 1], best.right = acc;
+    }
+  }
+  if (best_axis >= 0) {
+    const int axis = best_axis;
+    const double lo_axis = clo[axis], scale = kBins / (chi[axis] - clo[axis]);
+    const auto at_left = [&](uint32_t t) { return std::min(kBins - 1, int((centre[t][axis] - lo_axis) * scale)) <= best_bin; };
+    best.mid = uint32_t(std::partition(order.begin() + first, order.begin() + last, at_left) - order.begin());
+    return best;
+  }
+  // Every centre in one point: halves by position in the order.
+  best.mid = first + (last - first) / 2;
+  best.left = bounds(first, best.mid, order, lo, hi);
+  best.right = bounds(best.mid, last, order, lo, hi);
+  return best;
+}
+
+MeshDistance::Bounds MeshDistance::bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order,
+                                       const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
+  Bounds b{{kHuge, kHuge, kHuge}, {-kHuge, -kHuge, -kHuge}};
+  for (uint32_t i = first; i < last; ++i) b.grow(lo[order[i]], hi[order[i]]);
+  return b;
+}
+
+void MeshDistance::build(std::vector<BNode>& out, uint32_t self, const Bounds& box, uint32_t first, uint32_t last,
+                         std::vector<uint32_t>& order, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
+                         const std::vector<Vec3>& centre) {
   BNode nd;
-  for (int k = 0; k < 3; ++k) nd.lo[k] = round_down(blo[k]), nd.hi[k] = round_up(bhi[k]);
-  if (last - first <= 4) {
+  for (int k = 0; k < 3; ++k) nd.lo[k] = round_down(box.lo[k]), nd.hi[k] = round_up(box.hi[k]);
+  if (last - first <= kLeafSize) {
     nd.first = first;
     nd.count = last - first;
-    nodes_[id] = nd;
+    out[self] = nd;
     return;
   }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (bhi[k] - blo[k] > bhi[axis] - blo[axis]) axis = k;
-  const uint32_t mid = first + (last - first) / 2;
-  std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + last,
-                   [&](uint32_t a, uint32_t b) { return centre[a][axis] < centre[b][axis]; });
-  // The children take ids next and next + 1; the left one's descendants follow, then the right's.
-  nd.first = next;
-  nodes_[id] = nd;
-  const uint32_t right_next = next + 2 + node_count(mid - first) - 1;
-  const auto left = [&] { build(next, next + 2, first, mid, order, lo, hi, centre); };
-  const auto right = [&] { build(next + 1, right_next, mid, last, order, lo, hi, centre); };
-  if (last - first > kParallelBuild) tbb::parallel_invoke(left, right);
-  else left(), right();
+  const Split s = split(first, last, order, lo, hi, centre);
+  if (last - first <= kParallelBuild) {
+    // The children side by side, each one's descendants after them.
+    nd.first = uint32_t(out.size());
+    out[self] = nd;
+    out.resize(out.size() + 2);
+    build(out, nd.first, s.left, first, s.mid, order, lo, hi, centre);
+    build(out, nd.first + 1, s.right, s.mid, last, order, lo, hi, centre);
+    return;
+  }
+  // Large halves in parallel, each into its own nodes (its root first), then appended: the
+  // same layout whatever the thread count.
+  std::vector<BNode> left(1), right(1);
+  tbb::parallel_invoke([&] { build(left, 0, s.left, first, s.mid, order, lo, hi, centre); },
+                       [&] { build(right, 0, s.right, s.mid, last, order, lo, hi, centre); });
+  const uint32_t pair = uint32_t(out.size()), left_base = pair + 2, right_base = left_base + uint32_t(left.size()) - 1;
+  nd.first = pair;
+  out[self] = nd;
+  out.resize(out.size() + 2);
+  const auto append = [&](std::vector<BNode>& part, uint32_t root, uint32_t base) {
+    // Index i of the part (0 its root) goes to `root` for 0 and base + i - 1 after.
+    for (BNode& n : part)
+      if (n.count == 0) n.first = base + n.first - 1;
+    out[root] = part[0];
+    out.insert(out.end(), part.begin() + 1, part.end());
+  };
+  append(left, pair, left_base);
+  append(right, pair + 1, right_base);
 }
 
 namespace {

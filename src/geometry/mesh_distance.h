@@ -1,5 +1,5 @@
-// Distances from points to a triangle mesh: the nearest point over a median-split BVH (exact
-// point-triangle distances), and for a closed 2-manifold mesh the signed distance, its sign
+// Distances from points to a triangle mesh: the nearest point over a BVH split by the surface
+// area heuristic, leaves of up to 8 triangles (exact point-triangle distances), and for a closed 2-manifold mesh the signed distance, its sign
 // from the angle-weighted pseudonormal of the nearest feature (Baerentzen and Aanaes 2005:
 // exact for such a mesh, no ray and no winding number).
 #pragma once
@@ -57,9 +57,29 @@ class MeshDistance {
   };
   template <class Box>
   static double box_distance2(const Box& box, const Vec3& p);
-  /// Node `id` over order[first, last); its descendants take the ids from `next` on.
-  void build(uint32_t id, uint32_t next, uint32_t first, uint32_t last, std::vector<uint32_t>& order,
-             const std::vector<Vec3>& lo, const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
+  /// Triangles per leaf at most.
+  static constexpr uint32_t kLeafSize = 8;
+  struct Bounds {
+    Vec3 lo, hi;
+    void grow(const Vec3& l, const Vec3& h) {
+      for (int k = 0; k < 3; ++k) lo[k] = l[k] < lo[k] ? l[k] : lo[k], hi[k] = h[k] > hi[k] ? h[k] : hi[k];
+    }
+  };
+  /// Where a node's triangles split (order[first, mid) and order[mid, last)) and each run's box.
+  struct Split {
+    uint32_t mid = 0;
+    Bounds left, right;
+  };
+  /// Node out[self] over order[first, last), whose triangles' boxes fill `box`; its
+  /// descendants appended to `out`.
+  static void build(std::vector<BNode>& out, uint32_t self, const Bounds& box, uint32_t first, uint32_t last,
+                    std::vector<uint32_t>& order, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
+                    const std::vector<Vec3>& centre);
+  /// Reorders order[first, last) into two runs, the split the surface area heuristic picks.
+  static Split split(uint32_t first, uint32_t last, std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                     const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
+  static Bounds bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                    const std::vector<Vec3>& hi);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
 
