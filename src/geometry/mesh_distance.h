@@ -1,7 +1,8 @@
 // Distances from points to a triangle mesh: the nearest point over a BVH split by the surface
-// area heuristic, leaves of up to 8 triangles (exact point-triangle distances), and for a closed 2-manifold mesh the signed distance, its sign
-// from the angle-weighted pseudonormal of the nearest feature (Baerentzen and Aanaes 2005:
-// exact for such a mesh, no ray and no winding number).
+// area heuristic, leaves of up to 8 triangles (exact point-triangle distances), and for a
+// closed 2-manifold mesh the signed distance, its sign from the angle-weighted pseudonormal of
+// the nearest feature (Baerentzen and Aanaes 2005: exact for such a mesh, no ray and no
+// winding number).
 #pragma once
 
 #include <array>
