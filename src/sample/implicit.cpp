@@ -462,8 +462,11 @@ class LevelSampler {
       const double q = j.cell.size() / 4, diagonal = j.cell.size() * std::sqrt(3.0) / 2;
       for (int o = 0; o < 8; ++o) {
         if (reach(j.v[o]) > diagonal) continue;
+        const Vec3 c{m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q};
+        // Within the tolerance of a plane both tests below pass, whatever f says there.
+        if (nearest_plane(c, cell_edges[k], edges).first <= tolerance) continue;
         leaf.push_back(k);
-        centres.push_back({m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q});
+        centres.push_back(c);
       }
     }
     const std::vector<double> f = values(centres);
