@@ -170,8 +170,8 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   f.clear = [&](const Vec3& lo, const Vec3& hi) {
     const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
     Vec3 grad, nearest;
-    const double d = sum.distance().with_gradient(centre, grad, &hints.local(), &nearest);
-    const double fc = d > 0 ? d - body.support(grad) : d - body.inner;
+    double d = 0;
+    const double fc = sum(centre, grad, &hints.local(), &d, &nearest);
     if (std::abs(fc) > f.lipschitz * detail::norm3(detail::sub3(hi, lo)) / 2) return true;
     return clear_of_bands(sum.distance().mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest);
   };

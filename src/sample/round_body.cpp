@@ -72,9 +72,10 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
   return b;
 }
 
-double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint) const {
+double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, double* distance, Vec3* nearest) const {
   Nearest at;
-  const double d = distance_.with_gradient(p, gradient, hint, nullptr, &at);
+  const double d = distance_.with_gradient(p, gradient, hint, nearest, &at);
+  if (distance) *distance = d;
   if (!(d > 0)) return d - body_.inner;
   const auto [h, top] = body_.support_point(gradient);
   gradient = support_gradient(surface_, at, gradient, d, top);

@@ -34,8 +34,10 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points);
 class RoundSum {
  public:
   RoundSum(const TriMesh& surface, const RoundBody& body) : surface_(surface), body_(body), distance_(surface) {}
-  /// f at p and its gradient. `hint`: see MeshDistance::nearest.
-  double operator()(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr) const;
+  /// f at p and its gradient. `hint`: see MeshDistance::nearest; `distance` and `nearest`,
+  /// when given, get the signed distance d and the surface point nearest p.
+  double operator()(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr, double* distance = nullptr,
+                    Vec3* nearest = nullptr) const;
   const SignedDistance& distance() const { return distance_; }
   const RoundBody& body() const { return body_; }
 
