@@ -188,6 +188,24 @@ TEST(Minkowski, GradientIsTheNormalOfTheSumsSurface) {
   EXPECT_LT(distance_only, turning / 10);
 }
 
+TEST(Minkowski, NoCoarseLeafHidesTheSum) {
+  // fandisk plus a 32-segment sphere: the sum is the offset by the sphere's radius within its
+  // facet depth. A leaf 278 finest cells wide took the fandisk's underside and its crossings'
+  // planes held, while the sum's surface passed 36 cells from its polygons: its octants must
+  // be asked whether the surface lies nearer than the planes, as an offset's are.
+  const TriMesh fandisk = read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj");
+  const double r = 0.03;
+  const TriMesh ball = make_sphere({0, 0, 0}, r, 32);
+  const Octree t = minkowski_round(fandisk, ball.positions, at_depth(12));
+  const TriMesh m = contour(t);
+  expect_valid(m);
+  const double cell = finest_cell(t);
+  const OffsetDistance to_offset = offset_distance(m, fandisk, r, 20000);
+  std::printf("two-sided distance to the offset by r: %.2f / %.2f finest cells\n", to_offset.worst / cell,
+              to_offset.back_worst / cell);
+  EXPECT_LE(to_offset.hausdorff(), 4 * cell);
+}
+
 TEST(Minkowski, LPrismPlusASphereKeepsItsConcaveEdgeSharp) {
   SampleOptions o = at_depth(8);
   o.cube = Cube{{-0.5, -0.5, -0.5}, 3};

@@ -475,7 +475,10 @@ class LevelSampler {
       const double r = reach(f[i]), half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
       const auto [nearest, side] = nearest_plane(centres[i], cell_edges[k], edges);
       if (r > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
-      if (f_.distance && r < half_diagonal && nearest > r + tolerance) fits[k] = 0;
+      // Here |f| is taken at slope 1, as the distance along f's gradient to where f is 0: at
+      // most the distance to the surface, for a bound steeper than 1 only near it.
+      const double along = std::abs(f[i]) / cube_.size;
+      if (f_.distance && along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
     }
   }
 

@@ -165,6 +165,8 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
   // the bound covers for every cell wider than that depth (see docs/algorithms.md).
   f.lipschitz = 2;
+  // Along u, f falls at slope 1 towards its zero (d falls, u and h stay): |f| is a distance.
+  f.distance = true;
   // The surface lies where d = h(u), between the body's inner and outer radii; f's own
   // bound at the centre first (what the sampler would ask without this).
   f.clear = [&](const Vec3& lo, const Vec3& hi) {
