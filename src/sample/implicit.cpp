@@ -707,7 +707,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
-  FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo};
+  FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo, {}};
   const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) { return resample(l, p); };
   refine_coarse_sides(tree, resample, from_function);
   // Leaves the cap stopped with two surface components get one, as after any sampling; a
