@@ -96,9 +96,10 @@ struct ImplicitSolid {
   std::function<void(const std::vector<Vec3>& points, std::vector<Vec3>& gradients)> gradients;
   double lipschitz = 1;
   /// Whether |f| is about the distance to the surface {f = 0} (a signed distance grown, shrunk
-  /// or shelled): a leaf's octants are then also asked whether the surface lies nearer than
-  /// the leaf's planes, which a looser bound (a Minkowski sum's gauge, most functions) would
-  /// claim everywhere.
+  /// or shelled; a sum with a round body, along the direction it is measured in): a leaf's
+  /// octants are then also asked whether the surface lies nearer than the leaf's planes, |f|
+  /// taken at slope 1 -- which a function whose |f| falls short of the distance (most
+  /// functions) would claim everywhere.
   bool distance = false;
   /// Whether f keeps one sign over the whole box [lo, hi] (world units), proven (optional;
   /// false when unsure). Asked, in place of f at the centre, of each cell whose corners agree
