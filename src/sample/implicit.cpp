@@ -456,6 +456,7 @@ class LevelSampler {
     const double tolerance = sheet_tolerance();
     std::vector<size_t> leaf;  // per centre
     std::vector<Vec3> centres;
+    std::vector<std::pair<double, double>> planes;  // per centre: nearest_plane
     for (size_t k : asked) {
       const Job& j = jobs[cand[k]];
       const Vec3 m = j.cell.min_unit();
@@ -464,16 +465,18 @@ class LevelSampler {
         if (reach(j.v[o]) > diagonal) continue;
         const Vec3 c{m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q};
         // Within the tolerance of a plane both tests below pass, whatever f says there.
-        if (nearest_plane(c, cell_edges[k], edges).first <= tolerance) continue;
+        const auto plane = nearest_plane(c, cell_edges[k], edges);
+        if (plane.first <= tolerance) continue;
         leaf.push_back(k);
         centres.push_back(c);
+        planes.push_back(plane);
       }
     }
     const std::vector<double> f = values(centres);
     for (size_t i = 0; i < centres.size(); ++i) {
       const size_t k = leaf[i];
       const double r = reach(f[i]), half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
-      const auto [nearest, side] = nearest_plane(centres[i], cell_edges[k], edges);
+      const auto [nearest, side] = planes[i];
       if (r > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
       // Here |f| is taken at slope 1, as the distance along f's gradient to where f is 0: at
       // most the distance to the surface, for a bound steeper than 1 only near it.
