@@ -190,9 +190,9 @@ TEST(Minkowski, GradientIsTheNormalOfTheSumsSurface) {
 
 TEST(Minkowski, NoCoarseLeafHidesTheSum) {
   // fandisk plus a 32-segment sphere: the sum is the offset by the sphere's radius within its
-  // facet depth. A leaf 278 finest cells wide took the fandisk's underside and its crossings'
-  // planes held, while the sum's surface passed 36 cells from its polygons: its octants must
-  // be asked whether the surface lies nearer than the planes, as an offset's are.
+  // facet depth. Under the fandisk a leaf 278 finest cells wide has crossings whose planes
+  // fit while the sum's surface runs 36 cells from its polygons: its octants must be asked
+  // whether the surface lies nearer than the planes, as an offset's are.
   const TriMesh fandisk = read_mesh(std::string(PIC_DATA_DIR) + "/fandisk.obj");
   const double r = 0.03;
   const TriMesh ball = make_sphere({0, 0, 0}, r, 32);
