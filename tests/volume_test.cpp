@@ -11,6 +11,7 @@
 #include <random>
 
 #include "geometry/mesh_distance.h"
+#include "geometry/vec3.h"
 #include "sample/round_body.h"
 #include "pic/contour.h"
 #include "pic/csg.h"
@@ -142,6 +143,33 @@ TEST(Minkowski, CubePlusAFacetedSphereHasFlatFacesAtTheSupport) {
   // Volume: the box grown by a ball of about the same radius (facets 0.1 % deep).
   const double exact = grown_box_volume(1, 1, 1, 0.1);
   EXPECT_NEAR(volume(m), exact, 3e-3 * exact);
+}
+
+TEST(Minkowski, IndexedSupportIsTheWholeScans) {
+  // The support looked up among a direction cell's candidates must be the scan over every
+  // vertex: the same value and the same vertex, the first among equals -- also along the
+  // axes and the cube's diagonals, where a ring of a faceted sphere ties and cells meet.
+  for (const int segments : {24, 32, 64}) {
+    const detail::RoundBody plain = *detail::round_body_if_round(make_sphere({0.1, 0, -0.2}, 0.5, segments).positions);
+    detail::RoundBody indexed = plain;
+    indexed.index_directions();
+    std::vector<Vec3> directions;
+    for (int x = -2; x <= 2; ++x)
+      for (int y = -2; y <= 2; ++y)
+        for (int z = -2; z <= 2; ++z)
+          if (x || y || z) directions.push_back({double(x), double(y), double(z)});
+    std::mt19937 rng(segments);
+    std::normal_distribution<double> n;
+    for (int i = 0; i < 20000; ++i) directions.push_back({n(rng), n(rng), n(rng)});
+    size_t differ = 0;
+    for (Vec3 u : directions) {
+      u = detail::scale3(u, 1 / detail::norm3(u));
+      const auto [h, v] = plain.support_point(u);
+      const auto [hi, vi] = indexed.support_point(u);
+      differ += h != hi || v != vi;
+    }
+    EXPECT_EQ(differ, 0u) << segments << " segments";
+  }
 }
 
 TEST(Minkowski, GradientIsTheNormalOfTheSumsSurface) {

@@ -141,10 +141,11 @@ bool is_round_body(const std::vector<Vec3>& points) { return detail::round_body_
 
 Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, const SampleOptions& options,
                        SampleStats* stats, VolumeMesh* mesh) {
-  const std::optional<RoundBody> found = detail::round_body_if_round(round);
+  std::optional<RoundBody> found = detail::round_body_if_round(round);
   if (!found)
     throw InvalidInput("the Minkowski sum takes a round body here: a faceted sphere, every vertex and facet "
                        "within 2 % of one radius from its centre");
+  found->index_directions();
   const RoundBody& body = *found;
   TriMesh surface = closed_surface(solid, options);
   for (Vec3& p : surface.positions) p = detail::add3(p, body.centre);

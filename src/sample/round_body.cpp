@@ -10,12 +10,75 @@
 
 namespace pic::detail {
 
+namespace {
+
+/// The direction through the point of the cube face `face` (axis face / 2, sign by face % 2)
+/// at coordinates (x, y) in [-1, 1] along the face's other two axes.
+Vec3 face_direction(int face, double x, double y) {
+  const int a = face / 2;
+  Vec3 d{0, 0, 0};
+  d[a] = face % 2 ? -1 : 1;
+  d[(a + 1) % 3] = x;
+  d[(a + 2) % 3] = y;
+  return scale3(d, 1 / norm3(d));
+}
+
+}  // namespace
+
+int RoundBody::cell_of(const Vec3& u) const {
+  int a = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(u[k]) > std::abs(u[a])) a = k;
+  const double m = std::abs(u[a]);
+  if (!(m > 0) || !std::isfinite(m)) return -1;
+  auto bin = [&](double t) { return std::clamp(int((t / m + 1) / 2 * side_), 0, side_ - 1); };
+  const int face = 2 * a + (u[a] < 0);
+  return (face * side_ + bin(u[(a + 1) % 3])) * side_ + bin(u[(a + 2) % 3]);
+}
+
 std::pair<double, Vec3> RoundBody::support_point(const Vec3& u) const {
   double h = -kHuge;
   Vec3 top{0, 0, 0};
-  for (const Vec3& v : rel)
-    if (const double x = dot3(v, u); x > h) h = x, top = v;
+  const int cell = side_ > 0 ? cell_of(u) : -1;
+  if (cell < 0) {
+    for (const Vec3& v : rel)
+      if (const double x = dot3(v, u); x > h) h = x, top = v;
+    return {h, top};
+  }
+  // The cell's candidates hold every vertex that can reach the support there, in the order
+  // of `rel`: the first maximum is the one the whole scan finds.
+  for (uint32_t i = first_[cell]; i < first_[cell + 1]; ++i)
+    if (const double x = dot3(rel[candidates_[i]], u); x > h) h = x, top = rel[candidates_[i]];
   return {h, top};
+}
+
+void RoundBody::index_directions() {
+  // Cells about 1/side of a face wide: the candidates thin out with the cell's angle, the
+  // build costs cells times vertices (bounded here).
+  side_ = int(std::clamp(std::sqrt(2e7 / (6.0 * double(std::max<size_t>(rel.size(), 1)))), 1.0, 32.0));
+  const int cells = 6 * side_ * side_;
+  first_.assign(size_t(cells) + 1, 0);
+  candidates_.clear();
+  for (int cell = 0; cell < cells; ++cell) {
+    const int face = cell / (side_ * side_), i = (cell / side_) % side_, j = cell % side_;
+    const auto at = [&](double t) { return 2 * t / side_ - 1; };
+    const Vec3 mid = face_direction(face, at(i + 0.5), at(j + 0.5));
+    // Every unit direction of the cell lies within `chord` of mid: the cell is convex on
+    // the sphere, so its farthest points are its corners.
+    double chord = 0;
+    for (int c = 0; c < 4; ++c)
+      chord = std::max(chord, norm3(sub3(face_direction(face, at(i + (c & 1)), at(j + (c >> 1))), mid)));
+    // Over the cell a vertex's v.u moves by at most |v| chord, as does the support: one
+    // more than 2 outer chord below the support at mid never reaches it (a margin above
+    // rounding, and for a u a hair off unit length).
+    chord = chord * (1 + 1e-6) + 1e-9;
+    double h = -kHuge;
+    for (const Vec3& v : rel) h = std::max(h, dot3(v, mid));
+    const double floor = h - 2 * outer * chord - 1e-9 * outer;
+    for (uint32_t k = 0; k < rel.size(); ++k)
+      if (dot3(rel[k], mid) >= floor) candidates_.push_back(k);
+    first_[size_t(cell) + 1] = uint32_t(candidates_.size());
+  }
 }
 
 namespace {

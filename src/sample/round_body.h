@@ -19,8 +19,17 @@ struct RoundBody {
   double outer = 0;       ///< largest |v - c|
   double inner = 0;       ///< smallest support over all directions (the inradius about c)
   double support(const Vec3& u) const { return support_point(u).first; }
-  /// The support along u and a vertex where it is reached.
+  /// The support along u and a vertex where it is reached (the first in `rel` among equals).
   std::pair<double, Vec3> support_point(const Vec3& u) const;
+  /// Bins the directions so that support_point looks at a few candidate vertices, not all.
+  void index_directions();
+
+ private:
+  /// Directions binned by a cube around the unit sphere, `side` x `side` cells per face; per
+  /// cell, the vertices that can reach the support for some unit direction in it, in order.
+  int side_ = 0;
+  std::vector<uint32_t> first_, candidates_;
+  int cell_of(const Vec3& u) const;
 };
 
 /// The body about its centroid when it is round (every vertex and facet within 2 % of one
