@@ -405,10 +405,36 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
       "[1, 2, 8, 7], [2, 3, 9, 8], [3, 4, 10, 9], [4, 5, 11, 10], [5, 0, 6, 11]]);";
   EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell_polyhedron + " cube(size = [1, 1, 1]); }", o))), 63,
               63 * 1e-5);
-  // Two non-convex leaves: each moved by a point of the other, and every pair of their planar
-  // pieces summed (a hull each) -- the L plus itself again, 52 * 4.
+  // The polyhedron is a prism whose caps arrive as fans: its pieces are the cap's convex
+  // pieces (two boxes here, four hulls), not the general sum of two non-convex solids below.
   EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell_polyhedron + " " + ell_polyhedron + " }", o))), 52 * 4,
               208 * 1e-5);
+  // Two non-convex leaves that are no prisms (the L's top slanted, z = 2 + x / 2): each moved
+  // by a point of the other, and every pair of their planar pieces summed (a hull each). The
+  // same solid as the union of its two convex pieces sums exactly by hulls of vertex sums.
+  const auto slanted = [](const std::vector<std::array<double, 2>>& ring) {
+    const size_t n = ring.size();
+    std::string points, faces = "[";
+    for (int top = 0; top < 2; ++top)
+      for (const auto& [x, y] : ring)
+        points += (points.empty() ? "[" : ", [") + std::to_string(x) + ", " + std::to_string(y) + ", " +
+                  std::to_string(top ? 2 + x / 2 : 0) + "]";
+    for (size_t k = n; k-- > 0;) faces += std::to_string(k) + (k ? ", " : "], [");
+    for (size_t k = 0; k < n; ++k) faces += std::to_string(n + k) + (k + 1 < n ? ", " : "]");
+    for (size_t k = 0; k < n; ++k) {
+      const size_t j = (k + 1) % n;
+      faces += ", [" + std::to_string(k) + ", " + std::to_string(j) + ", " + std::to_string(n + j) + ", " +
+               std::to_string(n + k) + "]";
+    }
+    return "polyhedron(points = [" + points + "], faces = [" + faces + "]);";
+  };
+  const std::string slanted_ell = slanted({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 2}, {0, 2}});
+  const std::string slanted_pieces =
+      "union() { " + slanted({{0, 0}, {4, 0}, {4, 2}, {0, 2}}) + " " + slanted({{2, 2}, {4, 2}, {4, 4}, {2, 4}}) + " }";
+  const TriMesh general = contour(eval_csg("minkowski() { " + slanted_ell + " " + slanted_ell + " }", o));
+  EXPECT_TRUE(test::IsClosedManifold(general));
+  const double by_pieces = volume(contour(eval_csg("minkowski() { " + slanted_pieces + " " + slanted_pieces + " }", o)));
+  EXPECT_NEAR(volume(general), by_pieces, by_pieces * 1e-4);
   // Two twisted extrusions: 66 planar pieces each (every side triangle its own), 4,356 hulls
   // -- refused at once with the count.
   const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 8) { square(size = [2, 2]); }";

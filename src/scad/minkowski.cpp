@@ -212,7 +212,9 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
     else return false;  // a vertex between the caps: twisted, scaled in slices, or no prism
   }
   if (!same_points(bottom, top, eps)) return false;
-  // The cap: the union of the triangles on the bottom plane, seen from outside the solid.
+  // The cap: the union of the triangles on the bottom plane, counted by winding. Each keeps its
+  // orientation: a non-convex face triangulated as a fan has triangles turned against the face
+  // that cancel the others' overhang (turned one by one, they would fill its notches).
   Region cap;
   for (const auto& t : m.triangles) {
     bool on = true;
@@ -220,7 +222,6 @@ bool prism_pieces(const TriMesh& m, double eps, std::vector<Convex>& out) {
     if (!on) continue;
     Ring ring;
     for (uint32_t k : t) ring.push_back({dot3(u, m.positions[k]), dot3(v, m.positions[k])});
-    if (signed_area(ring) < 0) std::reverse(ring.begin(), ring.end());
     cap.push_back(std::move(ring));
   }
   const Region outline = region_union({cap});
