@@ -409,9 +409,9 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   // pieces (two boxes here, four hulls), not the general sum of two non-convex solids below.
   EXPECT_NEAR(volume(contour(eval_csg("minkowski() { " + ell_polyhedron + " " + ell_polyhedron + " }", o))), 52 * 4,
               208 * 1e-5);
-  // Two non-convex leaves that are no prisms (the L's top slanted, z = 2 + x / 2): each moved
-  // by a point of the other, and every pair of their planar pieces summed (a hull each). The
-  // same solid as the union of its two convex pieces sums exactly by hulls of vertex sums.
+  // A non-convex leaf that is no prism (the L's top slanted, z = 2 + x / 2) is cut into convex
+  // pieces by the plane of a face at its reflex edge: two pieces, four hulls, the same sum as
+  // the union of the two pieces written out.
   const auto slanted = [](const std::vector<std::array<double, 2>>& ring) {
     const size_t n = ring.size();
     std::string points, faces = "[";
@@ -431,10 +431,33 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   const std::string slanted_ell = slanted({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 2}, {0, 2}});
   const std::string slanted_pieces =
       "union() { " + slanted({{0, 0}, {4, 0}, {4, 2}, {0, 2}}) + " " + slanted({{2, 2}, {4, 2}, {4, 4}, {2, 4}}) + " }";
-  const TriMesh general = contour(eval_csg("minkowski() { " + slanted_ell + " " + slanted_ell + " }", o));
-  EXPECT_TRUE(test::IsClosedManifold(general));
+  EvalStats cut_stats;
+  const TriMesh cut = contour(eval_csg("minkowski() { " + slanted_ell + " " + slanted_ell + " }", o, &cut_stats));
+  EXPECT_TRUE(test::IsClosedManifold(cut));
+  EXPECT_EQ(cut_stats.leaves, 4u);  // the hulls of two pieces plus two, not one per pair of faces
   const double by_pieces = volume(contour(eval_csg("minkowski() { " + slanted_pieces + " " + slanted_pieces + " }", o)));
-  EXPECT_NEAR(volume(general), by_pieces, by_pieces * 1e-4);
+  EXPECT_NEAR(volume(cut), by_pieces, by_pieces * 1e-4);
+  // A 2-cube and a 2 x 3 x 3 box apart as one polyhedron: no reflex edge and no prism, so no
+  // convex pieces -- the general sum: each moved by a point of each of the other's shells, and
+  // every pair of planar pieces summed (a hull each). The sums are boxes that only touch:
+  // 64 + 100 + 144.
+  const auto box = [](int first, double x0, double x1, double h, std::string& points, std::string& faces) {
+    for (int k = 0; k < 8; ++k)
+      points += (points.empty() ? "[" : ", [") + std::to_string(k & 1 ? x1 : x0) + ", " + std::to_string(k & 2 ? h : 0) +
+                ", " + std::to_string(k & 4 ? h : 0) + "]";
+    for (const auto& q : {std::array{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+      faces += std::string(faces.empty() ? "[" : ", [") + std::to_string(first + q[0]) + ", " + std::to_string(first + q[1]) +
+               ", " + std::to_string(first + q[2]) + ", " + std::to_string(first + q[3]) + "]";
+  };
+  std::string points, faces;
+  box(0, 0, 2, 2, points, faces);
+  box(8, 4, 6, 3, points, faces);
+  const std::string two_boxes = "polyhedron(points = [" + points + "], faces = [" + faces + "]);";
+  EvalStats general_stats;
+  const TriMesh general = contour(eval_csg("minkowski() { " + two_boxes + " " + two_boxes + " }", o, &general_stats));
+  EXPECT_TRUE(test::IsClosedManifold(general));
+  EXPECT_GT(general_stats.leaves, 50u);  // not the four hulls of the cut L above
+  EXPECT_NEAR(volume(general), 64 + 100 + 144, 308 * 1e-5);
   // Two twisted extrusions: 66 planar pieces each (every side triangle its own), 4,356 hulls
   // -- refused at once with the count.
   const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 8) { square(size = [2, 2]); }";

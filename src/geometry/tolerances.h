@@ -123,6 +123,12 @@ inline constexpr double kSamePlaneCosine = 1e-12;
 inline constexpr double kSamePlaneOffset = 1e-12;
 /// A prism's volume must match its cap's area times its height to this fraction.
 inline constexpr double kPrismVolume = 1e-6;
+/// Convex pieces of a polyhedron (hulls in the cells of its reflex edges' planes) are taken
+/// when their volumes add up to the solid's within this fraction: a hull over two parts of a
+/// cell fills the gap between them and adds that gap. Pieces of a non-convex face come
+/// through Clipper's integer grid (about 1e-8 of the extent), which this must allow; a gap
+/// thinner than that lies far below the finest cell of any depth.
+inline constexpr double kPieceVolume = 1e-7;
 /// Float contour vertices on a flat face sit within ~1e-7 of a cell of its plane: this
 /// fraction of the extent.
 inline constexpr double kFlatFaceTolerance = 1e-6;

@@ -15,6 +15,7 @@
 #include "geometry/tolerances.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
+#include "geometry/winding.h"
 
 namespace pic::detail::scad {
 namespace {
@@ -281,6 +282,239 @@ void subtract_convex(const Convex& part, const Convex& q, const std::vector<Plan
     if (Convex c = clip_convex(rest, pl, true, eps); !c.empty()) out.push_back(std::move(c));
 }
 
+// ---- convex decomposition of a non-convex polyhedron by its reflex edges' planes ----------
+
+// A reflex edge (the solid's angle there over 180 degrees) and the plane of one of its faces:
+// on either side of that plane the edge is no longer reflex.
+struct ReflexEdge {
+  Vec3 a, b;
+  Plane cut;
+};
+
+// Per triangle, its face's outward unit normal: its flat group's (a non-convex face fanned
+// into triangles that partly face back still has one), else its own; zero for a degenerate
+// triangle alone.
+std::vector<Vec3> face_normals(const TriMesh& m, const std::vector<std::vector<uint32_t>>& groups, double tol) {
+  std::vector<Vec3> normal(m.triangles.size());
+  const auto area_normal = [&](uint32_t f) {
+    const auto& t = m.triangles[f];
+    return cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+  };
+  for (const auto& g : groups) {
+    Vec3 n{0, 0, 0};
+    for (uint32_t f : g) n = add3(n, area_normal(f));
+    const double len = norm3(n);
+    bool flat = len > 0;
+    if (flat) n = scale3(n, 1 / len);
+    const Vec3& o = m.positions[m.triangles[g[0]][0]];
+    for (uint32_t f : g)
+      for (uint32_t k : m.triangles[f]) flat = flat && std::abs(dot3(n, sub3(m.positions[k], o))) <= tol;
+    for (uint32_t f : g) {
+      const Vec3 own = area_normal(f);
+      const double l = norm3(own);
+      normal[f] = flat ? n : l > 0 ? scale3(own, 1 / l) : Vec3{0, 0, 0};
+    }
+  }
+  return normal;
+}
+
+// The reflex edges of a closed, consistently oriented surface, or false when an edge is open
+// or shared by more than two triangles.
+bool reflex_edges(const TriMesh& m, double tol, std::vector<ReflexEdge>& out) {
+  const auto groups = coplanar_groups(m, tol);
+  const std::vector<Vec3> normal = face_normals(m, groups, tol);
+  std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
+  const auto key = [](uint32_t a, uint32_t b) { return uint64_t(a) << 32 | b; };
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int e = 0; e < 3; ++e)
+      if (!by_edge.emplace(key(m.triangles[f][e], m.triangles[f][(e + 1) % 3]), f).second) return false;
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = m.triangles[f][e], b = m.triangles[f][(e + 1) % 3];
+      const auto twin = by_edge.find(key(b, a));
+      if (twin == by_edge.end()) return false;
+      const uint32_t g = twin->second;
+      if (a > b || normal[f] == normal[g]) continue;  // each edge once; none inside a flat face
+      // Face B turns from the edge, within its plane, along w = n_B x (a - b) (B holds b -> a):
+      // above A's plane, the solid's angle at the edge is over 180 degrees.
+      const Vec3 &pa = m.positions[a], &pb = m.positions[b];
+      const Vec3 w = cross3(normal[g], sub3(pa, pb));
+      if (dot3(normal[f], w) > tol * norm3(w)) out.push_back({pa, pb, {normal[f], dot3(normal[f], pa)}});
+    }
+  return true;
+}
+
+// Whether the segment ab passes through the inside of the convex cell (its face planes) by
+// more than eps.
+bool crosses_inside(const Vec3& a, const Vec3& b, const std::vector<Plane>& cell, double eps) {
+  double t0 = 0, t1 = 1;
+  for (const Plane& p : cell) {
+    const double fa = dot3(p.n, a) - p.d + eps, fb = dot3(p.n, b) - p.d + eps;  // <= 0 inside
+    if (fa > 0 && fb > 0) return false;
+    if (fa > 0) t0 = std::max(t0, fa / (fa - fb));
+    else if (fb > 0) t1 = std::min(t1, fa / (fa - fb));
+  }
+  return (t1 - t0) * norm3(sub3(b, a)) > eps;
+}
+
+// Clips a convex polygon (a ring) to n.x <= d.
+std::vector<Vec3> clip_polygon(const std::vector<Vec3>& poly, const Plane& p) {
+  std::vector<Vec3> out;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Vec3 &x = poly[i], &y = poly[(i + 1) % poly.size()];
+    const double fx = dot3(p.n, x) - p.d, fy = dot3(p.n, y) - p.d;
+    if (fx <= 0) out.push_back(x);
+    if ((fx < 0 && fy > 0) || (fx > 0 && fy < 0)) out.push_back(add3(x, scale3(sub3(y, x), fx / (fx - fy))));
+  }
+  return out;
+}
+
+// Twice a ring's vector area.
+Vec3 ring_area2(const std::vector<Vec3>& ring) {
+  Vec3 a{0, 0, 0};
+  for (size_t i = 0; i < ring.size(); ++i) a = add3(a, cross3(ring[i], ring[(i + 1) % ring.size()]));
+  return a;
+}
+
+// A flat face's convex piece as a ring, with the face's outward normal.
+struct FacePiece {
+  std::vector<Vec3> ring;
+  Vec3 normal;
+};
+
+// The surface's convex face pieces (planar_pieces, group by group) as rings about their
+// centroids, each with its face's outward normal (face_normals).
+std::vector<FacePiece> face_rings(const TriMesh& m, double tol) {
+  std::vector<FacePiece> out;
+  const auto groups = coplanar_groups(m, tol);
+  const std::vector<Vec3> normal = face_normals(m, groups, tol);
+  for (const auto& tris : groups) {
+    // Triangles that all face out tile their face exactly as they are; a fan with triangles
+    // facing back is the union of its triangles by winding (group_pieces, rounded by Clipper).
+    const bool facing_out = std::all_of(tris.begin(), tris.end(), [&](uint32_t f) {
+      const auto& t = m.triangles[f];
+      return dot3(normal[f], cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]))) > 0;
+    });
+    std::vector<std::vector<Vec3>> pieces;
+    if (facing_out) {
+      for (uint32_t f : tris) {
+        const auto& t = m.triangles[f];
+        pieces.push_back({m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]});
+      }
+    } else {
+      group_pieces(m, tris, tol, pieces);
+    }
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      // One piece per triangle, in order, or pieces of one flat face sharing its normal.
+      const Vec3 n = normal[tris[pieces.size() == tris.size() ? i : 0]];
+      if (n == Vec3{0, 0, 0}) continue;
+      const Vec3 u = cross3(n, std::abs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}), v = cross3(n, u);
+      std::vector<Vec3>& pts = pieces[i];
+      Vec3 c{0, 0, 0};
+      for (const Vec3& p : pts) c = add3(c, scale3(p, 1.0 / double(pts.size())));
+      const auto angle = [&](const Vec3& p) { return std::atan2(dot3(sub3(p, c), v), dot3(sub3(p, c), u)); };
+      std::sort(pts.begin(), pts.end(), [&](const Vec3& a, const Vec3& b) { return angle(a) < angle(b); });
+      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+      out.push_back({std::move(pts), n});
+    }
+  }
+  return out;
+}
+
+// The convex cells a BSP by reflex-edge planes leaves around a solid (each its planes,
+// n.x <= d), split until no reflex edge passes through a cell's inside: there the solid is
+// locally convex, so each of its connected parts in the cell is convex. False past
+// `max_cells`.
+bool reflex_cells(const std::vector<Plane>& cell, const std::vector<ReflexEdge>& edges, std::vector<uint32_t> left,
+                  double eps, size_t max_cells, std::vector<std::vector<Plane>>& out) {
+  std::erase_if(left, [&](uint32_t e) { return !crosses_inside(edges[e].a, edges[e].b, cell, eps); });
+  if (left.empty()) {
+    out.push_back(cell);
+    return out.size() <= max_cells;
+  }
+  const Plane& cut = edges[left.front()].cut;
+  for (const Plane& side : {cut, Plane{scale3(cut.n, -1), -cut.d}}) {
+    std::vector<Plane> half = cell;
+    half.push_back(side);
+    if (!reflex_cells(half, edges, left, eps, max_cells, out)) return false;
+  }
+  return true;
+}
+
+// The corners of a cell: where three of its planes meet, within eps of every other.
+std::vector<Vec3> cell_corners(const std::vector<Plane>& cell, double eps) {
+  std::vector<Vec3> out;
+  for (size_t i = 0; i < cell.size(); ++i)
+    for (size_t j = i + 1; j < cell.size(); ++j)
+      for (size_t k = j + 1; k < cell.size(); ++k) {
+        const Plane &a = cell[i], &b = cell[j], &c = cell[k];
+        const Vec3 bc = cross3(b.n, c.n), ca = cross3(c.n, a.n), ab = cross3(a.n, b.n);
+        const double det = dot3(a.n, bc);
+        if (std::abs(det) < kSamePlaneCosine) continue;
+        const Vec3 x = scale3(add3(add3(scale3(bc, a.d), scale3(ca, b.d)), scale3(ab, c.d)), 1 / det);
+        if (std::all_of(cell.begin(), cell.end(), [&](const Plane& p) { return dot3(p.n, x) <= p.d + eps; }))
+          out.push_back(x);
+      }
+  return out;
+}
+
+// A closed, non-convex polyhedron as convex polytopes with disjoint insides whose union it is:
+// the solid in each cell of a BSP by its reflex edges' planes, each the hull of its faces'
+// pieces clipped to the cell and the cell's corners inside it. A cell may still hold two
+// convex parts apart, whose hull fills the gap between them: the hulls' volumes must add up
+// to the solid's (they can only exceed it), else false, as past `max_pieces`.
+bool reflex_pieces(const TriMesh& mesh, double eps, size_t max_pieces, std::vector<Convex>& out) {
+  const TriMesh m = weld(mesh);
+  const double solid = volume(m);
+  std::vector<ReflexEdge> edges;
+  if (!(solid > 0) || !reflex_edges(m, eps, edges) || edges.empty() || edges.size() > max_pieces) return false;
+  const auto [lo, hi] = box_of(m.positions);
+  const double extent = norm3(sub3(hi, lo));
+  std::vector<Plane> box;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 axis{0, 0, 0};
+    axis[k] = 1;
+    box.push_back({axis, hi[k] + 0.01 * extent});
+    box.push_back({scale3(axis, -1), -(lo[k] - 0.01 * extent)});
+  }
+  std::vector<uint32_t> all(edges.size());
+  for (uint32_t e = 0; e < all.size(); ++e) all[e] = e;
+  std::vector<std::vector<Plane>> cells;
+  if (!reflex_cells(box, edges, all, eps, 4 * max_pieces, cells)) return false;
+  const std::vector<FacePiece> faces = face_rings(m, eps);
+  std::vector<Convex> pieces;
+  double total = 0;
+  for (const std::vector<Plane>& planes : cells) {
+    Convex points;
+    for (const FacePiece& face : faces) {
+      std::vector<Vec3> poly = face.ring;
+      for (size_t k = 0; k < planes.size() && !poly.empty(); ++k) poly = clip_polygon(poly, planes[k]);
+      // The solid in the cell is its inside's closure: a face met only along a line, or lying
+      // on the cell's side with the solid beyond it, is no part of it.
+      if (norm3(ring_area2(poly)) <= eps * extent) continue;
+      const bool beyond = std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) {
+        return dot3(pl.n, face.normal) < 0 &&
+               std::all_of(poly.begin(), poly.end(), [&](const Vec3& x) { return std::abs(dot3(pl.n, x) - pl.d) <= eps; });
+      });
+      if (!beyond) points.insert(points.end(), poly.begin(), poly.end());
+    }
+    for (const Vec3& corner : cell_corners(planes, eps)) {
+      double w = 0;
+      for (const auto& t : m.triangles) w += triangle_winding(corner, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]);
+      if (w > 0.75) points.push_back(corner);
+    }
+    const TriMesh hull = points.size() < 4 ? TriMesh{} : convex_hull(points);
+    const double v = hull.triangles.empty() ? 0 : volume(hull);
+    if (!(v > 0)) continue;
+    total += v;
+    pieces.push_back(hull.positions);
+    if (pieces.size() > max_pieces) return false;
+  }
+  if (!(std::abs(total - solid) <= kPieceVolume * solid)) return false;
+  out.insert(out.end(), pieces.begin(), pieces.end());
+  return true;
+}
+
 /// The solid as convex polytopes whose union it is (they may overlap), or false: a leaf that
 /// is neither convex nor a prism, a hull of a difference, too many pieces.
 bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) {
@@ -291,7 +525,8 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
         out.push_back(convex_hull(s.mesh.positions).positions);
         return true;
       }
-      return prism_pieces(s.mesh, eps, out) && out.size() <= kMaxConvexPieces;
+      if (prism_pieces(s.mesh, eps, out)) return out.size() <= kMaxConvexPieces;
+      return reflex_pieces(s.mesh, eps, kMaxConvexPieces, out) && out.size() <= kMaxConvexPieces;
     case Solid::Kind::Union:
       for (const Solid& c : s.children)
         if (!convex_decomposition(c, eps, out)) return false;
