@@ -4,6 +4,7 @@
 // formula), stored here so the tests do not need `openscad`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -458,6 +459,38 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   EXPECT_TRUE(test::IsClosedManifold(general));
   EXPECT_GT(general_stats.leaves, 50u);  // not the four hulls of the cut L above
   EXPECT_NEAR(volume(general), 64 + 100 + 144, 308 * 1e-5);
+  // A slanted U (top z = 2 + x / 2) and a unit cube far off, as one polyhedron: a cell of the
+  // U's reflex planes holds both shells, so no convex pieces -- each planar piece of it plus a
+  // unit cube. Its caps arrive as fans with triangles facing back and one on a line; taken
+  // apart at that line, the back-facing triangles alone filled the U's notch, and a piece
+  // of no width across the notch summed to a solid in it (+1.5 % volume). Exact: the U plus
+  // the cube, 33 * 2 + 33 + 2 * (11 + 17), and the 2-cube.
+  std::string u_points, u_faces;
+  size_t u_count = 0;  // points so far
+  const auto shell = [&](const std::vector<std::array<double, 2>>& ring, bool slanted_top) {
+    const size_t n = ring.size(), first = u_count;
+    u_count += 2 * n;
+    for (int top = 0; top < 2; ++top)
+      for (const auto& [x, y] : ring)
+        u_points += (u_points.empty() ? "[" : ", [") + std::to_string(x) + ", " + std::to_string(y) + ", " +
+                    std::to_string(top ? (slanted_top ? 2 + x / 2 : 1) : 0) + "]";
+    const auto index = [&](size_t k) { return std::to_string(first + k); };
+    std::string bottom = "[", cap = "[";
+    for (size_t k = 0; k < n; ++k) bottom += index(n - 1 - k) + (k + 1 < n ? ", " : "]");
+    for (size_t k = 0; k < n; ++k) cap += index(n + k) + (k + 1 < n ? ", " : "]");
+    u_faces += (u_faces.empty() ? "" : ", ") + bottom + ", " + cap;
+    for (size_t k = 0; k < n; ++k)
+      u_faces += ", [" + index(k) + ", " + index((k + 1) % n) + ", " + index(n + (k + 1) % n) + ", " + index(n + k) + "]";
+  };
+  shell({{0, 0}, {6, 0}, {6, 4}, {4, 4}, {4, 2}, {2, 2}, {2, 4}, {0, 4}}, true);
+  shell({{20, 0}, {21, 0}, {21, 1}, {20, 1}}, false);
+  EvalStats u_stats;
+  const TriMesh u_sum = contour(eval_csg("minkowski() { polyhedron(points = [" + u_points + "], faces = [" + u_faces +
+                                             "]); cube(size = [1, 1, 1]); }",
+                                         o, &u_stats));
+  EXPECT_TRUE(test::IsClosedManifold(u_sum));
+  EXPECT_GT(u_stats.leaves, 10u);  // the planar pieces, not convex ones
+  EXPECT_NEAR(volume(u_sum), 155 + 8, 163 * 2e-3);
   // Two twisted extrusions: 66 planar pieces each (every side triangle its own), 4,356 hulls
   // -- refused at once with the count.
   const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 8) { square(size = [2, 2]); }";

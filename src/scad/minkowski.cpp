@@ -48,6 +48,27 @@ std::vector<std::vector<uint32_t>> coplanar_groups(const TriMesh& m, double tol)
       if (flat) groups.join(f, it->second);
     }
   }
+  // A flat triangle (three vertices on a line) in a fan breaks the chain of neighbours: its
+  // neighbours that lie in one plane are one face through it (it also touches the face that
+  // meets that one along its line, which it must not join).
+  const auto in_plane = [&](uint32_t f, uint32_t g) {
+    if (std::abs(dot3(normal[f], normal[g])) < 1 - kFlatNeighbourCosine) return false;
+    for (uint32_t v : m.triangles[g])
+      if (std::abs(dot3(normal[f], sub3(m.positions[v], m.positions[m.triangles[f][0]]))) > tol) return false;
+    return true;
+  };
+  for (uint32_t f = 0; f < nt; ++f) {
+    if (normal[f] != Vec3{0, 0, 0}) continue;
+    std::vector<uint32_t> near;
+    for (int e = 0; e < 3; ++e) {
+      const auto& t = m.triangles[f];
+      const auto it = by_edge.find(uint64_t(t[(e + 1) % 3]) << 32 | t[e]);
+      if (it != by_edge.end() && normal[it->second] != Vec3{0, 0, 0}) near.push_back(it->second);
+    }
+    for (size_t i = 0; i < near.size(); ++i)
+      for (size_t j = i + 1; j < near.size(); ++j)
+        if (in_plane(near[i], near[j])) groups.join(near[i], near[j]), groups.join(f, near[i]);
+  }
   std::unordered_map<size_t, size_t> slot;
   std::vector<std::vector<uint32_t>> out;
   for (uint32_t f = 0; f < nt; ++f) {
@@ -108,6 +129,12 @@ void group_pieces(const TriMesh& m, const std::vector<uint32_t>& tris, double to
     return;
   }
   for (const Ring& r : convex_pieces(outline)) {
+    // A piece thinner than tol (a trapezoid of zero height, a segment) covers nothing, but its
+    // sum with a body is a solid: a segment across a notch would fill it.
+    double diameter = 0;
+    for (const P2& a : r)
+      for (const P2& b : r) diameter = std::max(diameter, std::hypot(a[0] - b[0], a[1] - b[1]));
+    if (std::abs(signed_area(r)) <= tol * diameter) continue;
     std::vector<Vec3> pts;
     for (const P2& p : r) pts.push_back(add3(o, add3(scale3(u, p[0]), scale3(v, p[1]))));
     out.push_back(std::move(pts));
@@ -458,6 +485,32 @@ std::vector<Vec3> cell_corners(const std::vector<Plane>& cell, double eps) {
   return out;
 }
 
+// Joins pieces with disjoint insides two by two where their union is convex (its hull adds no
+// more than `slack` of volume), until no two join: a BSP cuts through parts that need no cut
+// (a plane through one slice of an extrusion cuts every slice), and each piece left costs a
+// hull per piece of the other operand.
+void merge_convex_unions(std::vector<Convex>& pieces, double slack) {
+  std::vector<double> vol(pieces.size());
+  std::vector<std::array<Vec3, 2>> box(pieces.size());
+  for (size_t i = 0; i < pieces.size(); ++i) vol[i] = volume(convex_hull(pieces[i])), box[i] = box_of(pieces[i]);
+  for (bool joined = true; joined;) {
+    joined = false;
+    for (size_t i = 0; i < pieces.size(); ++i)
+      for (size_t j = i + 1; j < pieces.size(); ++j) {
+        if (boxes_apart(box[i], box[j])) continue;
+        Convex both = pieces[i];
+        both.insert(both.end(), pieces[j].begin(), pieces[j].end());
+        const TriMesh hull = convex_hull(both);
+        const double v = volume(hull);
+        if (!(v - vol[i] - vol[j] <= slack)) continue;
+        pieces[i] = hull.positions, vol[i] = v, box[i] = box_of(pieces[i]);
+        pieces.erase(pieces.begin() + long(j)), vol.erase(vol.begin() + long(j)), box.erase(box.begin() + long(j));
+        joined = true;
+        --j;
+      }
+  }
+}
+
 // A closed, non-convex polyhedron as convex polytopes with disjoint insides whose union it is:
 // the solid in each cell of a BSP by its reflex edges' planes, each the hull of its faces'
 // pieces clipped to the cell and the cell's corners inside it. A cell may still hold two
@@ -511,6 +564,7 @@ bool reflex_pieces(const TriMesh& mesh, double eps, size_t max_pieces, std::vect
     if (pieces.size() > max_pieces) return false;
   }
   if (!(std::abs(total - solid) <= kPieceVolume * solid)) return false;
+  merge_convex_unions(pieces, kPieceVolume * solid);
   out.insert(out.end(), pieces.begin(), pieces.end());
   return true;
 }
