@@ -467,13 +467,13 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   // the cube, 33 * 2 + 33 + 2 * (11 + 17), and the 2-cube.
   std::string u_points, u_faces;
   size_t u_count = 0;  // points so far
-  const auto shell = [&](const std::vector<std::array<double, 2>>& ring, bool slanted_top) {
+  const auto shell = [&](const std::vector<std::array<double, 2>>& ring, double (*top_at)(double)) {
     const size_t n = ring.size(), first = u_count;
     u_count += 2 * n;
     for (int top = 0; top < 2; ++top)
       for (const auto& [x, y] : ring)
         u_points += (u_points.empty() ? "[" : ", [") + std::to_string(x) + ", " + std::to_string(y) + ", " +
-                    std::to_string(top ? (slanted_top ? 2 + x / 2 : 1) : 0) + "]";
+                    std::to_string(top ? top_at(x) : 0) + "]";
     const auto index = [&](size_t k) { return std::to_string(first + k); };
     std::string bottom = "[", cap = "[";
     for (size_t k = 0; k < n; ++k) bottom += index(n - 1 - k) + (k + 1 < n ? ", " : "]");
@@ -482,8 +482,9 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
     for (size_t k = 0; k < n; ++k)
       u_faces += ", [" + index(k) + ", " + index((k + 1) % n) + ", " + index(n + (k + 1) % n) + ", " + index(n + k) + "]";
   };
-  shell({{0, 0}, {6, 0}, {6, 4}, {4, 4}, {4, 2}, {2, 2}, {2, 4}, {0, 4}}, true);
-  shell({{20, 0}, {21, 0}, {21, 1}, {20, 1}}, false);
+  const std::vector<std::array<double, 2>> u_ring{{0, 0}, {6, 0}, {6, 4}, {4, 4}, {4, 2}, {2, 2}, {2, 4}, {0, 4}};
+  shell(u_ring, [](double x) { return 2 + x / 2; });
+  shell({{20, 0}, {21, 0}, {21, 1}, {20, 1}}, [](double) { return 1.0; });
   EvalStats u_stats;
   const TriMesh u_sum = contour(eval_csg("minkowski() { polyhedron(points = [" + u_points + "], faces = [" + u_faces +
                                              "]); cube(size = [1, 1, 1]); }",
@@ -491,6 +492,15 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   EXPECT_TRUE(test::IsClosedManifold(u_sum));
   EXPECT_GT(u_stats.leaves, 10u);  // the planar pieces, not convex ones
   EXPECT_NEAR(volume(u_sum), 155 + 8, 163 * 2e-3);
+  // The U with a flat top is a prism: the convex pieces of its cap, which Clipper's union of the
+  // fan leaves as two rings touching along a diagonal -- no strip of no width between them may
+  // become a piece. (U + square) 33 times 3 high.
+  u_points.clear(), u_faces.clear(), u_count = 0;
+  shell(u_ring, [](double) { return 2.0; });
+  const TriMesh u_prism = contour(eval_csg("minkowski() { polyhedron(points = [" + u_points + "], faces = [" +
+                                               u_faces + "]); cube(size = [1, 1, 1]); }",
+                                           o));
+  EXPECT_NEAR(volume(u_prism), 99, 99 * 1e-5);
   // Two twisted extrusions: 66 planar pieces each (every side triangle its own), 4,356 hulls
   // -- refused at once with the count.
   const std::string twisted = "linear_extrude(height = 2, twist = 90, slices = 8) { square(size = [2, 2]); }";

@@ -129,12 +129,6 @@ void group_pieces(const TriMesh& m, const std::vector<uint32_t>& tris, double to
     return;
   }
   for (const Ring& r : convex_pieces(outline)) {
-    // A piece thinner than tol (a trapezoid of zero height, a segment) covers nothing, but its
-    // sum with a body is a solid: a segment across a notch would fill it.
-    double diameter = 0;
-    for (const P2& a : r)
-      for (const P2& b : r) diameter = std::max(diameter, std::hypot(a[0] - b[0], a[1] - b[1]));
-    if (std::abs(signed_area(r)) <= tol * diameter) continue;
     std::vector<Vec3> pts;
     for (const P2& p : r) pts.push_back(add3(o, add3(scale3(u, p[0]), scale3(v, p[1]))));
     out.push_back(std::move(pts));

@@ -244,6 +244,18 @@ std::vector<Ring> convex_pieces(const Region& region) {
   }
   for (const Piece& p : open)
     if (!p.left.empty()) out.push_back(p.ring());
+  // Rings that touch along an edge (Clipper's union of a fan can end so) cross each strip
+  // there at one place, give or take Clipper's grid (about 1e-9 of the extent), bounding a
+  // strip of no width: a segment, nothing in the region but a solid once summed with a body.
+  double scale = 0;
+  for (const Ring& r : region)
+    for (const P2& p : r) scale = std::max({scale, std::abs(p[0]), std::abs(p[1])});
+  std::erase_if(out, [&](const Ring& r) {
+    double diameter = 0;
+    for (const P2& a : r)
+      for (const P2& b : r) diameter = std::max(diameter, std::hypot(a[0] - b[0], a[1] - b[1]));
+    return std::abs(signed_area(r)) <= 1e-8 * scale * diameter;
+  });
   return out;
 }
 
