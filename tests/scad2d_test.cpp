@@ -334,6 +334,17 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
       "cube(size = [10, 2, 2]); cube(size = [2, 10, 2]); } cube(size = [2, 2, 2], center = true); } }",
       o)));
   EXPECT_NEAR(ell, 12 * 4 * 4 + 4 * 12 * 4 - 4 * 4 * 4, 320 * 1e-6);
+  // A hull() is one convex part whatever it holds (it was contoured and taken apart into the
+  // contour's flat pieces: 9 hulls here, and thousands, refused, for a hull with a ball in it).
+  // Two unit cubes offset diagonally hull to a hexagonal prism; plus a unit cube, the hexagon
+  // (0,0) (2,0) (3,1) (3,3) (1,3) (0,2), area 8, twice as high: 16.
+  EvalStats stats;
+  const double prism = volume(contour(eval_csg(
+      "minkowski() { hull() { cube(size = [1, 1, 1]); multmatrix([[1, 0, 0, 1], [0, 1, 0, 1], [0, 0, 1, 0], "
+      "[0, 0, 0, 1]]) { cube(size = [1, 1, 1]); } } cube(size = [1, 1, 1]); }",
+      o, &stats)));
+  EXPECT_NEAR(prism, 16, 16 * 1e-6);
+  EXPECT_EQ(stats.leaves, 1u);
 }
 
 // A non-convex operand plus a convex one: the operand cut into convex pieces (a difference of

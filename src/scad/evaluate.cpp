@@ -31,20 +31,6 @@ using namespace detail::scad;
 using detail::Clock;
 using detail::since;
 
-// Hull input: the vertices of the leaves, when the subtree is only unions (and hulls) of them.
-bool hull_points(const Solid& s, std::vector<Vec3>& out) {
-  switch (s.kind) {
-    case Solid::Kind::Empty: return true;
-    case Solid::Kind::Mesh: out.insert(out.end(), s.mesh.positions.begin(), s.mesh.positions.end()); return true;
-    case Solid::Kind::Union:
-    case Solid::Kind::Hull:
-      for (const Solid& c : s.children)
-        if (!hull_points(c, out)) return false;
-      return true;
-    default: return false;
-  }
-}
-
 void append_mesh(TriMesh& to, const TriMesh& m) {
   const auto base = static_cast<uint32_t>(to.positions.size());
   to.positions.insert(to.positions.end(), m.positions.begin(), m.positions.end());

@@ -74,6 +74,19 @@ bool is_convex(const TriMesh& m) {
 }
 
 
+bool hull_points(const Solid& s, std::vector<Vec3>& out) {
+  switch (s.kind) {
+    case Solid::Kind::Empty: return true;
+    case Solid::Kind::Mesh: out.insert(out.end(), s.mesh.positions.begin(), s.mesh.positions.end()); return true;
+    case Solid::Kind::Union:
+    case Solid::Kind::Hull:
+      for (const Solid& c : s.children)
+        if (!hull_points(c, out)) return false;
+      return true;
+    default: return false;
+  }
+}
+
 std::vector<Plane> face_planes(const TriMesh& hull) {
   std::vector<Plane> out;
   for (const auto& t : hull.triangles) {

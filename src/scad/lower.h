@@ -66,6 +66,9 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options, 
 /// Whether a closed surface bounds a convex solid: connected, positive volume, convex at
 /// every edge (hull.cpp).
 bool is_convex(const TriMesh& m);
+/// hull() input: the vertices of the leaves, when the subtree is only unions (and hulls) of
+/// them; false otherwise (hull.cpp).
+bool hull_points(const Solid& s, std::vector<Vec3>& out);
 /// A plane n.x = d, n unit and outward.
 struct Plane {
   Vec3 n;

@@ -579,6 +579,13 @@ bool convex_decomposition(const Solid& s, double eps, std::vector<Convex>& out) 
       for (const Solid& c : s.children)
         if (!convex_decomposition(c, eps, out)) return false;
       return out.size() <= kMaxConvexPieces;
+    case Solid::Kind::Hull: {  // convex whatever its children, when they are meshes
+      std::vector<Vec3> points;
+      if (!hull_points(s, points)) return false;
+      const TriMesh hull = convex_hull(points);
+      if (!hull.triangles.empty()) out.push_back(hull.positions);
+      return out.size() <= kMaxConvexPieces;
+    }
     case Solid::Kind::Difference:
     case Solid::Kind::Intersect: {
       const bool difference = s.kind == Solid::Kind::Difference;
