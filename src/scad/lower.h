@@ -55,10 +55,11 @@ TriMesh solid_surface(const Solid& s, const EvalOptions& options);
 /// projection(): the shadow of a closed surface on z = 0 (union of its triangles' shadows), or,
 /// with `cut`, its section by that plane (projection.cpp).
 std::vector<Ring> project(const TriMesh& surface, bool cut);
-/// minkowski() of operands that are unions of convex parts (the union of the hulls of their
-/// parts' vertex sums), at most one of them with non-convex parts (each such part plus a convex
-/// one: the part moved, and the hull of each surface triangle plus the convex part).
-/// \throws InvalidInput for two operands with non-convex parts.
+/// minkowski(): each operand as convex parts where it decomposes (hulls, differences and
+/// intersections of convex parts, prisms, polyhedra cut at their reflex edges) and the union of
+/// the hulls of the parts' vertex sums; a non-convex part that does not decompose is summed by
+/// its moved copies and the hulls of its planar pieces (minkowski.cpp, docs/openscad.md).
+/// \throws InvalidInput past the count of hulls it takes on.
 /// A non-convex operand plus a round one (a faceted sphere) is a RoundSum instead, unless
 /// `exact_only`.
 Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& options, bool exact_only = false);

@@ -505,6 +505,31 @@ void merge_convex_unions(std::vector<Convex>& pieces, double slack) {
   }
 }
 
+// The corners of the solid's part in a convex cell (its planes): its faces' pieces clipped to
+// the cell and the cell's corners inside the solid.
+Convex solid_in_cell(const TriMesh& m, const std::vector<FacePiece>& faces, const std::vector<Plane>& planes,
+                     double eps, double extent) {
+  Convex points;
+  for (const FacePiece& face : faces) {
+    std::vector<Vec3> poly = face.ring;
+    for (size_t k = 0; k < planes.size() && !poly.empty(); ++k) poly = clip_polygon(poly, planes[k]);
+    // The part is the closure of the solid's inside: a face met only along a line, or lying
+    // on the cell's side with the solid beyond it, is no part of it.
+    if (norm3(ring_area2(poly)) <= eps * extent) continue;
+    const bool beyond = std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) {
+      return dot3(pl.n, face.normal) < 0 &&
+             std::all_of(poly.begin(), poly.end(), [&](const Vec3& x) { return std::abs(dot3(pl.n, x) - pl.d) <= eps; });
+    });
+    if (!beyond) points.insert(points.end(), poly.begin(), poly.end());
+  }
+  for (const Vec3& corner : cell_corners(planes, eps)) {
+    double w = 0;
+    for (const auto& t : m.triangles) w += triangle_winding(corner, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]);
+    if (w > 0.75) points.push_back(corner);  // 1 inside, 1/2 on the surface (a face's piece has it)
+  }
+  return points;
+}
+
 // A closed, non-convex polyhedron as convex polytopes with disjoint insides whose union it is:
 // the solid in each cell of a BSP by its reflex edges' planes, each the hull of its faces'
 // pieces clipped to the cell and the cell's corners inside it. A cell may still hold two
@@ -532,24 +557,7 @@ bool reflex_pieces(const TriMesh& mesh, double eps, size_t max_pieces, std::vect
   std::vector<Convex> pieces;
   double total = 0;
   for (const std::vector<Plane>& planes : cells) {
-    Convex points;
-    for (const FacePiece& face : faces) {
-      std::vector<Vec3> poly = face.ring;
-      for (size_t k = 0; k < planes.size() && !poly.empty(); ++k) poly = clip_polygon(poly, planes[k]);
-      // The solid in the cell is its inside's closure: a face met only along a line, or lying
-      // on the cell's side with the solid beyond it, is no part of it.
-      if (norm3(ring_area2(poly)) <= eps * extent) continue;
-      const bool beyond = std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) {
-        return dot3(pl.n, face.normal) < 0 &&
-               std::all_of(poly.begin(), poly.end(), [&](const Vec3& x) { return std::abs(dot3(pl.n, x) - pl.d) <= eps; });
-      });
-      if (!beyond) points.insert(points.end(), poly.begin(), poly.end());
-    }
-    for (const Vec3& corner : cell_corners(planes, eps)) {
-      double w = 0;
-      for (const auto& t : m.triangles) w += triangle_winding(corner, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]);
-      if (w > 0.75) points.push_back(corner);
-    }
+    const Convex points = solid_in_cell(m, faces, planes, eps, extent);
     const TriMesh hull = points.size() < 4 ? TriMesh{} : convex_hull(points);
     const double v = hull.triangles.empty() ? 0 : volume(hull);
     if (!(v > 0)) continue;
