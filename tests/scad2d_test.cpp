@@ -334,8 +334,8 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
       "cube(size = [10, 2, 2]); cube(size = [2, 10, 2]); } cube(size = [2, 2, 2], center = true); } }",
       o)));
   EXPECT_NEAR(ell, 12 * 4 * 4 + 4 * 12 * 4 - 4 * 4 * 4, 320 * 1e-6);
-  // A hull() is one convex part whatever it holds (it was contoured and taken apart into the
-  // contour's flat pieces: 9 hulls here, and thousands, refused, for a hull with a ball in it).
+  // A hull() is one convex part whatever it holds, not its contour's flat pieces (9 hulls
+  // here, and thousands, past the limit, for a hull with a faceted ball in it).
   // Two unit cubes offset diagonally hull to a hexagonal prism; plus a unit cube, the hexagon
   // (0,0) (2,0) (3,1) (3,3) (1,3) (0,2), area 8, twice as high: 16.
   EvalStats stats;
@@ -472,10 +472,10 @@ TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {
   EXPECT_NEAR(volume(general), 64 + 100 + 144, 308 * 1e-5);
   // A slanted U (top z = 2 + x / 2) and a unit cube far off, as one polyhedron: a cell of the
   // U's reflex planes holds both shells, so no convex pieces -- each planar piece of it plus a
-  // unit cube. Its caps arrive as fans with triangles facing back and one on a line; taken
-  // apart at that line, the back-facing triangles alone filled the U's notch, and a piece
-  // of no width across the notch summed to a solid in it (+1.5 % volume). Exact: the U plus
-  // the cube, 33 * 2 + 33 + 2 * (11 + 17), and the 2-cube.
+  // unit cube. Its caps arrive as fans with triangles facing back and one on a line: each cap
+  // is one face through that line (the back-facing triangles alone would fill the notch), and
+  // no piece of no width crosses the notch (summed with the cube it would be a solid there).
+  // Exact: the U plus the cube, 33 * 2 + 33 + 2 * (11 + 17), and the 2-cube.
   std::string u_points, u_faces;
   size_t u_count = 0;  // points so far
   const auto shell = [&](const std::vector<std::array<double, 2>>& ring, double (*top_at)(double)) {

@@ -312,18 +312,25 @@ struct ReflexEdge {
   Plane cut;
 };
 
-// Per triangle, its face's outward unit normal: its flat group's (a non-convex face fanned
-// into triangles that partly face back still has one), else its own; zero for a degenerate
-// triangle alone.
-std::vector<Vec3> face_normals(const TriMesh& m, const std::vector<std::vector<uint32_t>>& groups, double tol) {
-  std::vector<Vec3> normal(m.triangles.size());
-  const auto area_normal = [&](uint32_t f) {
-    const auto& t = m.triangles[f];
-    return cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
-  };
-  for (const auto& g : groups) {
+// Triangle f's normal scaled by twice its area.
+Vec3 area_normal(const TriMesh& m, uint32_t f) {
+  const auto& t = m.triangles[f];
+  return cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+}
+
+// A surface's flat groups (coplanar_groups) and per triangle its face's outward unit normal:
+// its flat group's (a non-convex face fanned into triangles that partly face back still has
+// one), else its own; zero for a degenerate triangle alone.
+struct Faces {
+  std::vector<std::vector<uint32_t>> groups;
+  std::vector<Vec3> normal;
+};
+
+Faces faces_of(const TriMesh& m, double tol) {
+  Faces out{coplanar_groups(m, tol), std::vector<Vec3>(m.triangles.size())};
+  for (const auto& g : out.groups) {
     Vec3 n{0, 0, 0};
-    for (uint32_t f : g) n = add3(n, area_normal(f));
+    for (uint32_t f : g) n = add3(n, area_normal(m, f));
     const double len = norm3(n);
     bool flat = len > 0;
     if (flat) n = scale3(n, 1 / len);
@@ -331,19 +338,18 @@ std::vector<Vec3> face_normals(const TriMesh& m, const std::vector<std::vector<u
     for (uint32_t f : g)
       for (uint32_t k : m.triangles[f]) flat = flat && std::abs(dot3(n, sub3(m.positions[k], o))) <= tol;
     for (uint32_t f : g) {
-      const Vec3 own = area_normal(f);
+      const Vec3 own = area_normal(m, f);
       const double l = norm3(own);
-      normal[f] = flat ? n : l > 0 ? scale3(own, 1 / l) : Vec3{0, 0, 0};
+      out.normal[f] = flat ? n : l > 0 ? scale3(own, 1 / l) : Vec3{0, 0, 0};
     }
   }
-  return normal;
+  return out;
 }
 
 // The reflex edges of a closed, consistently oriented surface, or false when an edge is open
 // or shared by more than two triangles.
-bool reflex_edges(const TriMesh& m, double tol, std::vector<ReflexEdge>& out) {
-  const auto groups = coplanar_groups(m, tol);
-  const std::vector<Vec3> normal = face_normals(m, groups, tol);
+bool reflex_edges(const TriMesh& m, const Faces& faces, double tol, std::vector<ReflexEdge>& out) {
+  const std::vector<Vec3>& normal = faces.normal;
   std::unordered_map<uint64_t, uint32_t> by_edge;  // directed edge -> triangle
   const auto key = [](uint32_t a, uint32_t b) { return uint64_t(a) << 32 | b; };
   for (uint32_t f = 0; f < m.triangles.size(); ++f)
@@ -404,18 +410,15 @@ struct FacePiece {
 };
 
 // The surface's convex face pieces (planar_pieces, group by group) as rings about their
-// centroids, each with its face's outward normal (face_normals).
-std::vector<FacePiece> face_rings(const TriMesh& m, double tol) {
+// centroids, each with its face's outward normal.
+std::vector<FacePiece> face_rings(const TriMesh& m, const Faces& faces, double tol) {
   std::vector<FacePiece> out;
-  const auto groups = coplanar_groups(m, tol);
-  const std::vector<Vec3> normal = face_normals(m, groups, tol);
-  for (const auto& tris : groups) {
+  const std::vector<Vec3>& normal = faces.normal;
+  for (const auto& tris : faces.groups) {
     // Triangles that all face out tile their face exactly as they are; a fan with triangles
     // facing back is the union of its triangles by winding (group_pieces, rounded by Clipper).
-    const bool facing_out = std::all_of(tris.begin(), tris.end(), [&](uint32_t f) {
-      const auto& t = m.triangles[f];
-      return dot3(normal[f], cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]))) > 0;
-    });
+    const bool facing_out =
+        std::all_of(tris.begin(), tris.end(), [&](uint32_t f) { return dot3(normal[f], area_normal(m, f)) > 0; });
     std::vector<std::vector<Vec3>> pieces;
     if (facing_out) {
       for (uint32_t f : tris) {
@@ -538,8 +541,9 @@ Convex solid_in_cell(const TriMesh& m, const std::vector<FacePiece>& faces, cons
 bool reflex_pieces(const TriMesh& mesh, double eps, size_t max_pieces, std::vector<Convex>& out) {
   const TriMesh m = weld(mesh);
   const double solid = volume(m);
+  const Faces faces = faces_of(m, eps);
   std::vector<ReflexEdge> edges;
-  if (!(solid > 0) || !reflex_edges(m, eps, edges) || edges.empty() || edges.size() > max_pieces) return false;
+  if (!(solid > 0) || !reflex_edges(m, faces, eps, edges) || edges.empty() || edges.size() > max_pieces) return false;
   const auto [lo, hi] = box_of(m.positions);
   const double extent = norm3(sub3(hi, lo));
   std::vector<Plane> box;
@@ -553,11 +557,11 @@ bool reflex_pieces(const TriMesh& mesh, double eps, size_t max_pieces, std::vect
   for (uint32_t e = 0; e < all.size(); ++e) all[e] = e;
   std::vector<std::vector<Plane>> cells;
   if (!reflex_cells(box, edges, all, eps, 4 * max_pieces, cells)) return false;
-  const std::vector<FacePiece> faces = face_rings(m, eps);
+  const std::vector<FacePiece> rings = face_rings(m, faces, eps);
   std::vector<Convex> pieces;
   double total = 0;
   for (const std::vector<Plane>& planes : cells) {
-    const Convex points = solid_in_cell(m, faces, planes, eps, extent);
+    const Convex points = solid_in_cell(m, rings, planes, eps, extent);
     const TriMesh hull = points.size() < 4 ? TriMesh{} : convex_hull(points);
     const double v = hull.triangles.empty() ? 0 : volume(hull);
     if (!(v > 0)) continue;
