@@ -443,8 +443,9 @@ class Simplifier {
   /// Whether the new star lies within the tolerance of the original surface (the other way
   /// round): its vertex, and each triangle's centroid (a long triangle across a fold). A point
   /// near a triangle of the stars as they are now is as near the original as that triangle
-  /// (`off_`: how far each triangle was found from it, 0 for one no collapse has changed);
-  /// else the original surface is searched. The bounds found go to the new star (new_off).
+  /// (`off_`: how far each triangle was found from it at such points, 0 for one no collapse
+  /// has changed); else the original surface is searched, which the point must then reach. The
+  /// bounds found go to the new star (new_off).
   bool near_original(uint32_t u, uint32_t v, const Vec3& x, Scratch& s) {
     const auto& star = s.star;
     const auto& corners = s.star_corners;
@@ -455,24 +456,16 @@ class Simplifier {
       return off_[f] + std::sqrt(detail::point_triangle_distance2(m, pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     };
     // `own`: the triangle whose new shape the point lies on, tried first (the nearest, mostly).
+    // Within half the tolerance it will do: the bound stays low enough for the next collapse.
+    // Else the original surface is asked, and its nearer triangle found sets the bound.
     auto bound = [&](const Vec3& m, uint32_t own) {
-      // The first triangle within half the tolerance will do: the bound stays low enough
-      // for the next collapse, at a fraction of the distances.
-      double best = own != kNoTriangle ? bound_by(m, own) : detail::kHuge;
-      if (best <= tol_ / 2) return best;
-      for (uint32_t w : {u, v})
-        for (uint32_t f : faces_[w]) {
-          if (f == own || off_[f] >= tol_) continue;
-          best = std::min(best, bound_by(m, f));
-          if (best <= tol_ / 2) return best;
-        }
-      if (best <= tol_) return best;
-      return original_surface_.within(m, tol_, &hint) ? tol_ : detail::kHuge;
+      const double by_own = bound_by(m, own);
+      if (by_own <= tol_ / 2) return by_own;
+      double found = 0;
+      return original_surface_.within(m, tol_, &hint, &found) ? std::min(found, by_own) : detail::kHuge;
     };
-    // The vertex itself is asked of the original surface: the bounds above are as good as
-    // the points they were found at.
-    if (!original_surface_.within(x, tol_, &hint)) return false;
-    const double at_x = bound(x, kNoTriangle);
+    double at_x = 0;
+    if (!original_surface_.within(x, tol_, &hint, &at_x)) return false;
     new_off.clear();
     for (size_t i = 0; i < star.size(); ++i) {
       const auto& c = corners[i];

@@ -152,20 +152,23 @@ double MeshDistance::distance(const Vec3& p) const {
   return std::sqrt(best2);
 }
 
-bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint) const {
+bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found) const {
   const double r2 = r * r;
+  double d2 = 0;
   auto reaches = [&](const LeafTriangle& t) {
-    return box_distance2(t, p) <= r2 && point_triangle_distance2(p, t.a, t.b, t.c) <= r2;
+    return box_distance2(t, p) <= r2 && (d2 = point_triangle_distance2(p, t.a, t.b, t.c)) <= r2;
+  };
+  auto take = [&](const LeafTriangle& t) {
+    if (hint) *hint = static_cast<uint32_t>(&t - tris_.data());
+    if (found) *found = std::sqrt(d2);
+    return true;
   };
   // The hint's triangles first: stored in leaf order, the slots around it lie close by.
   constexpr uint32_t kAround = 8;
   if (hint && *hint < triangles_) {
     const uint32_t lo = *hint > kAround ? *hint - kAround : 0, hi = std::min<uint32_t>(uint32_t(triangles_), *hint + kAround + 1);
     for (uint32_t i = lo; i < hi; ++i)
-      if (reaches(tris_[i])) {
-        *hint = i;
-        return true;
-      }
+      if (reaches(tris_[i])) return take(tris_[i]);
   }
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the
   // bound drops below every distance and the search ends.
@@ -173,7 +176,7 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint) const {
   search(p, bound2, [&](const LeafTriangle& t) {
     if (bound2 >= 0 && reaches(t)) {
       bound2 = -1;
-      if (hint) *hint = static_cast<uint32_t>(&t - tris_.data());
+      take(t);
     }
   });
   return bound2 < 0;

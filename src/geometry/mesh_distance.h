@@ -34,7 +34,8 @@ class MeshDistance {
   double distance(const Vec3& p) const;
   /// Whether some triangle lies within r of p (the search ends at the first one found).
   /// `hint` (opaque, optional): where a point close by found one; set to this one's.
-  bool within(const Vec3& p, double r, uint32_t* hint = nullptr) const;
+  /// `found` (optional): the distance to the triangle found, at most r.
+  bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
   /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when
   /// unsure: a triangle's bounds, its plane and its distance from the box's centre or its
   /// octants' centres each may prove it away).
