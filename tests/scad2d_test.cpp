@@ -702,6 +702,20 @@ TEST(ScadMinkowski, TwoDimensionalRoundedRectangle) {
   EXPECT_NEAR(area(outline_of("minkowski() { " + ell + " " + ell + " }")), 52, 1e-6);
 }
 
+// A notched pentagon plus a square turned 45 degrees: the sum's outline has 11 vertices (as
+// OpenSCAD's own output has), none where the sums of the convex pieces (cut at the notch's
+// heights) meet along a straight side -- a twisted extrusion splits each side quad, and such a
+// vertex took 4 % off its volume.
+TEST(ScadMinkowski, TwoDimensionalSumHasOnlyItsOwnVertices) {
+  const Outline o = outline_of(
+      "minkowski() { polygon(points = [[0, 0], [2.54, 0], [2.06, 2.31], [1, 1], [0, 2.2]]); "
+      "circle(r = 0.24, $fn = 4); }");
+  ASSERT_EQ(o.rings.size(), 1u);
+  EXPECT_EQ(o.rings[0].size(), 11u);
+  // OpenSCAD's area (its extrusion by 1, `openscad -o x.stl`: 6.305639198, STL-rounded).
+  EXPECT_NEAR(area(o), 6.305639, 1e-5);
+}
+
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
   EvalOptions o;
   o.depth = 7;

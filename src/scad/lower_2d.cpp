@@ -4,6 +4,7 @@
 #include <numbers>
 #include <string>
 
+#include "geometry/tolerances.h"
 #include "io/file_util.h"
 #include "scad/dxf.h"
 #include "scad/lower.h"
@@ -79,7 +80,10 @@ Region Lowering::shape(const Node& n, const Affine2& m) {
 }
 
 // 2D minkowski(): each operand cut into convex parts that cover it, the sum the union of the
-// hulls of the parts' vertex sums.
+// hulls of the parts' vertex sums. Where the sums of two neighbouring parts meet along the sum's
+// edge, the union leaves a vertex on that straight edge: dropped, so that the outline has the
+// vertices of the sum itself, as OpenSCAD's has (a twisted extrusion splits every side quad,
+// and one more vertex on a side changes its volume: 4 % for a notched pentagon).
 Region Lowering::minkowski_2d(const Node& n, const Affine2& m) {
   std::vector<Ring> acc;
   bool first = true;
@@ -103,7 +107,11 @@ Region Lowering::minkowski_2d(const Node& n, const Affine2& m) {
       }
     acc = std::move(next);
   }
-  return apply2(m, region_union({acc}));
+  const Region sum = region_union({acc});
+  double extent = 0;
+  for (const Ring& r : sum)
+    for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  return apply2(m, without_straight_vertices(sum, kStraightVertex * extent));
 }
 
 // The convex parts of a 2D operand: the children of its unions kept apart, each evaluated
