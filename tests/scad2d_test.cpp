@@ -712,8 +712,19 @@ TEST(ScadMinkowski, TwoDimensionalSumHasOnlyItsOwnVertices) {
       "circle(r = 0.24, $fn = 4); }");
   ASSERT_EQ(o.rings.size(), 1u);
   EXPECT_EQ(o.rings[0].size(), 11u);
-  // OpenSCAD's area (its extrusion by 1, `openscad -o x.stl`: 6.305639198, STL-rounded).
-  EXPECT_NEAR(area(o), 6.305639, 1e-5);
+  // The exact sum's area: its vertices are the pentagon's moved by the square's, but at the
+  // notch, where the side (1.82, 2.31)-(0.76, 1) meets (1.24, 1)-(0.24, 2.2) at t = 2.006 /
+  // 2.582 along the first (OpenSCAD's 6.30564 carries its fixed-point grid).
+  const double t = 2.006 / 2.582;
+  const Ring exact{{-0.24, 0}, {0, -0.24}, {2.54, -0.24}, {2.78, 0}, {2.30, 2.31}, {2.06, 2.55}, {1.82, 2.31},
+                   {1.82 - 1.06 * t, 2.31 - 1.31 * t}, {0.24, 2.2}, {0, 2.44}, {-0.24, 2.2}};
+  double expected = 0;
+  for (size_t i = 0; i < exact.size(); ++i) {
+    const auto& a = exact[i];
+    const auto& b = exact[(i + 1) % exact.size()];
+    expected += (a[0] * b[1] - b[0] * a[1]) / 2;
+  }
+  EXPECT_NEAR(area(o), expected, 1e-7);
 }
 
 TEST(ScadModel, BackgroundAndDisabledObjectsAreLeftOut) {
