@@ -113,6 +113,37 @@ TEST(Eval, TwistedQuadsSplitAsOpenScadSplitsThem) {
   EXPECT_NEAR(volume(detail::scad::extrude_linear(square, e)), 13.93333333, 1e-4);
 }
 
+// Slices when none are given: OpenSCAD 2021's counts (its output's triangles, `openscad -o
+// x.stl`, less the two caps' over 8 per slice of a square's 4 sides) for a square [0.51, 1.44]
+// (first four rows, height 2.08) and a unit square (height 0.1): a twist without scale walks
+// its helix, an even scale a section of an Archimedes spiral that ends at the unscaled radius
+// (3 slices at scale 1.5 and at 10, 4 at 3, where the true path grows with the scale), an
+// uneven one the more of the helix and its longest vertex path.
+TEST(Eval, LinearExtrudeSlicesAsOpenScadCountsThem) {
+  struct Case {
+    const char* twist_scale_height;
+    double square;
+    int slices;
+  };
+  const Case cases[] = {{"twist = 200, scale = 1, height = 2.08", 0, 3},
+                        {"twist = 200, scale = 2, height = 2.08", 0, 3},
+                        {"twist = 200, scale = [1.5, 0.7], height = 2.08", 0, 3},
+                        {"twist = 200, scale = 1.5, height = 20", 0, 11},
+                        {"twist = 360, scale = 3, height = 0.1", 1, 4},
+                        {"twist = 360, scale = 10, height = 0.1", 1, 3},
+                        {"twist = 360, scale = 1.2, height = 0.1", 1, 5},
+                        {"twist = 720, scale = 0.5, height = 0.1", 1, 7},
+                        {"twist = 1000, scale = 0.2, height = 0.1", 1, 9}};
+  for (const Case& c : cases) {
+    const std::string square = c.square > 0 ? "square(size = [1, 1]);" : "square(size = [0.51, 1.44]);";
+    EvalOptions o;
+    o.depth = 9;  // the 0.1 slabs a few cells thick in their cubes
+    EvalStats stats;
+    eval_csg(std::string("linear_extrude(") + c.twist_scale_height + ") { " + square + " }", o, &stats);
+    EXPECT_EQ(stats.triangles, size_t(8 * c.slices + 4)) << c.twist_scale_height;
+  }
+}
+
 // A leaf thinner than a finest cell (here a 1e-7 thick box; in GEB.scad a sliver ring of a 2D
 // difference, extruded) is empty at that depth, not an error that stops the whole model.
 TEST(Eval, FlatLeafIsEmpty) { expect_volume(eval_file("flat_leaf.csg"), 1000, 1e-3); }

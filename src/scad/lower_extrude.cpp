@@ -54,6 +54,57 @@ Region Lowering::shape_children(const Node& n, double st) {
   return r;
 }
 
+namespace {
+
+/// Length of an Archimedes spiral r = a phi from phi = 0 to theta.
+double spiral_length(double a, double theta) {
+  return a / 2 * (theta * std::sqrt(1 + theta * theta) + std::asinh(theta));
+}
+
+/// Slices of a linear_extrude given no `slices`, as OpenSCAD 2021.01 counts them (checked
+/// against its output): a twist takes the fewer of |twist| / $fa and the path of the
+/// outermost vertex / $fs, at least one per 120 degrees, or |twist| $fn / 360 with $fn set. The
+/// path is a helix of the unscaled radius -- or, scaled evenly, a section of an Archimedes
+/// spiral ending at that radius, as it measures it (a growing extrusion's spiral is taken to
+/// shrink to the radius over the scale). A scale different along x and y adds (its longest
+/// vertex path) / $fs, or $fn; otherwise one slice.
+int default_slices(const Region& s, const LinearExtrude& e, double fn, double fs, double fa) {
+  double r2 = 0, d2 = 0;
+  for (const Ring& ring : s)
+    for (const P2& p : ring) {
+      r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
+      const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
+      d2 = std::max(d2, dx * dx + dy * dy);
+    }
+  const bool uneven = e.scale[0] != e.scale[1];
+  int diagonal = 1;
+  if (uneven && std::sqrt(d2) >= kGridFine)
+    diagonal = fn > 0 ? std::max(int(fn), 1) : std::max(int(std::ceil(std::sqrt(d2 + e.height * e.height) / fs)), 1);
+  const double tw = std::abs(e.twist);
+  if (tw == 0) return diagonal;
+  const int least = std::max(int(std::ceil(tw / 120.0)), 1);
+  const double r = std::sqrt(r2);
+  int twisted = least;
+  if (r >= kGridFine) {
+    if (fn > 0) {
+      twisted = std::max(int(std::ceil(tw / 360.0 * fn)), least);
+    } else {
+      const double th = tw * std::numbers::pi / 180;
+      double flat = r * th;  // the helix's turn, flattened
+      if (!uneven && e.scale[0] != 1) {
+        const double sc = e.scale[0];
+        const double end = sc > 1 ? th * sc / (sc - 1) : th / (1 - sc);
+        flat = spiral_length(r / end, end) - spiral_length(r / end, end - th);
+      }
+      const int by_fs = int(std::ceil(std::hypot(flat, e.height) / fs)), by_fa = int(std::ceil(tw / fa));
+      twisted = std::max(std::min(by_fa, by_fs), least);
+    }
+  }
+  return uneven ? std::max(twisted, diagonal) : twisted;
+}
+
+}  // namespace
+
 Solid Lowering::linear_extrude(const Node& n, const Affine& m) {
   const Region s = shape_children(n, stretch(m));
   LinearExtrude e;
@@ -67,50 +118,8 @@ Solid Lowering::linear_extrude(const Node& n, const Affine& m) {
   }
   e.scale = {std::max(0.0, e.scale[0]), std::max(0.0, e.scale[1])};
   check_finite(n, {e.height, e.twist, e.scale[0], e.scale[1]});
-  // Slices when `slices` is not given, as OpenSCAD 2021.01 does (measured against its
-  // output; Calc::get_helix_slices / get_diagonal_slices): a twist takes the fewer of
-  // |twist| / $fa and (helix length of the outermost vertex) / $fs, at least one per 120
-  // degrees, or |twist| $fn / 360 when $fn is set; a non-uniform scale without twist takes
-  // (length of the longest vertex path) / $fs; otherwise one slice.
   int slices = static_cast<int>(number(n, "slices", 0));
-  if (slices <= 0) {
-    const double fn = number(n, "$fn", 0), fs = number(n, "$fs", 2), fa = number(n, "$fa", 12);
-    double r2 = 0, d2 = 0;
-    for (const Ring& ring : s)
-      for (const P2& p : ring) {
-        r2 = std::max(r2, p[0] * p[0] + p[1] * p[1]);
-        const double dx = p[0] * (e.scale[0] - 1), dy = p[1] * (e.scale[1] - 1);
-        d2 = std::max(d2, dx * dx + dy * dy);
-      }
-    const double tw = std::abs(e.twist);
-    slices = 1;
-    if (tw > 0) {
-      const int min_slices = std::max(static_cast<int>(std::ceil(tw / 120.0)), 1);
-      if (fn > 0) {
-        slices = std::max(static_cast<int>(std::ceil(tw / 360.0 * fn)), min_slices);
-      } else if (std::sqrt(r2) >= 0.00000095367431640625) {
-        // Length of the outermost vertex's path: a conical helix when scaled (Simpson's rule).
-        const double r0 = std::sqrt(r2), th = tw * std::numbers::pi / 180;
-        const double sc = std::max(e.scale[0], e.scale[1]);
-        auto speed = [&](double t) {
-          const double r = r0 * (1 + (sc - 1) * t), dr = r0 * (sc - 1);
-          return std::sqrt(r * r * th * th + dr * dr + e.height * e.height);
-        };
-        constexpr int kSteps = 64;
-        double len = speed(0) + speed(1);
-        for (int i = 1; i < kSteps; ++i) len += (i % 2 ? 4 : 2) * speed(double(i) / kSteps);
-        len /= 3.0 * kSteps;
-        const int fa_slices = static_cast<int>(std::ceil(tw / fa));
-        const int fs_slices = static_cast<int>(std::ceil(len / fs));
-        slices = std::max(std::min(fa_slices, fs_slices), min_slices);
-      } else {
-        slices = min_slices;
-      }
-    } else if (e.scale[0] != e.scale[1]) {
-      slices = fn > 0 ? std::max(static_cast<int>(fn), 1)
-                      : std::max(static_cast<int>(std::ceil(std::sqrt(d2 + e.height * e.height) / fs)), 1);
-    }
-  }
+  if (slices <= 0) slices = default_slices(s, e, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12));
   if (opt_.smooth && e.twist != 0) {
     // The walls follow helices: keep the chord of the largest radius below the tolerance.
     const auto [lo, hi] = x_range(s);

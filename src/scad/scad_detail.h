@@ -12,6 +12,9 @@
 
 namespace pic::detail::scad {
 
+/// OpenSCAD's GRID_FINE (2^-20): radii below it get the fewest fragments or slices.
+inline constexpr double kGridFine = 0.00000095367431640625;
+
 /// A literal of the .csg format: number, boolean, string, vector or undef.
 struct Value {
   enum class Kind { Undef, Number, Bool, String, Vector };

@@ -15,8 +15,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 double rad(double deg) { return deg * kPi / 180; }
 
-// OpenSCAD's GRID_FINE (2^-20): radii below it get the minimum of 3 fragments.
-constexpr double kGridFine = 0.00000095367431640625;
 // OpenSCAD's linear_extrude: two diagonals of a side quad whose lengths differ by less than
 // their mean over this count as equal (10 ppm).
 constexpr double kDiagonalTieRatio = 1e5;
