@@ -610,6 +610,11 @@ TEST(ScadResize, ToTheGivenSizeOrProportionally) {
   const double circle = area(outline_of("circle(r = 3, $fn = 30);"));
   EXPECT_NEAR(area(outline_of("resize(newsize = [10, 0], auto = true) { circle(r = 3, $fn = 30); }")),
               circle * 100 / 36, 1e-6);
+  // An axis left at 0 takes the factor of the axis given the largest new size, not the
+  // largest factor: a 1 x 1 x 4 box to x 2, z 3 has y scaled by 3 / 4 (OpenSCAD: volume 4.5).
+  const TriMesh auto_sized =
+      contour(eval_csg("resize(newsize = [2, 0, 3], auto = true) { cube(size = [1, 1, 4]); }", o));
+  EXPECT_NEAR(volume(auto_sized), 4.5, 4.5 * 1e-6);
 }
 
 // Malformed drawings are one clear error; a drawing with nothing closed in the layer is empty.

@@ -114,7 +114,8 @@ Solid Lowering::leaf(TriMesh mesh, const Affine& m) {
 }
 
 // resize(newsize, auto): per axis newsize / size where newsize > 0; an axis left at 0 keeps
-// its size, or with `auto` takes the largest factor of the axes given.
+// its size, or with `auto` takes the factor of the axis given the largest new size (as
+// OpenSCAD 2021 does: resize([2, 0, 3], auto = true) of a 1 x 1 x 4 box scales y by 3 / 4).
 std::array<double, 3> Lowering::resize_factors(const Node& n, const std::array<double, 3>& size, int dims) const {
   std::array<double, 3> want{0, 0, 0}, f{1, 1, 1};
   std::array<bool, 3> automatic{false, false, false};
@@ -132,13 +133,14 @@ std::array<double, 3> Lowering::resize_factors(const Node& n, const std::array<d
       automatic.fill(flag(n, "auto", false));
     }
   }
-  double largest = 0;
+  int widest = 0;  // the axis given the largest new size
   for (int a = 0; a < dims; ++a) {
     check_finite(n, {want[a]});
-    if (want[a] > 0 && size[a] > 0) largest = std::max(largest, f[a] = want[a] / size[a]);
+    if (want[a] > 0 && size[a] > 0) f[a] = want[a] / size[a];
+    if (want[a] > want[widest]) widest = a;
   }
   for (int a = 0; a < dims; ++a)
-    if (!(want[a] > 0) && automatic[a] && largest > 0) f[a] = largest;
+    if (!(want[a] > 0) && automatic[a]) f[a] = f[widest];
   return f;
 }
 
