@@ -379,7 +379,7 @@ class Simplifier {
     if (common != 2) return false;
     // A closed mesh of 4 vertices (a tetrahedron) would fold flat.
     if (s.ring_u.size() <= 3 && s.ring_v.size() <= 3) return false;
-    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x, s) && near_original(u, v, x, s);
+    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x, s) && near_original(x, s);
   }
 
   /// Whether every original point the stars of u and v answer for lies within the tolerance
@@ -440,13 +440,14 @@ class Simplifier {
     return true;
   }
 
-  /// Whether the new star lies within the tolerance of the original surface (the other way
-  /// round): its vertex, and each triangle's centroid (a long triangle across a fold). A point
-  /// near a triangle of the stars as they are now is as near the original as that triangle
-  /// (`off_`: how far each triangle was found from it at such points, 0 for one no collapse
-  /// has changed); else the original surface is searched, which the point must then reach. The
-  /// bounds found go to the new star (new_off).
-  bool near_original(uint32_t u, uint32_t v, const Vec3& x, Scratch& s) {
+  /// Whether the new star (keeps_points left it in `s`) lies within the tolerance of the
+  /// original surface (the other way round): its vertex x, and each triangle's centroid (a
+  /// long triangle across a fold) and side from x. A point near the triangle it lies on before
+  /// the collapse is as near the original as that triangle (`off_`: how far each triangle was
+  /// found from it at such points, 0 for one no collapse has changed); else the original
+  /// surface is searched, which the point must then reach. The bounds found go to the new
+  /// star (new_off).
+  bool near_original(const Vec3& x, Scratch& s) {
     const auto& star = s.star;
     const auto& corners = s.star_corners;
     auto& new_off = s.new_off;
