@@ -73,6 +73,13 @@ TEST(ScadOutline, OffsetMatchesOpenScad) {
             1e-4);
   EXPECT_LT(relative(area_of("offset(delta = 1, chamfer = true) { square(size = [5, 5]); }"), 48.313718), 1e-4);
   EXPECT_NEAR(area_of("offset(r = -1, $fn = 24) { square(size = [10, 10]); }"), 64, 1e-6);
+  // Six pieces per turn ask for 1.5 steps on a square's corner: one, as OpenSCAD's cosine of
+  // 30 degrees gives (its output: 8 vertices, each corner cut straight), where the cosine of
+  // the rounded radian angle gave two (12 vertices, 3 % more area on a small square).
+  const Outline six = outline_of("offset(r = 1, $fn = 6) { square(size = [4, 4], center = true); }");
+  ASSERT_EQ(six.rings.size(), 1u);
+  EXPECT_EQ(six.rings[0].size(), 8u);
+  EXPECT_NEAR(area(six), 16 + 4 * 4 + 4 * 0.5, 1e-6);
 }
 
 TEST(ScadOutline, PolygonPathsAreEvenOdd) {

@@ -181,9 +181,11 @@ Region Lowering::offset(const Node& n, const Affine2& m) {
   double tolerance = 0;
   if (by_r) {
     join = OffsetJoin::kRound;
-    // OpenSCAD: arcs of fragments_from_r(|r|) pieces per turn.
+    // OpenSCAD: arcs of fragments_from_r(|r|) pieces per turn. Clipper rounds a corner's
+    // steps to the nearest whole number, and a square's corner with 6 pieces per turn asks for
+    // 1.5: OpenSCAD's cosine of 30 degrees makes it one step.
     const int f = frags(n, std::abs(amount), stretch2(m) * stretch_3d_);
-    tolerance = std::abs(amount) * (1 - std::cos(std::numbers::pi / f));
+    tolerance = std::abs(amount) * (1 - cos_degrees(180.0 / f));
   }
   return apply2(m, region_offset(in, amount, join, tolerance));
 }

@@ -41,6 +41,11 @@ using Ring = std::vector<P2>;
 
 /// OpenSCAD's Calc::get_fragments_from_r: $fn if set (at least 3), else from $fa and $fs.
 int fragments_from_r(double r, double fn, double fs, double fa);
+/// The cosine of an angle in degrees as OpenSCAD takes it: exact at multiples of 30 and 45
+/// degrees (cos 30 is sqrt(3) / 2 rounded, one unit in the last place below the cosine of
+/// the rounded radian angle), which decides knife-edge counts such as the arc steps of an
+/// offset with $fn = 6.
+double cos_degrees(double deg);
 /// Regular polygon with `n` vertices at angles 360 i / n (OpenSCAD's circle placement).
 Ring circle_ring(double r, int n);
 /// OpenSCAD's sphere: (n + 1) / 2 rings at polar angles 180 (i + 0.5) / rings, n points each.

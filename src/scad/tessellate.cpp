@@ -41,6 +41,22 @@ void orient_outward(TriMesh& m) {
 
 }  // namespace
 
+double cos_degrees(double deg) {
+  if (!std::isfinite(deg)) return std::nan("");
+  double x = deg - 360 * std::floor(deg / 360);  // [0, 360)
+  bool negative = false;
+  if (x >= 180) x -= 180, negative = true;
+  if (x > 90) x = 180 - x, negative = !negative;
+  double c;
+  if (x == 0) c = 1;
+  else if (x == 30) c = std::sqrt(3.0) / 2;
+  else if (x == 45) c = std::sqrt(0.5);
+  else if (x == 60) c = 0.5;
+  else if (x == 90) c = 0;
+  else c = std::cos(rad(x));
+  return negative ? -c : c;
+}
+
 int fragments_from_r(double r, double fn, double fs, double fa) {
   if (r < kGridFine || std::isinf(fn) || std::isnan(fn)) return 3;
   if (fn > 0.0) return static_cast<int>(fn >= 3 ? fn : 3);
