@@ -7,8 +7,8 @@
 Where bench/scad_fuzz.py puts simple shapes on the lattice, these models lean on what a `.csg`
 file leaves to the evaluator: fragment counts from $fn, $fa and $fs; linear_extrude's slices,
 twist, scale (even, uneven, to a point) and wall diagonals; rotate_extrude by an angle; 2D
-booleans, offsets, hulls and Minkowski sums; polygons with holes; resize with auto; mirrors
-and shears. A case is reported when PIC's volume differs from OpenSCAD's CGAL render by more
+booleans, offsets, hulls and Minkowski sums; polygons with holes or crossing themselves;
+projections; text; rounded boxes; `%` and `*` parts; resize with auto; mirrors and shears. A case is reported when PIC's volume differs from OpenSCAD's CGAL render by more
 than 0.5 % at DEPTH and two levels deeper still by more than 0.1 % and more than half as much
 (sampling error shrinks with the cell, a different shape does not). OpenSCAD itself fails on some models (a twisted
 extrusion to a point with a hole is not closed, and CGAL then drops it from the Boolean): its
@@ -35,7 +35,7 @@ def resolution(r):
 
 
 def shape2(r, depth):
-    kinds = ["square", "circle", "polygon", "holed"] + (["difference", "union", "offset", "hull", "minkowski"] if depth else [])
+    kinds = ["square", "circle", "polygon", "holed", "crossed"] + (["difference", "union", "offset", "hull", "minkowski"] if depth else [])
     k = r.choice(kinds)
     if k == "square":
         return "square([%g,%g], center=%s);" % (num(r, 0.5, 4), num(r, 0.5, 4), r.choice(["true", "false"]))
@@ -43,6 +43,8 @@ def shape2(r, depth):
         return "circle(r=%g%s);" % (num(r, 0.3, 3), resolution(r))
     if k == "polygon":
         return "polygon([[0,0],[%g,0],[%g,%g],[1,1],[0,%g]]);" % (num(r, 2, 4), num(r, 2, 4), num(r, 1, 3), num(r, 2, 4))
+    if k == "crossed":  # a bow tie: its two lobes filled
+        return "polygon([[0,0],[%g,%g],[%g,0],[0,%g]]);" % ((num(r, 2, 4),) * 2 + (num(r, 2, 4), num(r, 2, 4)))
     if k == "holed":
         return "polygon(points=[[0,0],[4,0],[4,4],[0,4],[1,1],[3,1],[3,3],[1,3]], paths=[[0,1,2,3],[4,5,6,7]]);"
     if k in ("difference", "union"):
@@ -56,9 +58,23 @@ def shape2(r, depth):
 
 
 def solid(r):
-    k = r.choice(["sphere", "cylinder", "cone", "pyramid", "linear", "rotate", "rotate_angle", "hull"])
+    k = r.choice(["sphere", "cylinder", "cone", "pyramid", "linear", "rotate", "rotate_angle", "hull",
+                  "projection", "text", "modifier", "rounded_box"])
     if k == "sphere":
-        return "sphere(r=%g%s);" % (num(r, 0.5, 3), resolution(r))
+        return "sphere(%s=%g%s);" % (r.choice(["r", "d"]), num(r, 0.5, 3), resolution(r))
+    if k == "projection":
+        cut = r.choice(["", "cut=true"])
+        return "linear_extrude(%g) projection(%s) translate([0,0,%g]) rotate([%d,%d,0]) %s" % (
+            num(r, 0.5, 2), cut, num(r, -0.5, 0.5), r.choice([0, 30, 60]), r.choice([0, 45]),
+            r.choice(["cube([2,1,3], center=true);", "sphere(1.5%s);" % resolution(r)]))
+    if k == "text":
+        return 'linear_extrude(1) text("%s", size=%g, halign="%s");' % (
+            r.choice(["A", "Hi", "g8"]), num(r, 2, 4), r.choice(["left", "center", "right"]))
+    if k == "modifier":  # a background or disabled part is not in the model
+        return "union() { cube(%g); %s translate([1,0,0]) sphere(1%s); }" % (num(r, 1, 2), r.choice(["%", "*"]), resolution(r))
+    if k == "rounded_box":
+        return "minkowski() { cube([%g,%g,%g]); sphere(r=%g, $fn=%d); }" % (
+            num(r, 0.5, 2), num(r, 0.5, 2), num(r, 0.5, 2), num(r, 0.1, 0.5), r.choice([6, 8, 12]))
     if k == "cylinder":
         return "cylinder(h=%g, r=%g, center=%s%s);" % (num(r, 1, 4), num(r, 0.3, 2.5), r.choice(["true", "false"]), resolution(r))
     if k == "cone":
