@@ -144,6 +144,17 @@ TEST(Eval, LinearExtrudeSlicesAsOpenScadCountsThem) {
   }
 }
 
+// A polygon crossing itself (a bow tie) is two lobes touching at a point; each ring's nesting
+// was asked at its first vertex, which is that point, on the other ring: one lobe became the
+// other's hole and the extrusion was half of OpenSCAD's 4.5.
+TEST(Eval, RingsTouchingAtAPointAreNotNested) {
+  EvalOptions o;
+  o.depth = 8;
+  const TriMesh m = unsplit_contour(
+      eval_csg("linear_extrude(height = 1) { polygon(points = [[0, 0], [3, 3], [3, 0], [0, 3]], paths = undef); }", o));
+  EXPECT_NEAR(volume(m), 4.5, 4.5 * 1e-3);
+}
+
 // A leaf thinner than a finest cell (here a 1e-7 thick box; in GEB.scad a sliver ring of a 2D
 // difference, extruded) is empty at that depth, not an error that stops the whole model.
 TEST(Eval, FlatLeafIsEmpty) { expect_volume(eval_file("flat_leaf.csg"), 1000, 1e-3); }

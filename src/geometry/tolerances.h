@@ -134,8 +134,9 @@ inline constexpr double kPieceVolume = 1e-7;
 inline constexpr double kFlatFaceTolerance = 1e-6;
 /// A 2D ring is convex when its hull's area exceeds its own by at most this fraction.
 inline constexpr double kConvexArea = 1e-9;
-/// A vertex of a 2D Minkowski sum off the line through its neighbours by less than this times
-/// the sum's extent lies on a straight edge (Clipper's grid is about 1e-9 of it).
+/// A 2D point nearer than this times the region's extent to a line or a ring lies on it
+/// (Clipper's grid is about 1e-9 of the extent): a vertex left on a Minkowski sum's straight
+/// side, a vertex where two rings touch.
 inline constexpr double kStraightVertex = 1e-8;
 /// The smallest arc tolerance of a 2D offset, so a zero request cannot ask for endless arcs.
 inline constexpr double kMinArcTolerance = 1e-9;

@@ -3,11 +3,23 @@
 #include <cmath>
 #include <numbers>
 
+#include "geometry/tolerances.h"
 #include "scad/lowering.h"
 #include "scad/region.h"
 #include "geometry/vec3.h"
 
 namespace pic::detail::scad {
+
+namespace {
+
+/// Distance from p to the segment ab.
+double segment_distance(const P2& p, const P2& a, const P2& b) {
+  const double dx = b[0] - a[0], dy = b[1] - a[1], len2 = dx * dx + dy * dy;
+  const double t = len2 > 0 ? std::clamp(((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
+}
+
+}  // namespace
 
 // A region's rings (which do not cross) -> Booleans of extruded simple rings: each ring at
 // even nesting depth minus the rings directly inside it.
@@ -25,10 +37,27 @@ Solid Lowering::extrude(const Region& region, const Extrude& ext) {
         in = !in;
     return in;
   };
+  double extent = 0;
+  for (const Ring& r : rings)
+    for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  const double touch = kStraightVertex * extent;
+  // Rings may touch at a vertex (a bow tie's two lobes): whether ring a lies inside ring b is
+  // asked at a vertex of a, or the middle of a side, that is not on b.
+  auto nested = [&](const Ring& a, const Ring& b) {
+    for (int middles = 0; middles < 2; ++middles)
+      for (size_t i = 0; i < a.size(); ++i) {
+        const P2& q = a[(i + 1) % a.size()];
+        const P2 p = middles ? P2{(a[i][0] + q[0]) / 2, (a[i][1] + q[1]) / 2} : a[i];
+        bool on = false;
+        for (size_t k = 0; k < b.size() && !on; ++k) on = segment_distance(p, b[k], b[(k + 1) % b.size()]) <= touch;
+        if (!on) return inside(p, b);
+      }
+    return false;
+  };
   std::vector<int> depth(n, 0), parent(n, -1);
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j)
-      if (i != j && inside(rings[i][0], rings[j])) {
+      if (i != j && nested(rings[i], rings[j])) {
         ++depth[i];
         if (parent[i] < 0 || std::abs(signed_area(rings[j])) < std::abs(signed_area(rings[size_t(parent[i])])))
           parent[i] = static_cast<int>(j);
