@@ -12,7 +12,9 @@ projections; text; rounded boxes; `%` and `*` parts; resize with auto; mirrors a
 than 0.5 % at DEPTH and two levels deeper still by more than 0.1 % and more than half as much
 (sampling error shrinks with the cell, a different shape does not). OpenSCAD itself fails on some models (a twisted
 extrusion to a point with a hole is not closed, and CGAL then drops it from the Boolean): its
-stderr is kept in OUTDIR/SEED/openscad.err, read it before calling a case PIC's.
+stderr is kept in OUTDIR/SEED/openscad.err and a reported line says when it holds an ERROR:
+read it before calling a case PIC's. A negative OpenSCAD volume (a polyhedron whose faces
+turn inward, written as given) is compared by its size.
 """
 import json
 import os
@@ -165,17 +167,26 @@ def main():
         if expected is None or got is None:
             print(seed, "skipped: pic %s, openscad %s %s" % (got, expected, why))
             continue
-        off = abs(got - expected) / max(abs(expected), 1e-12)
+        # OpenSCAD writes a polyhedron given with faces turned inward as it is (a negative
+        # volume); PIC turns it outward.
+        inverted = expected < 0
+        expected = abs(expected)
+        with open(os.path.join(d, "openscad.err")) as err:
+            failed = "ERROR" in err.read()
+        off = abs(got - expected) / max(expected, 1e-12)
         if off > 5e-3:
             finer, _ = pic_volume(csg, os.path.join(d, "pic_finer.stl"), depth + 2)
             off_finer = abs(finer - expected) / max(abs(expected), 1e-12) if finer is not None else 1
             if off_finer > 1e-3 and off_finer > off / 2:
                 reported += 1
-                print(seed, "DIFF pic %.6g (depth %d: %.6g) openscad %.6g" % (got, depth + 2, finer or 0, expected))
+                # OpenSCAD's own ERROR (a mesh it cannot close is left out of its Boolean) is
+                # more often the cause than PIC: said on the line.
+                print(seed, "DIFF pic %.6g (depth %d: %.6g) openscad %.6g%s" % (
+                    got, depth + 2, finer or 0, expected, " (openscad reported an ERROR)" if failed else ""))
             else:
                 print(seed, "ok %.2e at depth %d (%.2e at %d)" % (off_finer, depth + 2, off, depth))
             continue
-        print(seed, "ok %.2e" % off)
+        print(seed, "ok %.2e%s" % (off, " (openscad's mesh inside out)" if inverted else ""))
     print("%d of %d reported" % (reported, count))
 
 
