@@ -94,7 +94,8 @@ TEST(Eval, TwistedBandKeepsItsVolume) {
 // the axis have diagonals of equal length, and OpenSCAD 2021 splits those by the twist's
 // direction. Volumes of OpenSCAD's own output (`openscad -o x.stl`, CGAL): 23.26630439 and,
 // twisted the other way, 23.26628369; a square centred on the axis scaled unevenly without a
-// twist (every quad a tie) 13.93333333. Ties taken by rounding gave 23.11 for the first.
+// twist (every quad a tie) 13.93333333, each within the STL's rounding. Ties taken by rounding
+// gave 23.16 and 22.90.
 TEST(Eval, TwistedQuadsSplitAsOpenScadSplitsThem) {
   const detail::scad::Ring rectangle{{0, 0}, {3.28, 0}, {3.28, 1.83}, {0, 1.83}};
   detail::scad::LinearExtrude e;

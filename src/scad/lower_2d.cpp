@@ -108,10 +108,7 @@ Region Lowering::minkowski_2d(const Node& n, const Affine2& m) {
     acc = std::move(next);
   }
   const Region sum = region_union({acc});
-  double extent = 0;
-  for (const Ring& r : sum)
-    for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
-  return apply2(m, without_straight_vertices(sum, kStraightVertex * extent));
+  return apply2(m, without_straight_vertices(sum, kStraightVertex * region_extent(sum)));
 }
 
 // The convex parts of a 2D operand: the children of its unions kept apart, each evaluated

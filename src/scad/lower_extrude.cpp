@@ -19,72 +19,6 @@ double segment_distance(const P2& p, const P2& a, const P2& b) {
   return std::hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
 }
 
-}  // namespace
-
-// A region's rings (which do not cross) -> Booleans of extruded simple rings: each ring at
-// even nesting depth minus the rings directly inside it.
-template <class Extrude>
-Solid Lowering::extrude(const Region& region, const Extrude& ext) {
-  std::vector<Ring> rings;
-  for (const Ring& r : region)
-    if (r.size() >= 3 && signed_area(r) != 0) rings.push_back(r);
-  const size_t n = rings.size();
-  auto inside = [](const P2& p, const Ring& r) {
-    bool in = false;
-    for (size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
-      if ((r[i][1] > p[1]) != (r[j][1] > p[1]) &&
-          p[0] < (r[j][0] - r[i][0]) * (p[1] - r[i][1]) / (r[j][1] - r[i][1]) + r[i][0])
-        in = !in;
-    return in;
-  };
-  double extent = 0;
-  for (const Ring& r : rings)
-    for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
-  const double touch = kStraightVertex * extent;
-  // Rings may touch at a vertex (a bow tie's two lobes): whether ring a lies inside ring b is
-  // asked at a vertex of a, or the middle of a side, that is not on b.
-  auto nested = [&](const Ring& a, const Ring& b) {
-    for (int middles = 0; middles < 2; ++middles)
-      for (size_t i = 0; i < a.size(); ++i) {
-        const P2& q = a[(i + 1) % a.size()];
-        const P2 p = middles ? P2{(a[i][0] + q[0]) / 2, (a[i][1] + q[1]) / 2} : a[i];
-        bool on = false;
-        for (size_t k = 0; k < b.size() && !on; ++k) on = segment_distance(p, b[k], b[(k + 1) % b.size()]) <= touch;
-        if (!on) return inside(p, b);
-      }
-    return false;
-  };
-  std::vector<int> depth(n, 0), parent(n, -1);
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j)
-      if (i != j && nested(rings[i], rings[j])) {
-        ++depth[i];
-        if (parent[i] < 0 || std::abs(signed_area(rings[j])) < std::abs(signed_area(rings[size_t(parent[i])])))
-          parent[i] = static_cast<int>(j);
-      }
-  std::vector<Solid> outers;
-  for (size_t i = 0; i < n; ++i) {
-    if (depth[i] % 2) continue;
-    std::vector<Solid> parts;
-    parts.push_back(leaf(ext(rings[i]), kIdentity));
-    for (size_t j = 0; j < n; ++j)
-      if (parent[j] == static_cast<int>(i) && depth[j] == depth[i] + 1) parts.push_back(leaf(ext(rings[j]), kIdentity));
-    outers.push_back(combine(Solid::Kind::Difference, std::move(parts)));
-  }
-  return combine(Solid::Kind::Union, std::move(outers));
-}
-
-Region Lowering::shape_children(const Node& n, double st) {
-  if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
-    return import_2d(n);
-  stretch_3d_ = st;
-  Region r = region_union(children2(n, kIdentity2));
-  stretch_3d_ = 1;
-  return r;
-}
-
-namespace {
-
 /// Length of an Archimedes spiral r = a phi from phi = 0 to theta.
 double spiral_length(double a, double theta) {
   return a / 2 * (theta * std::sqrt(1 + theta * theta) + std::asinh(theta));
@@ -133,6 +67,65 @@ int default_slices(const Region& s, const LinearExtrude& e, double fn, double fs
 }
 
 }  // namespace
+
+// A region's rings (which do not cross) -> Booleans of extruded simple rings: each ring at
+// even nesting depth minus the rings directly inside it.
+template <class Extrude>
+Solid Lowering::extrude(const Region& region, const Extrude& ext) {
+  std::vector<Ring> rings;
+  for (const Ring& r : region)
+    if (r.size() >= 3 && signed_area(r) != 0) rings.push_back(r);
+  const size_t n = rings.size();
+  auto inside = [](const P2& p, const Ring& r) {
+    bool in = false;
+    for (size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
+      if ((r[i][1] > p[1]) != (r[j][1] > p[1]) &&
+          p[0] < (r[j][0] - r[i][0]) * (p[1] - r[i][1]) / (r[j][1] - r[i][1]) + r[i][0])
+        in = !in;
+    return in;
+  };
+  const double touch = kStraightVertex * region_extent(rings);
+  // Rings may touch at a vertex (a bow tie's two lobes): whether ring a lies inside ring b is
+  // asked at a vertex of a, or the middle of a side, that is not on b.
+  auto nested = [&](const Ring& a, const Ring& b) {
+    for (int middles = 0; middles < 2; ++middles)
+      for (size_t i = 0; i < a.size(); ++i) {
+        const P2& q = a[(i + 1) % a.size()];
+        const P2 p = middles ? P2{(a[i][0] + q[0]) / 2, (a[i][1] + q[1]) / 2} : a[i];
+        bool on = false;
+        for (size_t k = 0; k < b.size() && !on; ++k) on = segment_distance(p, b[k], b[(k + 1) % b.size()]) <= touch;
+        if (!on) return inside(p, b);
+      }
+    return false;
+  };
+  std::vector<int> depth(n, 0), parent(n, -1);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      if (i != j && nested(rings[i], rings[j])) {
+        ++depth[i];
+        if (parent[i] < 0 || std::abs(signed_area(rings[j])) < std::abs(signed_area(rings[size_t(parent[i])])))
+          parent[i] = static_cast<int>(j);
+      }
+  std::vector<Solid> outers;
+  for (size_t i = 0; i < n; ++i) {
+    if (depth[i] % 2) continue;
+    std::vector<Solid> parts;
+    parts.push_back(leaf(ext(rings[i]), kIdentity));
+    for (size_t j = 0; j < n; ++j)
+      if (parent[j] == static_cast<int>(i) && depth[j] == depth[i] + 1) parts.push_back(leaf(ext(rings[j]), kIdentity));
+    outers.push_back(combine(Solid::Kind::Difference, std::move(parts)));
+  }
+  return combine(Solid::Kind::Union, std::move(outers));
+}
+
+Region Lowering::shape_children(const Node& n, double st) {
+  if (arg(n, "file") && arg(n, "file")->kind == Value::Kind::String && !arg(n, "file")->text.empty())
+    return import_2d(n);
+  stretch_3d_ = st;
+  Region r = region_union(children2(n, kIdentity2));
+  stretch_3d_ = 1;
+  return r;
+}
 
 Solid Lowering::linear_extrude(const Node& n, const Affine& m) {
   const Region s = shape_children(n, stretch(m));

@@ -17,9 +17,7 @@ namespace cl = ClipperLib;
 
 double fitted_scale(std::initializer_list<const Region*> regions) {
   double extent = 0;
-  for (const Region* r : regions)
-    for (const Ring& ring : *r)
-      for (const P2& p : ring) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  for (const Region* r : regions) extent = std::max(extent, region_extent(*r));
   if (!(extent > 0)) return 1;
   return std::exp2(std::floor(std::log2(double(0x3FFFFFFF) / extent)));
 }
@@ -69,6 +67,13 @@ Region clip(const Region& subject, const Region& clip_region, cl::ClipType type,
 }
 
 }  // namespace
+
+double region_extent(const Region& region) {
+  double extent = 0;
+  for (const Ring& r : region)
+    for (const P2& p : r) extent = std::max({extent, std::abs(p[0]), std::abs(p[1])});
+  return extent;
+}
 
 Region region_even_odd(const std::vector<Ring>& rings) { return clip(rings, {}, cl::ctUnion, cl::pftEvenOdd); }
 
@@ -247,9 +252,7 @@ std::vector<Ring> convex_pieces(const Region& region) {
   // Rings that touch along an edge (Clipper's union of a fan can end so) cross each strip
   // there at one place, give or take Clipper's grid (about 1e-9 of the extent), bounding a
   // strip of no width: a segment, nothing in the region but a solid once summed with a body.
-  double scale = 0;
-  for (const Ring& r : region)
-    for (const P2& p : r) scale = std::max({scale, std::abs(p[0]), std::abs(p[1])});
+  const double scale = region_extent(region);
   std::erase_if(out, [&](const Ring& r) {
     double diameter = 0;
     for (const P2& a : r)

@@ -31,6 +31,8 @@ std::vector<Ring> rings_from_segments(const std::vector<Segment>& segs, double t
 
 /// Area (holes subtracted).
 double region_area(const Region& region);
+/// The largest |x| or |y| of the region's points: the scale its tolerances are taken in.
+double region_extent(const Region& region);
 
 /// Whether a counter-clockwise ring turns left (or goes straight) at every vertex.
 bool convex_ring(const Ring& ring);
