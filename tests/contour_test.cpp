@@ -605,7 +605,7 @@ TEST(ContourConstruction, AddedPointsStayOnTheSurface) {
   ContourOptions c;
   c.split_sheets = false;  // keep the added points at the end of the vertex list
   const TriMesh m = contour(t, c, &st);
-  ASSERT_GT(st.face_points, 10000u);
+  ASSERT_GT(st.face_points, 2000u);
   const size_t added = st.face_points + st.fans;
   const std::vector<Vec3> points(m.positions.end() - std::ptrdiff_t(added), m.positions.end());
   const std::vector<double> d = distance_to_mesh(input, points);

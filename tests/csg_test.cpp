@@ -455,8 +455,12 @@ TEST(Csg, SculptingStaysClosedAndManifold) {
 TEST(Csg, UnionOfDisjointPartsIsThePartsThemselves) {
   const int depth = 10;
   const Octree a = sample_in_unit(make_sphere({0.27, 0.5, 0.5}, 0.2, 96), depth);
-  const Octree b = sample_in_unit(make_torus({0.73, 0.5, 0.5}, 0.14, 0.06, 2, 96), depth);
-  ASSERT_GT(b.nodes.size(), size_t{1} << 15) << "large enough to be copied as a part";
+  SampleOptions fine;  // a finely faceted torus sampled to a tight error: many cells
+  fine.depth = depth;
+  fine.cube = kUnit;
+  fine.error = 1e-10;
+  const Octree b = sample(make_torus({0.73, 0.5, 0.5}, 0.14, 0.06, 2, 192), fine);
+  ASSERT_GT(b.nodes.size(), size_t{1} << 15) << b.nodes.size() << " nodes: large enough to be copied as a part";
   Octree u = a;
   csg_inplace(u, b, CsgOp::Union);
   const TriMesh m = unsplit_contour(u);

@@ -409,6 +409,7 @@ class Combiner {
     const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
     Qef::Solution sol = q.sum.solve_in_box(seed, lo, hi);
     if (!inside_cell(sol.position, cell)) sol = cell_vertex(q.sum, cell, sr, true);
+    sol = sharpen(q.sum, cell, sr, sol, seed, true, error_);
     if (sol.error < error_ && inside_cell(sol.position, cell) && one_component(sr) &&
         feature_is_local(a_, b_, cell, sol.position, error_, scratch_))
       return out_.gray(cell, sr, sol.position, 0);

@@ -47,11 +47,12 @@ bool in_box(const Eigen::Vector3d& x, const Vec3& lo, const Vec3& hi) {
 
 }  // namespace
 
-Qef::Solution Qef::solve(const Vec3& seed) const {
-  return solve_in_box(seed, {-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge});
+Qef::Solution Qef::solve(const Vec3& seed, double cutoff) const {
+  return solve_in_box(seed, {-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge}, cutoff);
 }
 
-Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi) const {
+Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, double cutoff) const {
+  const bool damped = cutoff < kRelativeCutoff;
   if (weight <= 0) return {seed, 0, 0};
   Eigen::Matrix3d m;
   m << a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5];
@@ -63,11 +64,12 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
   const double top = std::max({std::abs(ev[0]), std::abs(ev[1]), std::abs(ev[2])});
   Eigen::Vector3d inv = Eigen::Vector3d::Zero();
   int rank = 0;
+  std::array<bool, 3> fixed{};
   for (int k = 0; k < 3; ++k) {
-    if (top > 0 && std::abs(ev[k]) > kRelativeCutoff * top) {
-      inv[k] = 1.0 / ev[k];
-      ++rank;
-    }
+    fixed[k] = top > 0 && std::abs(ev[k]) > cutoff * top;
+    rank += fixed[k];
+    if (damped && top > 0) inv[k] = 1.0 / (std::abs(ev[k]) + cutoff * top);
+    else if (fixed[k]) inv[k] = 1.0 / ev[k];
   }
   const Eigen::Matrix3d& u = eig.eigenvectors();
   Eigen::Vector3d x = s + u * inv.asDiagonal() * (u.transpose() * r);
@@ -75,7 +77,7 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
     // A crease: the minimizers form the line x + t d. Clip it to the box.
     Eigen::Vector3d d;
     for (int k = 0; k < 3; ++k)
-      if (inv[k] == 0) d = u.col(k);
+      if (!fixed[k]) d = u.col(k);
     double t0 = -kHuge, t1 = kHuge;
     for (int k = 0; k < 3; ++k) {
       if (std::abs(d[k]) < kTinyDivisor) {
@@ -92,7 +94,7 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
     // A plane: the centroid of its section with the box (where it crosses the box edges).
     Eigen::Vector3d n = Eigen::Vector3d::Zero();  // rank 1: one column below is taken
     for (int k = 0; k < 3; ++k)
-      if (inv[k] != 0) n = u.col(k);
+      if (fixed[k]) n = u.col(k);
     const double off = n.dot(x);
     Eigen::Vector3d acc = Eigen::Vector3d::Zero();
     int cnt = 0;

@@ -4,6 +4,7 @@
 
 #include <array>
 
+#include "geometry/tolerances.h"
 #include "pic/types.h"
 
 namespace pic::detail {
@@ -29,11 +30,11 @@ struct Qef {
   /// x = seed + A+ (b - A seed), A+ by truncated eigendecomposition (Lindstrom 2000):
   /// eigenvalues below kRelativeCutoff * largest are zeroed, so flat and creased patches
   /// keep the vertex close to the seed along their free directions.
-  Solution solve(const Vec3& seed) const;
+  Solution solve(const Vec3& seed, double cutoff = kRelativeCutoff) const;
   /// As solve(), but when the minimum leaves the box [lo, hi] and the QEF has free
   /// directions (a crease line or a plane), slides along them to a point inside the box:
   /// the middle of the line's chord through the box, or the centroid of the plane's section.
-  Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi) const;
+  Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, double cutoff = kRelativeCutoff) const;
 };
 
 }  // namespace pic::detail

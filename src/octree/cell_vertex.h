@@ -14,7 +14,15 @@ namespace pic::detail {
 /// one corner differs from the other seven takes that corner as its vertex when the planes pass
 /// through it and leave the vertex free: two parts touching at a lattice point, as a Boolean
 /// meets them.
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner = false);
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner = false,
+                          double cutoff = kRelativeCutoff);
+/// cell_vertex, or, where its residual is `error` or more, the vertex with every direction the
+/// planes fix solved (kSharpCutoff) when that one lies in the cell and fits better: a shallow
+/// crease's vertex on its line, so the cell need not split until the crease looks flat.
+Qef::Solution cell_vertex_sharp(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, double error);
+/// The same second solve for a vertex found some other way (`sol`, seeded at `seed`).
+Qef::Solution sharpen(const Qef& q, const Cell& cell, uint8_t signs, const Qef::Solution& sol, const Vec3& seed,
+                      bool tip_at_corner, double error);
 bool inside_cell(const Vec3& x, const Cell& cell);
 
 }  // namespace pic::detail

@@ -135,7 +135,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     const bool planeless = p.partial_contour && !meets_box(src.tris(), idx, cell.box());
     if (!planeless) cell_qef(src.tris(), idx, cell, q);
     src.add_fill_planes(cell, signs, wind, idx, q);
-    const Qef::Solution sol = cell_vertex(q, cell, signs, p.tips_at_corners);
+    const Qef::Solution sol = cell_vertex_sharp(q, cell, signs, p.tips_at_corners, p.error);
     const bool ok = sol.error < p.error && inside_cell(sol.position, cell) && one_component(signs) &&
                     !has_double_crossing(src.tris(), idx, cell, signs, p.edge_memo);
     if (ok || at_cap) {
