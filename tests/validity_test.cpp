@@ -347,7 +347,9 @@ TEST(Validity, CoarseSidesAreSplitAtTheirFace) {
   ContourStats st;
   contour(t, {}, &st);
   EXPECT_GT(st.face_points, 0u);
-  expect_construction_keeps_the_surface(t, input, 0.6, "suzanne depth 12");
+  // Suzanne's farthest points lie on the winding number's caps over its holes, 7-9 cells from
+  // any input triangle whichever split is taken (there is no surface to keep): a wider slack.
+  expect_construction_keeps_the_surface(t, input, 1.5, "suzanne depth 12");
 }
 
 // The Thingi10K difference pair (1706459 − 1514499, both sampled in one cube). The

@@ -214,8 +214,8 @@ bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, co
   scratch.clear();
   xb.bvh.query(xb.tris, g.lo, g.hi, scratch);
   box_qef(xb.tris, scratch, g, face, q);
-  // A shallow crease over the grown cell is still one line (see kSharpCutoff).
-  return q.solve(x).error < error || q.solve(x, kSharpCutoff).error < error;
+  // A shallow crease over the grown cell is still one line (see Qef::Pinv::Damped).
+  return q.solve(x).error < error || q.solve(x, Qef::Pinv::Damped).error < error;
 }
 
 /// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a

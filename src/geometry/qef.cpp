@@ -47,12 +47,13 @@ bool in_box(const Eigen::Vector3d& x, const Vec3& lo, const Vec3& hi) {
 
 }  // namespace
 
-Qef::Solution Qef::solve(const Vec3& seed, double cutoff) const {
-  return solve_in_box(seed, {-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge}, cutoff);
+Qef::Solution Qef::solve(const Vec3& seed, Pinv pinv) const {
+  return solve_in_box(seed, {-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge}, pinv);
 }
 
-Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, double cutoff) const {
-  const bool damped = cutoff < kRelativeCutoff;
+Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, Pinv pinv) const {
+  const bool damped = pinv == Pinv::Damped;
+  const double cutoff = damped ? kSharpDamping : kRelativeCutoff;
   if (weight <= 0) return {seed, 0, 0};
   Eigen::Matrix3d m;
   m << a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5];
@@ -68,7 +69,7 @@ Qef::Solution Qef::solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi
   for (int k = 0; k < 3; ++k) {
     fixed[k] = top > 0 && std::abs(ev[k]) > cutoff * top;
     rank += fixed[k];
-    if (damped && top > 0) inv[k] = 1.0 / (std::abs(ev[k]) + cutoff * top);
+    if (damped && top > 0) inv[k] = ev[k] / (ev[k] * ev[k] + cutoff * top * cutoff * top);
     else if (fixed[k]) inv[k] = 1.0 / ev[k];
   }
   const Eigen::Matrix3d& u = eig.eigenvectors();

@@ -4,7 +4,6 @@
 
 #include <array>
 
-#include "geometry/tolerances.h"
 #include "pic/types.h"
 
 namespace pic::detail {
@@ -30,11 +29,15 @@ struct Qef {
   /// x = seed + A+ (b - A seed), A+ by truncated eigendecomposition (Lindstrom 2000):
   /// eigenvalues below kRelativeCutoff * largest are zeroed, so flat and creased patches
   /// keep the vertex close to the seed along their free directions.
-  Solution solve(const Vec3& seed, double cutoff = kRelativeCutoff) const;
+  /// How A+ treats small eigenvalues λ: Truncated drops those below kRelativeCutoff of the
+  /// largest; Damped takes λ/(λ² + μ²) with μ = kSharpDamping times the largest, continuous in
+  /// the planes and exact to (μ/λ)² where λ is well above μ (a shallow crease's line).
+  enum class Pinv { Truncated, Damped };
+  Solution solve(const Vec3& seed, Pinv pinv = Pinv::Truncated) const;
   /// As solve(), but when the minimum leaves the box [lo, hi] and the QEF has free
   /// directions (a crease line or a plane), slides along them to a point inside the box:
   /// the middle of the line's chord through the box, or the centroid of the plane's section.
-  Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, double cutoff = kRelativeCutoff) const;
+  Solution solve_in_box(const Vec3& seed, const Vec3& lo, const Vec3& hi, Pinv pinv = Pinv::Truncated) const;
 };
 
 }  // namespace pic::detail

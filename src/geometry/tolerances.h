@@ -33,11 +33,12 @@ inline constexpr double kProductRounding = 1e-12;
 /// Relative eigenvalue cutoff of the QEF's pseudo-inverse. Singular values of A^(1/2) below 0.1
 /// of the largest are dropped, as in Ju et al. 2002 (dual contouring).
 inline constexpr double kRelativeCutoff = 1e-2;
-/// The cutoff of a second solve where the first leaves the residual above δ²: two planes a
-/// few degrees apart (a faceted sphere's crease, 12° in OpenSCAD's default) have a weakest
-/// eigenvalue near or below kRelativeCutoff, so the first solve takes their crease for a plane
-/// and puts the vertex off it; this one keeps every direction the planes fix to 1 %.
-inline constexpr double kSharpCutoff = 1e-4;
+/// The damping of the QEF's sharp solve (relative to the largest eigenvalue; Qef::Pinv::Damped).
+/// Two planes a few degrees apart (a faceted sphere's crease, 12° in OpenSCAD's default) have
+/// a weakest eigenvalue near or below kRelativeCutoff, so the truncated solve takes their
+/// crease for a plane and puts the vertex off it; the sharp one solves every direction well
+/// above this.
+inline constexpr double kSharpDamping = 1e-6;
 
 // ---- octree/ -------------------------------------------------------------------------------
 

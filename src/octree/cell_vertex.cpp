@@ -15,7 +15,7 @@ bool inside_cell(const Vec3& x, const Cell& cell) {
   return true;
 }
 
-Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, double cutoff) {
+Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, Qef::Pinv pinv) {
   const Vec3 m = cell.min_unit();
   const double s = cell.size();
   if (q.empty()) {
@@ -36,7 +36,7 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool ti
     return {{acc[0] / n, acc[1] / n, acc[2] / n}, 0, 0};
   }
   const Vec3 hi{m[0] + s, m[1] + s, m[2] + s};
-  Qef::Solution sol = q.solve_in_box({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, m, hi, cutoff);
+  Qef::Solution sol = q.solve_in_box({m[0] + s / 2, m[1] + s / 2, m[2] + s / 2}, m, hi, pinv);
   if (const int in = std::popcount(signs); tip_at_corner && sol.rank < 3 && (in == 1 || in == 7)) {
     // A tip: one corner apart from the other seven. Where the planes leave the vertex free
     // (a face or a crease) and pass through that corner, the surface meets there (two parts
@@ -59,7 +59,7 @@ Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool ti
     }
   }
   const Vec3 p{m[0] + (best & 1) * s, m[1] + ((best >> 1) & 1) * s, m[2] + ((best >> 2) & 1) * s};
-  Qef::Solution again = q.solve_in_box(p, m, hi, cutoff);
+  Qef::Solution again = q.solve_in_box(p, m, hi, pinv);
   return inside_cell(again.position, cell) ? again : sol;
 }
 
@@ -67,8 +67,8 @@ Qef::Solution sharpen(const Qef& q, const Cell& cell, uint8_t signs, const Qef::
                       bool tip_at_corner, double error) {
   if (sol.error < error) return sol;
   const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
-  Qef::Solution sharp = q.solve_in_box(seed, lo, hi, kSharpCutoff);
-  if (!inside_cell(sharp.position, cell)) sharp = cell_vertex(q, cell, signs, tip_at_corner, kSharpCutoff);
+  Qef::Solution sharp = q.solve_in_box(seed, lo, hi, Qef::Pinv::Damped);
+  if (!inside_cell(sharp.position, cell)) sharp = cell_vertex(q, cell, signs, tip_at_corner, Qef::Pinv::Damped);
   return sharp.error < sol.error && inside_cell(sharp.position, cell) ? sharp : sol;
 }
 

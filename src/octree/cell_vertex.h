@@ -15,9 +15,9 @@ namespace pic::detail {
 /// through it and leave the vertex free: two parts touching at a lattice point, as a Boolean
 /// meets them.
 Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner = false,
-                          double cutoff = kRelativeCutoff);
+                          Qef::Pinv pinv = Qef::Pinv::Truncated);
 /// cell_vertex, or, where its residual is `error` or more, the vertex with every direction the
-/// planes fix solved (kSharpCutoff) when that one lies in the cell and fits better: a shallow
+/// planes fix solved (Qef::Pinv::Damped) when that one lies in the cell and fits better: a shallow
 /// crease's vertex on its line, so the cell need not split until the crease looks flat.
 Qef::Solution cell_vertex_sharp(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, double error);
 /// The same second solve for a vertex found some other way (`sol`, seeded at `seed`).
