@@ -215,7 +215,7 @@ bool feature_is_local(const Operand& xa, const Operand& xb, const Cell& cell, co
   xb.bvh.query(xb.tris, g.lo, g.hi, scratch);
   box_qef(xb.tris, scratch, g, face, q);
   // A shallow crease over the grown cell is still one line (see Qef::Pinv::Damped).
-  return q.solve(x).error < error || q.solve(x, Qef::Pinv::Damped).error < error;
+  return q.solve(x).error < error || q.solve(x, Qef::Pinv::Damped).error < kSharpFit * error;
 }
 
 /// The result's signs on the cell's child grid are simple (see grid_is_simple): otherwise a

@@ -69,7 +69,7 @@ Qef::Solution sharpen(const Qef& q, const Cell& cell, uint8_t signs, const Qef::
   const Vec3 lo = cell.min_unit(), hi{lo[0] + cell.size(), lo[1] + cell.size(), lo[2] + cell.size()};
   Qef::Solution sharp = q.solve_in_box(seed, lo, hi, Qef::Pinv::Damped);
   if (!inside_cell(sharp.position, cell)) sharp = cell_vertex(q, cell, signs, tip_at_corner, Qef::Pinv::Damped);
-  return sharp.error < sol.error && inside_cell(sharp.position, cell) ? sharp : sol;
+  return sharp.error < kSharpFit * error && inside_cell(sharp.position, cell) ? sharp : sol;
 }
 
 Qef::Solution cell_vertex_sharp(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, double error) {

@@ -17,8 +17,9 @@ namespace pic::detail {
 Qef::Solution cell_vertex(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner = false,
                           Qef::Pinv pinv = Qef::Pinv::Truncated);
 /// cell_vertex, or, where its residual is `error` or more, the vertex with every direction the
-/// planes fix solved (Qef::Pinv::Damped) when that one lies in the cell and fits better: a shallow
-/// crease's vertex on its line, so the cell need not split until the crease looks flat.
+/// planes fix solved (Qef::Pinv::Damped) when that one lies in the cell and the planes meet in
+/// it (residual below kSharpFit * error): a shallow crease's vertex on its line, so the cell
+/// need not split until the crease looks flat.
 Qef::Solution cell_vertex_sharp(const Qef& q, const Cell& cell, uint8_t signs, bool tip_at_corner, double error);
 /// The same second solve for a vertex found some other way (`sol`, seeded at `seed`).
 Qef::Solution sharpen(const Qef& q, const Cell& cell, uint8_t signs, const Qef::Solution& sol, const Vec3& seed,
