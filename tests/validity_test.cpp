@@ -12,6 +12,7 @@
 #include "geometry/predicates.h"
 #include "pic/pic.h"
 #include "pic/primitives.h"
+#include "signs/invariants.h"
 #include "support/csg_cases.h"
 #include "support/mesh_checks.h"
 #include "support/thingi_pair.h"
@@ -250,6 +251,23 @@ TEST(Validity, SculptingRunStaysValid) {
     csg_inplace(clay, sample_in(make_sphere(c, 0.03, 24), depth), CsgOp::Subtract);
   }
   EXPECT_TRUE(IsValidSolid(written(clay)));
+}
+
+// A 32-segment ball's shallow creases sample to coarse leaves beside fine ones. Where the
+// recursion enters such a leaf, a part of it that no triangle of its contour meets takes its
+// corners' sign, yet a finer neighbour's corner on the leaf's face may have the other (the
+// leaf's vertex lies across the leaf, and its polygons reach that face elsewhere); taken as
+// uniform, the part left the result with two signs at that point. The patch is a carved slab
+// after 179 sculpting strokes (`pic_sculpt`, seed 1), cut to a 0.2 box around the next stroke.
+TEST(Validity, CoarseToolLeavesKeepOneSignPerPoint) {
+  Octree t = load(std::string(PIC_TESTS_DIR) + "/data/csg/carved_slab_patch.pic");
+  SampleOptions o;
+  o.cube = t.cube;
+  o.depth = t.max_depth;
+  const Vec3 c{0.19837614533025771, 0.26947201747680083, 0.57910779783469479};
+  csg_inplace(t, sample(make_sphere(c, 0.02, 32), o), CsgOp::Subtract);
+  EXPECT_NO_THROW(detail::check_octree(t, "the stroke"));
+  EXPECT_TRUE(IsValidSolid(written(t)));
 }
 
 // A sculpting session: 300 strokes, then the written mesh is a valid solid. Strokes

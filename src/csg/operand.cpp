@@ -21,6 +21,53 @@ Side side_of(Operand& x, uint32_t node, const Cell& cell) {
   return s;
 }
 
+namespace {
+
+/// Whether every leaf corner of `t` on the closed square across `axis` at `plane` (from `lo` to
+/// `hi` on the other two axes) has sign `inside`: a walk of the leaves touching the square.
+bool face_corners_are(const Octree& t, uint32_t node, const Cell& cell, int axis, int64_t plane, const Lat& lo,
+                      const Lat& hi, bool inside) {
+  const int64_t s = cell.span();
+  if (cell.lat[axis] > plane || cell.lat[axis] + s < plane) return true;
+  for (int k = 0; k < 3; ++k)
+    if (k != axis && (cell.lat[k] > hi[k] || cell.lat[k] + s < lo[k])) return true;
+  const Node& n = t.nodes[node];
+  if (n.kind == CellKind::Internal) {
+    for (int c = 0; c < 8; ++c)
+      if (!face_corners_are(t, n.index + c, cell.child(c), axis, plane, lo, hi, inside)) return false;
+    return true;
+  }
+  for (int c = 0; c < 8; ++c) {
+    const Lat p = cell.corner(c);
+    bool on = p[axis] == plane;
+    for (int k = 0; k < 3; ++k) on = on && (k == axis || (p[k] >= lo[k] && p[k] <= hi[k]));
+    const bool sign = n.kind == CellKind::Gray ? bool((n.signs >> c) & 1) : n.kind == CellKind::Black;
+    if (on && sign != inside) return false;
+  }
+  return true;
+}
+
+/// Whether x's sign is `inside` at every lattice point on the boundary of virtual cell `vc`
+/// (inside gray leaf `leaf`) where a finer leaf across the leaf's face has a corner. Inside the
+/// leaf, a cell that no triangle meets takes its corners' sign; on the leaf's faces, finer
+/// neighbours' corners have their own, and the partial contour need not pass through the
+/// virtual cell to separate them (the leaf's vertex may lie across the leaf, and its polygons
+/// reach the face elsewhere).
+bool boundary_is(const Octree& t, const Cell& vc, const Cell& leaf, bool inside) {
+  const int64_t s = vc.span();
+  for (int axis = 0; axis < 3; ++axis)
+    for (const bool high : {false, true}) {
+      const int64_t plane = vc.lat[axis] + (high ? s : 0);
+      if (plane != leaf.lat[axis] + (high ? leaf.span() : 0)) continue;  // a face inside the leaf
+      Lat lo = vc.lat, hi{vc.lat[0] + s, vc.lat[1] + s, vc.lat[2] + s};
+      lo[axis] = hi[axis] = plane;
+      if (!face_corners_are(t, 0, Cell{}, axis, plane, lo, hi, inside)) return false;
+    }
+  return true;
+}
+
+}  // namespace
+
 SignGrid sign_grid(Operand& x, const Side& s, const Cell& cell) {
   SignGrid g{};
   const int64_t h = cell.span() / 2;
@@ -49,7 +96,8 @@ Side child_side(Operand& x, const Side& s, const Cell& cell, int c, const SignGr
     v.signs |= uint8_t(grid[gx + 3 * gy + 9 * gz]) << k;
   }
   filter_box(x.tris, s.idx, cc.box(), v.idx);
-  if ((v.signs == 0 || v.signs == 0xff) && !meets_box(x.tris, v.idx, cc.box())) {
+  if ((v.signs == 0 || v.signs == 0xff) && !meets_box(x.tris, v.idx, cc.box()) &&
+      boundary_is(x.t, cc, s.leaf_cell, v.signs != 0)) {
     Side u;
     u.inside = v.signs != 0;
     return u;
