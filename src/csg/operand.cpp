@@ -47,21 +47,59 @@ bool face_corners_are(const Octree& t, uint32_t node, const Cell& cell, int axis
   return true;
 }
 
+/// The node of `t` at `cell`'s level holding lattice point p, or the leaf above it; the root
+/// when p lies outside the root cube.
+std::pair<uint32_t, Cell> node_at(const Octree& t, const Lat& p, int level) {
+  uint32_t n = 0;
+  Cell at{};
+  for (int k = 0; k < 3; ++k)
+    if (p[k] < 0 || p[k] >= at.span()) return {n, at};
+  while (at.level < level && t.nodes[n].kind == CellKind::Internal) {
+    const int k = at.child_toward(p);
+    n = t.nodes[n].index + k;
+    at = at.child(k);
+  }
+  return {n, at};
+}
+
 /// Whether x's sign is `inside` at every lattice point on the boundary of virtual cell `vc`
-/// (inside gray leaf `leaf`) where a finer leaf across the leaf's face has a corner. Inside the
+/// (inside gray leaf `leaf`) where a finer leaf beyond the leaf has a corner. Inside the
 /// leaf, a cell that no triangle meets takes its corners' sign; on the leaf's faces, finer
 /// neighbours' corners have their own, and the partial contour need not pass through the
 /// virtual cell to separate them (the leaf's vertex may lie across the leaf, and its polygons
-/// reach the face elsewhere).
+/// reach the face elsewhere). Only the neighbours of the leaf's size that are split are walked:
+/// across the face, and across its edges where vc reaches them.
 bool boundary_is(const Octree& t, const Cell& vc, const Cell& leaf, bool inside) {
-  const int64_t s = vc.span();
+  const int64_t s = vc.span(), ls = leaf.span();
   for (int axis = 0; axis < 3; ++axis)
     for (const bool high : {false, true}) {
       const int64_t plane = vc.lat[axis] + (high ? s : 0);
-      if (plane != leaf.lat[axis] + (high ? leaf.span() : 0)) continue;  // a face inside the leaf
+      if (plane != leaf.lat[axis] + (high ? ls : 0)) continue;  // a face inside the leaf
       Lat lo = vc.lat, hi{vc.lat[0] + s, vc.lat[1] + s, vc.lat[2] + s};
       lo[axis] = hi[axis] = plane;
-      if (!face_corners_are(t, 0, Cell{}, axis, plane, lo, hi, inside)) return false;
+      // Neighbours of the leaf's size: across the face, and across each of its edges vc touches.
+      std::array<int, 2> shifts[2];
+      int count[2] = {1, 1};
+      for (int j = 0, side = 0; j < 3; ++j) {
+        if (j == axis) continue;
+        shifts[side] = {0, 0};
+        if (lo[j] == leaf.lat[j]) shifts[side][count[side]++] = -1;
+        if (hi[j] == leaf.lat[j] + ls) shifts[side][count[side]++] = 1;
+        ++side;
+      }
+      const int i = axis == 0 ? 1 : 0, j = axis == 2 ? 1 : 2;
+      for (int u = 0; u < count[0]; ++u)
+        for (int v = 0; v < count[1]; ++v) {
+          if (shifts[0][u] != 0 && shifts[1][v] != 0) continue;  // a corner: the leaf's own sign
+          Lat across = leaf.lat;
+          across[axis] += high ? ls : -ls;
+          across[i] += shifts[0][u] * ls;
+          across[j] += shifts[1][v] * ls;
+          const auto [n, at] = node_at(t, across, leaf.level);
+          if (at.level < leaf.level && !at.holds(across)) continue;  // outside the root cube
+          if (t.nodes[n].kind != CellKind::Internal) continue;  // no corner finer than the leaf's
+          if (!face_corners_are(t, n, at, axis, plane, lo, hi, inside)) return false;
+        }
     }
   return true;
 }
