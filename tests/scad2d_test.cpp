@@ -762,5 +762,16 @@ TEST(ScadModel, TwoDimensionalModelsAreOutlinesNotSolids) {
   EXPECT_THROW(write_outline(o, dir / "out.stl"), InvalidInput);
 }
 
+// The shadow of OpenSCAD's GEB (three extruded letters intersected), from above: the "B" with
+// its two holes. The union of the contour's ~21,000 upward triangles leaves hundreds of
+// pinholes a grid step wide, and Clipper labelled the lower hole (area 8.56) an outer ring
+// among them, so the hole came out filled (66.75 for OpenSCAD's 58.17).
+TEST(ScadProjection, ShadowKeepsEveryHole) {
+  const std::optional<Outline> o = eval_outline(std::string(PIC_SCAD_DATA_DIR) + "/geb_projection.csg");
+  ASSERT_TRUE(o.has_value());
+  EXPECT_EQ(o->rings.size(), 3u);
+  EXPECT_LT(relative(area(*o), 58.169378), 1e-3);  // OpenSCAD 2021's DXF of the same projection
+}
+
 }  // namespace
 }  // namespace pic

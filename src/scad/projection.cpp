@@ -19,7 +19,11 @@ Region project(const TriMesh& m, bool cut) {
       const double z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
       if (z > 0) tris.push_back({{a[0], a[1]}, {b[0], b[1]}, {c[0], c[1]}});
     }
-    return region_union({tris});
+    // The union of thousands of shadows leaves pinholes between them a grid step wide, and
+    // among those Clipper can label a real hole an outer ring (GEB's "B": a hole of 8.6 came
+    // out filled). With the pinholes dropped (from_paths), the rings bound the shadow by their
+    // nesting alone: even-odd fill reads them so whatever their orientation.
+    return region_even_odd(region_union({tris}));
   }
   // The cut by z = 0: each triangle's segment across the plane (a vertex on it counts as
   // above, so every crossing edge is met by exactly the two triangles sharing it). Segments
