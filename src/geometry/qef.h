@@ -26,13 +26,12 @@ struct Qef {
     double error;  // mean squared distance (root-cube units squared)
     int rank;
   };
-  /// x = seed + A+ (b - A seed), A+ by truncated eigendecomposition (Lindstrom 2000):
-  /// eigenvalues below kRelativeCutoff * largest are zeroed, so flat and creased patches
-  /// keep the vertex close to the seed along their free directions.
   /// How A+ treats small eigenvalues λ: Truncated drops those below kRelativeCutoff of the
   /// largest; Damped takes λ/(λ² + μ²) with μ = kSharpDamping times the largest, continuous in
   /// the planes and exact to (μ/λ)² where λ is well above μ (a shallow crease's line).
   enum class Pinv { Truncated, Damped };
+  /// x = seed + A+ (b - A seed), A+ by eigendecomposition (Lindstrom 2000); truncated, flat and
+  /// creased patches keep the vertex close to the seed along their free directions.
   Solution solve(const Vec3& seed, Pinv pinv = Pinv::Truncated) const;
   /// As solve(), but when the minimum leaves the box [lo, hi] and the QEF has free
   /// directions (a crease line or a plane), slides along them to a point inside the box:

@@ -42,7 +42,7 @@ inline constexpr double kSharpDamping = 1e-6;
 /// The sharp solve's vertex is taken where the planes meet in it: its residual below this
 /// fraction of δ² (a quarter of δ as a distance). A compromise between features fits on average
 /// within δ² and can cut a corner by more than a finest cell (a hull's corner where facets
-/// meet at a few degrees, other facets beside it in the cell); those cells split as before.
+/// meet at a few degrees, other facets beside it in the cell); such cells split.
 inline constexpr double kSharpFit = 1.0 / 16;
 
 // ---- octree/ -------------------------------------------------------------------------------
