@@ -764,8 +764,8 @@ TEST(ScadModel, TwoDimensionalModelsAreOutlinesNotSolids) {
 
 // The shadow of OpenSCAD's GEB (three extruded letters intersected), from above: the "B" with
 // its two holes. The union of the contour's ~21,000 upward triangles leaves hundreds of
-// pinholes a grid step wide, and Clipper labelled the lower hole (area 8.56) an outer ring
-// among them, so the hole came out filled (66.75 for OpenSCAD's 58.17).
+// pinholes a grid step wide, among which Clipper can label a hole (the lower one, area 8.56)
+// an outer ring; read by its orientation, that hole is filled.
 TEST(ScadProjection, ShadowKeepsEveryHole) {
   const std::optional<Outline> o = eval_outline(std::string(PIC_SCAD_DATA_DIR) + "/geb_projection.csg");
   ASSERT_TRUE(o.has_value());

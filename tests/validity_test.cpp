@@ -258,7 +258,7 @@ TEST(Validity, SculptingRunStaysValid) {
 // corners' sign, yet a finer neighbour's corner on the leaf's face may have the other (the
 // leaf's vertex lies across the leaf, and its polygons reach that face elsewhere); taken as
 // uniform, the part left the result with two signs at that point. The patch is a carved slab
-// after 179 sculpting strokes (`pic_sculpt`, seed 1), cut to a 0.2 box around the next stroke.
+// after a sculpting session, cut to a 0.2 box around the stroke that meets such a leaf.
 TEST(Validity, CoarseToolLeavesKeepOneSignPerPoint) {
   Octree t = load(std::string(PIC_TESTS_DIR) + "/data/csg/carved_slab_patch.pic");
   SampleOptions o;

@@ -1,5 +1,6 @@
 // An operand's state over a cell of the recursion: see operand.h.
 #include "csg/operand.h"
+#include "octree/point_signs.h"
 
 namespace pic::detail {
 
@@ -47,21 +48,6 @@ bool face_corners_are(const Octree& t, uint32_t node, const Cell& cell, int axis
   return true;
 }
 
-/// The node of `t` at `cell`'s level holding lattice point p, or the leaf above it; the root
-/// when p lies outside the root cube.
-std::pair<uint32_t, Cell> node_at(const Octree& t, const Lat& p, int level) {
-  uint32_t n = 0;
-  Cell at{};
-  for (int k = 0; k < 3; ++k)
-    if (p[k] < 0 || p[k] >= at.span()) return {n, at};
-  while (at.level < level && t.nodes[n].kind == CellKind::Internal) {
-    const int k = at.child_toward(p);
-    n = t.nodes[n].index + k;
-    at = at.child(k);
-  }
-  return {n, at};
-}
-
 /// Whether x's sign is `inside` at every lattice point on the boundary of virtual cell `vc`
 /// (inside gray leaf `leaf`) where a finer leaf beyond the leaf has a corner. Inside the
 /// leaf, a cell that no triangle meets takes its corners' sign; on the leaf's faces, finer
@@ -95,10 +81,11 @@ bool boundary_is(const Octree& t, const Cell& vc, const Cell& leaf, bool inside)
           across[axis] += high ? ls : -ls;
           across[i] += shifts[0][u] * ls;
           across[j] += shifts[1][v] * ls;
-          const auto [n, at] = node_at(t, across, leaf.level);
-          if (at.level < leaf.level && !at.holds(across)) continue;  // outside the root cube
-          if (t.nodes[n].kind != CellKind::Internal) continue;  // no corner finer than the leaf's
-          if (!face_corners_are(t, n, at, axis, plane, lo, hi, inside)) return false;
+          if (std::any_of(across.begin(), across.end(), [&](int64_t c) { return c < 0 || c >= Cell{}.span(); }))
+            continue;  // outside the root cube
+          const LeafRef n = node_at(t, Cell{leaf.level, across});
+          if (t.nodes[n.node].kind != CellKind::Internal) continue;  // no corner finer than the leaf's
+          if (!face_corners_are(t, n.node, n.cell, axis, plane, lo, hi, inside)) return false;
         }
     }
   return true;
