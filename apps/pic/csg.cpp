@@ -13,7 +13,7 @@ struct CsgArgs {
   std::string out, mesh;
   bool json = false, no_split = false, no_check = false, raw = false;
   double error = 1e-8;
-  double simplify = 0.25;  // finest cells
+  double simplify = kCompactSimplify;  // finest cells
   int depth = 12;
 };
 

@@ -13,7 +13,7 @@ struct EvalArgs {
   int depth = 12;
   double error = 1e-8;
   bool smooth = false, json = false, serial = false, no_split = false, raw = false;
-  double simplify = 0.25;  // finest cells
+  double simplify = kCompactSimplify;  // finest cells
 };
 
 bool is_outline_path(const std::string& p) { return extension(p) == ".svg" || extension(p) == ".dxf"; }

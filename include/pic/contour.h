@@ -8,6 +8,12 @@
 
 namespace pic {
 
+/// The simplification the CLI's Boolean and OpenSCAD outputs use, in finest cells: the raw
+/// contour's vertices lie up to a few tenths of a cell off the creases they stand for, and
+/// merged vertices go onto the planes' point, so half a cell writes about half the triangles
+/// a quarter does, as near the exact surface (docs/algorithms.md).
+inline constexpr double kCompactSimplify = 0.5;
+
 /// Options for contouring.
 struct ContourOptions {
   /// Triangulate the dual polygons so that no two triangles cross, by construction: each
@@ -25,7 +31,8 @@ struct ContourOptions {
   bool fan_all = false;
   /// Merge the contour's vertices where the surface is flat or runs straight along a crease,
   /// staying within this many finest cells of the raw contour (simplify());
-  /// 0: the raw contour, a vertex per gray leaf.
+  /// 0: the raw contour, a vertex per gray leaf. kCompactSimplify is what `pic eval` and
+  /// `pic csg` write.
   double simplify = 0;
   /// The sampled solid's function, when known (input coordinates, < 0 inside: the function a
   /// volume operation or pic::sample of an ImplicitSolid sampled): the points the contour adds

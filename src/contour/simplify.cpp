@@ -114,7 +114,7 @@ struct Scratch {
 
 /// Blocks of a fixed grid over the mesh's box, each vertex in the one holding it: collapses whose
 /// two stars lie in one block touch nothing another block's collapses do.
-constexpr int kBlocksPerAxis = 4;
+constexpr int kBlocksPerAxis = 8;
 std::vector<uint16_t> block_of_vertices(const std::vector<Vec3>& pos) {
   Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
   for (const Vec3& p : pos)
