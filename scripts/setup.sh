@@ -15,7 +15,8 @@ pkgs+=(openscad openscad-mcad)
 # The `pic` Python module (pybind11) and its pytest suite; numpy arrays in and out.
 pkgs+=(pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest)
 if [[ "${1:-}" == "--bench" ]]; then
-  pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3)
+  # bench/any_input.py asks ../shared/tools/gwn.py (numpy, scipy) for exact winding numbers.
+  pkgs+=(libbenchmark-dev libopenvdb-dev libboost-iostreams-dev python3 python3-scipy)
 fi
 if [[ "${1:-}" == "--fuzz" ]]; then
   pkgs+=(clang libclang-rt-14-dev)
