@@ -544,12 +544,13 @@ size_t simplify(TriMesh& mesh, double tolerance) {
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
   // simplified again (a few rounds; the raw contour when crossings remain).
+  constexpr int kRounds = 6;
   std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
   const detail::MeshDistance surface(mesh);
   // A round's state after its blocks: the next round redoes only the blocks where vertices
   // were frozen since.
   std::optional<Simplifier> blocks_done;
-  for (int round = 0; round < 4; ++round) {
+  for (int round = 0; round < kRounds; ++round) {
     Simplifier s(mesh, surface, tolerance, frozen);
     std::vector<uint8_t> redo(s.blocks(), 1);
     if (blocks_done) {
@@ -570,12 +571,24 @@ size_t simplify(TriMesh& mesh, double tolerance) {
       mesh = std::move(out);
       return removed;
     }
-    std::vector<uint8_t> at_crossing(mesh.positions.size(), 0);
+    // The vertices of the crossing triangles, and from the second round on their neighbours
+    // too: keeping only the crossing triangles raw can make the next collapses beside them
+    // cross again, and a wider raw patch settles in fewer rounds.
+    std::vector<uint8_t> at_crossing(out.positions.size(), 0);
     for (const auto& [a, b] : crossings)
       for (uint32_t t : {a, b})
-        for (uint32_t v : out.triangles[t]) at_crossing[kept[v]] = 1;
+        for (uint32_t v : out.triangles[t]) at_crossing[v] = 1;
+    if (round > 0) {
+      std::vector<uint8_t> grown = at_crossing;
+      for (const auto& t : out.triangles)
+        if (at_crossing[t[0]] || at_crossing[t[1]] || at_crossing[t[2]]) grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
+      at_crossing.swap(grown);
+    }
+    std::vector<uint8_t> input_at(mesh.positions.size(), 0);
+    for (uint32_t v = 0; v < out.positions.size(); ++v)
+      if (at_crossing[v]) input_at[kept[v]] = 1;
     for (uint32_t u = 0; u < mesh.positions.size(); ++u)
-      if (at_crossing[s.survivor(u)]) frozen[u] = 1;
+      if (input_at[s.survivor(u)]) frozen[u] = 1;
   }
   return 0;
 }
