@@ -135,9 +135,9 @@ TEST(Simplify, NeverCollapsesTheSmallestClosedMesh) {
 }
 
 // OpenSCAD's example020 (twisted screws, a nut and a spring) read back from its .pic file: its
-// twisted sheets pass within a fraction of a cell of each other, and keeping only the crossing
-// triangles raw let the next collapses beside them cross again, round after round, until the
-// raw contour of 412,640 triangles was written. The result must be simplified and still valid.
+// twisted sheets pass within a fraction of a cell of each other, and where only the crossing
+// triangles stay raw the collapses right beside them cross again, round after round. The
+// rounds must still end with a simplified mesh (not the raw contour), valid.
 TEST(Simplify, CrossingsSettleBeforeTheRoundsRunOut) {
   const std::filesystem::path scad = "/usr/share/openscad/examples/Old/example020.scad";
   if (std::system("command -v openscad > /dev/null 2>&1") != 0 || !std::filesystem::exists(scad))
