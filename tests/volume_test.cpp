@@ -2,6 +2,7 @@
 // formulas, vertices on the exact offset surface, sharp edges where the exact answer is sharp.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -11,6 +12,7 @@
 #include <random>
 
 #include "geometry/mesh_distance.h"
+#include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "sample/round_body.h"
 #include "pic/contour.h"
@@ -506,6 +508,58 @@ TEST(MeshDistance, FartherThanNeverMissesATriangle) {
   EXPECT_GT(by_centre, 100);
   EXPECT_GT(beyond_centre, 30);
   std::printf("cleared %d of 3000 boxes, %d the centre alone would not\n", cleared, beyond_centre);
+}
+
+TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
+  // The search prunes by float boxes and by each triangle's plane and sides held in floats: a
+  // bound whose rounding slack were too small would skip the answer for points on or near the
+  // surface, most of all far from the origin. Spot as it is and moved 10^4 away, plus
+  // degenerate triangles (a repeated vertex, three on a line); points on the surface, a hair
+  // off it, at offset distances and far away, asked with the last answer as the hint and
+  // with none: the distance must be a scan's over every triangle, the triangle one at that
+  // distance whatever the hint, and `within` must agree.
+  TriMesh base = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  const uint32_t n0 = uint32_t(base.positions.size());
+  base.positions.push_back({0.1, 0.2, 0.3});
+  base.positions.push_back({0.4, 0.2, 0.3});
+  base.positions.push_back({0.7, 0.2, 0.3});
+  base.triangles.push_back({n0, n0, n0 + 1});
+  base.triangles.push_back({n0, n0 + 1, n0 + 2});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const double shift : {0.0, 1e4}) {
+    TriMesh mesh = base;
+    for (Vec3& x : mesh.positions) x = {x[0] + shift, x[1] - shift, x[2] + shift};
+    const detail::MeshDistance md(mesh);
+    uint32_t hint = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const auto& t = mesh.triangles[rng() % mesh.triangles.size()];
+      const double w0 = (u(rng) + 1) / 2, w1 = (1 - w0) * (u(rng) + 1) / 2;
+      Vec3 p;
+      for (int k = 0; k < 3; ++k)
+        p[k] = w0 * mesh.positions[t[0]][k] + w1 * mesh.positions[t[1]][k] + (1 - w0 - w1) * mesh.positions[t[2]][k];
+      const double off = std::array{0.0, 1e-9, 1e-4, 0.05, 0.5, 3.0}[i % 6];
+      for (int k = 0; k < 3; ++k) p[k] += off * u(rng);
+      double least = detail::kHuge;
+      for (const auto& g : mesh.triangles)
+        least = std::min(least, detail::nearest_on_triangle(p, mesh.positions[g[0]], mesh.positions[g[1]],
+                                                            mesh.positions[g[2]]).distance);
+      const detail::Nearest hinted = md.nearest(p, &hint), plain = md.nearest(p);
+      ASSERT_EQ(hinted.distance, least) << "shift " << shift << " point " << i;
+      // The triangle: one at that distance (ties of the rounded root may differ in their
+      // squares, which the search compares), the same with and without the hint.
+      const auto& g = mesh.triangles[hinted.triangle];
+      ASSERT_EQ(detail::nearest_on_triangle(p, mesh.positions[g[0]], mesh.positions[g[1]], mesh.positions[g[2]]).distance,
+                least);
+      ASSERT_EQ(plain.triangle, hinted.triangle) << "shift " << shift << " point " << i;
+      // distance() and within() have their own point-triangle formula: a margin for the two
+      // roundings.
+      const double margin = 1e-9 * least + 1e-14 * (1 + shift);
+      ASSERT_NEAR(md.distance(p), least, margin);
+      if (least > margin) ASSERT_FALSE(md.within(p, least - margin)) << "shift " << shift << " point " << i;
+      ASSERT_TRUE(md.within(p, least + margin)) << "shift " << shift << " point " << i;
+    }
+  }
 }
 
 /// f = g(signed distance to `mesh`) with g's value and slope, as the sampler asks it, without

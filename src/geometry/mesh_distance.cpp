@@ -7,6 +7,10 @@
 #include <numeric>
 #include <unordered_map>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
@@ -77,6 +81,114 @@ namespace {
 /// Ranges of more triangles than this build their halves as parallel tasks.
 constexpr uint32_t kParallelBuild = 1 << 15;
 
+/// Surface area of a box (half of it: only ratios are compared).
+double half_area(const Vec3& lo, const Vec3& hi) {
+  const double x = std::max(0.0, hi[0] - lo[0]), y = std::max(0.0, hi[1] - lo[1]), z = std::max(0.0, hi[2] - lo[2]);
+  return x * y + y * z + z * x;
+}
+
+/// A box [lo, hi] rounded outward to floats: what the vector tests measure against.
+struct FloatBox {
+  float lo[3], hi[3];
+  FloatBox(const Vec3& l, const Vec3& h) {
+    for (int k = 0; k < 3; ++k) lo[k] = round_down(l[k]), hi[k] = round_up(h[k]);
+  }
+};
+
+/// Squared distances from the box q to four boxes side by side (axis k's bounds at lo + k *
+/// stride, hi + k * stride) into out, each at most the exact distance between the boxes: q's
+/// bounds are rounded outward, and the float rounding of the differences, squares and sums (a
+/// few units in 2^-24, relative) is taken off by kShrink. An empty box (lo +inf, hi -inf) is
+/// infinitely far.
+void box_distance2_x4(const float* lo, const float* hi, size_t stride, const FloatBox& q, float* out) {
+  constexpr float kShrink = 1.0f - 1.0f / (1 << 20);
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps();
+  __m128 s = zero;
+  for (size_t k = 0; k < 3; ++k) {
+    const __m128 below = _mm_sub_ps(_mm_load_ps(lo + k * stride), _mm_set1_ps(q.hi[k]));
+    const __m128 above = _mm_sub_ps(_mm_set1_ps(q.lo[k]), _mm_load_ps(hi + k * stride));
+    const __m128 d = _mm_max_ps(_mm_max_ps(below, above), zero);
+    s = _mm_add_ps(s, _mm_mul_ps(d, d));
+  }
+  _mm_store_ps(out, _mm_mul_ps(s, _mm_set1_ps(kShrink)));
+#else
+  for (int i = 0; i < 4; ++i) {
+    float s = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const float d = std::max({lo[k * stride + i] - q.hi[k], q.lo[k] - hi[k * stride + i], 0.0f});
+      s += d * d;
+    }
+    out[i] = s * kShrink;
+  }
+#endif
+}
+
+/// How far a plane or side stored in floats may be from the exact one, at p, relative to p's
+/// and the mesh's largest coordinate: their products and sums round to a few units in 2^-24
+/// of those; 2^-18 is a wide margin over that.
+constexpr double kPlaneRounding = 1.0 / (1 << 18);
+
+/// Raises out[0..3] to lower bounds on the squared distances from p (in floats: x) to four
+/// triangles side by side (`plane`, `side`: LeafBounds' arrays at the first one's slot, rows
+/// of 8): a triangle lies in its plane and, within it, inside each side's line, so its distance
+/// is at least that of the half-plane beyond its farthest side, sqrt(h^2 + o^2) for p at height
+/// h over the plane and o outside that side. `slack` covers the floats' rounding.
+void plane_distance2_x4(const float* plane, const float* side, const float (&x)[3], float slack, float* out) {
+  constexpr float kShrink = 1.0f - 1.0f / (1 << 20);
+#if defined(__SSE2__)
+  const __m128 px = _mm_set1_ps(x[0]), py = _mm_set1_ps(x[1]), pz = _mm_set1_ps(x[2]), zero = _mm_setzero_ps();
+  const auto along = [&](const float* row) {  // n . x - offset for a row block (n: 3 rows, offset: 1)
+    __m128 v = _mm_mul_ps(_mm_load_ps(row), px);
+    v = _mm_add_ps(v, _mm_mul_ps(_mm_load_ps(row + 8), py));
+    v = _mm_add_ps(v, _mm_mul_ps(_mm_load_ps(row + 16), pz));
+    return _mm_sub_ps(v, _mm_load_ps(row + 24));
+  };
+  const __m128 h = along(plane);
+  const __m128 height = _mm_max_ps(_mm_max_ps(h, _mm_sub_ps(zero, h)), zero);
+  const __m128 out_of = _mm_max_ps(_mm_max_ps(along(side), along(side + 32)), along(side + 64));
+  const __m128 s = _mm_set1_ps(slack);
+  const __m128 a = _mm_max_ps(_mm_sub_ps(height, s), zero), b = _mm_max_ps(_mm_sub_ps(out_of, s), zero);
+  const __m128 d2 = _mm_mul_ps(_mm_add_ps(_mm_mul_ps(a, a), _mm_mul_ps(b, b)), _mm_set1_ps(kShrink));
+  _mm_store_ps(out, _mm_max_ps(_mm_load_ps(out), d2));
+#else
+  for (int i = 0; i < 4; ++i) {
+    const auto along = [&](const float* row) { return row[i] * x[0] + row[8 + i] * x[1] + row[16 + i] * x[2] - row[24 + i]; };
+    const float height = std::abs(along(plane));
+    const float out_of = std::max({along(side), along(side + 32), along(side + 64)});
+    const float a = std::max(height - slack, 0.0f), b = std::max(out_of - slack, 0.0f);
+    out[i] = std::max(out[i], (a * a + b * b) * kShrink);
+  }
+#endif
+}
+
+/// A query point as the vector tests take it: rounded outward to a box of floats, rounded to
+/// floats, and the slack of the leaves' planes there (see kPlaneRounding).
+struct FloatPoint {
+  FloatBox box;
+  float x[3];
+  float slack;
+  FloatPoint(const Vec3& p, float rounding)
+      : box(p, p),
+        x{float(p[0]), float(p[1]), float(p[2])},
+        slack(rounding + float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) * kPlaneRounding)) {}
+};
+
+/// Lower bounds on the squared distances from q to a leaf's eight triangles, into out.
+template <class Leaf>
+void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
+  box_distance2_x4(&l.lo[0][0], &l.hi[0][0], 8, q.box, out);
+  box_distance2_x4(&l.lo[0][4], &l.hi[0][4], 8, q.box, out + 4);
+  plane_distance2_x4(&l.plane[0][0], &l.side[0][0][0], q.x, q.slack, out);
+  plane_distance2_x4(&l.plane[0][4], &l.side[0][0][4], q.x, q.slack, out + 4);
+}
+
+/// box_distance2_x4 for a node's four children.
+template <class Node>
+void children_distance2(const Node& n, const FloatBox& q, float* out) {
+  box_distance2_x4(&n.lo[0][0], &n.hi[0][0], 4, q, out);
+}
+
 }  // namespace
 
 MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size()) {
@@ -93,61 +205,141 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
     }
   });
   if (n == 0) return;
-  nodes_.reserve(2 * (n / kLeafSize) + 3);
-  nodes_.resize(1);
-  build(nodes_, 0, bounds(0, uint32_t(n), order, lo, hi), 0, static_cast<uint32_t>(n), order, lo, hi, centre);
-  tris_.resize(n);
-  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-    const auto& t = mesh.triangles[order[i]];
-    LeafTriangle& l = tris_[i];
-    l.a = mesh.positions[t[0]], l.b = mesh.positions[t[1]], l.c = mesh.positions[t[2]];
-    for (int k = 0; k < 3; ++k) l.lo[k] = round_down(lo[order[i]][k]), l.hi[k] = round_up(hi[order[i]][k]);
-    l.id = order[i];
-  });
+  std::vector<BNode> binary;
+  binary.reserve(2 * (n / kLeafSize) + 3);
+  binary.resize(1);
+  build(binary, 0, bounds(0, uint32_t(n), order, lo, hi), 0, static_cast<uint32_t>(n), order, lo, hi, centre);
+  nodes_.reserve(binary.size() / 3 + 1);
+  leaves_.reserve(binary.size() / 2 + 1);
+  tris_.reserve(kLeafSize * (binary.size() / 2 + 1));
+  double extent = 0;
+  for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
+  rounding_ = float(extent * kPlaneRounding);
+  root_ = collapse(binary, 0, mesh, order, lo, hi);
 }
 
-template <class Box>
-double MeshDistance::box_distance2(const Box& box, const Vec3& p) {
-  double s = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = std::max({double(box.lo[k]) - p[k], 0.0, p[k] - double(box.hi[k])});
-    s += d * d;
+uint32_t MeshDistance::collapse(const std::vector<BNode>& binary, uint32_t b, const TriMesh& mesh,
+                                const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                                const std::vector<Vec3>& hi) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const BNode& nd = binary[b];
+  if (nd.count > 0) {
+    const uint32_t leaf = uint32_t(leaves_.size());
+    LeafBounds boxes{};
+    for (int k = 0; k < 3; ++k) std::fill_n(boxes.lo[k], 8, kInf), std::fill_n(boxes.hi[k], 8, -kInf);
+    tris_.resize(tris_.size() + kLeafSize, LeafTriangle{{}, {}, {}, kNoTriangle});
+    for (uint32_t i = 0; i < nd.count; ++i) {
+      const uint32_t t = order[nd.first + i];
+      const FloatBox box(lo[t], hi[t]);
+      for (int k = 0; k < 3; ++k) boxes.lo[k][i] = box.lo[k], boxes.hi[k][i] = box.hi[k];
+      const auto& v = mesh.triangles[t];
+      const LeafTriangle& tri = tris_[kLeafSize * leaf + i] = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], t};
+      set_planes(boxes, i, tri.a, tri.b, tri.c);
+    }
+    leaves_.push_back(boxes);
+    return leaf | kLeafBit;
   }
-  return s;
+  // Up to four descendants: the widest inner one opened until there are four (a query opens a
+  // box about in proportion to its area), in the binary tree's order.
+  uint32_t kids[4] = {nd.first, nd.first + 1};
+  int count = 2;
+  while (count < 4) {
+    int widest = -1;
+    double area = -1;
+    for (int i = 0; i < count; ++i) {
+      const BNode& k = binary[kids[i]];
+      if (k.count == 0 && half_area(k.lo, k.hi) > area) area = half_area(k.lo, k.hi), widest = i;
+    }
+    if (widest < 0) break;
+    const uint32_t first = binary[kids[widest]].first;
+    for (int i = count; i > widest + 1; --i) kids[i] = kids[i - 1];
+    kids[widest] = first, kids[widest + 1] = first + 1;
+    ++count;
+  }
+  const uint32_t self = uint32_t(nodes_.size());
+  nodes_.emplace_back();
+  Node4 out;
+  for (int k = 0; k < 3; ++k) std::fill_n(out.lo[k], 4, kInf), std::fill_n(out.hi[k], 4, -kInf);
+  for (int i = 0; i < 4; ++i) out.child[i] = 0;
+  for (int i = 0; i < count; ++i) {
+    const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
+    for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
+    out.child[i] = collapse(binary, kids[i], mesh, order, lo, hi);
+  }
+  nodes_[self] = out;
+  return self;
 }
 
-/// Visits the triangles that may be nearer than best2 (squared), nearer boxes first; `visit`
-/// lowers best2 as it finds nearer triangles.
-template <class Visit>
-void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
-  if (nodes_.empty()) return;
-  uint32_t stack[128];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const BNode& nd = nodes_[stack[--top]];
-    if (box_distance2(nd, p) >= best2) continue;
-    if (nd.count > 0) {
-      for (uint32_t i = nd.first; i < nd.first + nd.count; ++i) visit(tris_[i]);
+void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // A degenerate triangle bounds nothing: zero normals, every side's offset +inf (p is then
+  // -inf outside each side).
+  const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+  const double area2 = norm3(n);
+  const Vec3 corner[3] = {a, b, c};
+  if (!(area2 > kTinyDivisor)) {
+    for (int e = 0; e < 3; ++e) l.side[e][3][i] = std::numeric_limits<float>::infinity();
+    return;
+  }
+  const Vec3 u = scale3(n, 1 / area2);
+  for (int k = 0; k < 3; ++k) l.plane[k][i] = float(u[k]);
+  l.plane[3][i] = float(dot3(u, a));
+  for (int e = 0; e < 3; ++e) {
+    const Vec3 m = cross3(sub3(corner[(e + 1) % 3], corner[e]), u);  // in the plane, away from the third corner
+    const double len = norm3(m);
+    if (!(len > kTinyDivisor)) {
+      l.side[e][3][i] = std::numeric_limits<float>::infinity();
       continue;
     }
-    const BNode &l = nodes_[nd.first], &r = nodes_[nd.first + 1];
-    const double dl = box_distance2(l, p), dr = box_distance2(r, p);
-    // Push the farther first so the nearer is explored first.
-    if (dl < dr) {
-      if (dr < best2) stack[top++] = nd.first + 1;
-      if (dl < best2) stack[top++] = nd.first;
-    } else {
-      if (dl < best2) stack[top++] = nd.first;
-      if (dr < best2) stack[top++] = nd.first + 1;
+    for (int k = 0; k < 3; ++k) l.side[e][k][i] = float(m[k] / len);
+    l.side[e][3][i] = float(dot3(m, corner[e]) / len);
+  }
+}
+
+
+/// Visits the triangles whose boxes may be nearer than best2 (squared), nearer boxes first,
+/// with the box's squared distance (a lower bound); `visit` lowers best2 as it finds nearer
+/// triangles. Which boxes are opened depends on best2, their order does not.
+template <class Visit>
+void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
+  if (tris_.empty()) return;
+  const FloatPoint q(p, rounding_);
+  struct Entry {
+    uint32_t ref;
+    double d2;
+  };
+  // Each node opened pushes at most four: three per level of depth stay on the stack.
+  Entry stack[512];
+  int top = 0;
+  stack[top++] = {root_, 0};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    if (e.d2 >= best2) continue;
+    if (e.ref & kLeafBit) {
+      const uint32_t leaf = e.ref & ~kLeafBit;
+      alignas(16) float d[8];
+      leaf_distance2(leaves_[leaf], q, d);
+      for (uint32_t i = 0; i < kLeafSize; ++i)
+        if (double(d[i]) < best2) visit(tris_[kLeafSize * leaf + i], double(d[i]));
+      continue;
+    }
+    const Node4& nd = nodes_[e.ref];
+    alignas(16) float d[4];
+    children_distance2(nd, q.box, d);
+    // The children within best2, the nearest last so that it is opened next.
+    const int first = top;
+    for (int i = 0; i < 4; ++i) {
+      if (!(double(d[i]) < best2)) continue;
+      stack[top] = {nd.child[i], double(d[i])};
+      if (top > first && stack[top].d2 > stack[top - 1].d2) std::swap(stack[top], stack[top - 1]);
+      ++top;
     }
   }
 }
 
 double MeshDistance::distance(const Vec3& p) const {
   double best2 = std::numeric_limits<double>::infinity();
-  search(p, best2, [&](const LeafTriangle& t) {
-    if (box_distance2(t, p) < best2) best2 = std::min(best2, point_triangle_distance2(p, t.a, t.b, t.c));
+  search(p, best2, [&](const LeafTriangle& t, double box2) {
+    if (box2 < best2) best2 = std::min(best2, point_triangle_distance2(p, t.a, t.b, t.c));
   });
   return std::sqrt(best2);
 }
@@ -155,8 +347,8 @@ double MeshDistance::distance(const Vec3& p) const {
 bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found) const {
   const double r2 = r * r;
   double d2 = 0;
-  auto reaches = [&](const LeafTriangle& t) {
-    return box_distance2(t, p) <= r2 && (d2 = point_triangle_distance2(p, t.a, t.b, t.c)) <= r2;
+  auto reaches = [&](const LeafTriangle& t, double box2) {
+    return box2 <= r2 && (d2 = point_triangle_distance2(p, t.a, t.b, t.c)) <= r2;
   };
   auto take = [&](const LeafTriangle& t) {
     if (hint) *hint = static_cast<uint32_t>(&t - tris_.data());
@@ -165,16 +357,17 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
   };
   // The hint's triangles first: stored in leaf order, the slots around it lie close by.
   constexpr uint32_t kAround = 8;
-  if (hint && *hint < triangles_) {
-    const uint32_t lo = *hint > kAround ? *hint - kAround : 0, hi = std::min<uint32_t>(uint32_t(triangles_), *hint + kAround + 1);
+  if (hint && *hint < tris_.size()) {
+    const uint32_t lo = *hint > kAround ? *hint - kAround : 0;
+    const uint32_t hi = std::min<uint32_t>(uint32_t(tris_.size()), *hint + kAround + 1);
     for (uint32_t i = lo; i < hi; ++i)
-      if (reaches(tris_[i])) return take(tris_[i]);
+      if (tris_[i].id != kNoTriangle && reaches(tris_[i], 0)) return take(tris_[i]);
   }
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the
   // bound drops below every distance and the search ends.
   double bound2 = std::nextafter(r2, std::numeric_limits<double>::infinity());
-  search(p, bound2, [&](const LeafTriangle& t) {
-    if (bound2 >= 0 && reaches(t)) {
+  search(p, bound2, [&](const LeafTriangle& t, double box2) {
+    if (bound2 >= 0 && reaches(t, box2)) {
       bound2 = -1;
       take(t);
     }
@@ -183,17 +376,6 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
 }
 
 namespace {
-
-/// Squared distance between two boxes (0 when they meet).
-template <class A, class B>
-double box_box_distance2(const A& a, const B& b) {
-  double s = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = std::max({double(a.lo[k]) - double(b.hi[k]), 0.0, double(b.lo[k]) - double(a.hi[k])});
-    s += d * d;
-  }
-  return s;
-}
 
 struct Box {
   Vec3 lo, hi;
@@ -240,27 +422,33 @@ bool triangle_farther(const Box& box, const Vec3& a, const Vec3& b, const Vec3& 
 
 bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const {
   const Box box{lo, hi};
+  const FloatBox q(lo, hi);
   const double r2 = r * r;
   auto away = [&](const LeafTriangle& t) {
-    if (box_box_distance2(t, box) > r2) return true;
     const Vec3 n = cross3(sub3(t.b, t.a), sub3(t.c, t.a));
     const double len = norm3(n);
     return triangle_farther(box, t.a, t.b, t.c, len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0}, r, kOctantDepth);
   };
-  if (nodes_.empty()) return true;
-  uint32_t stack[128];
+  if (tris_.empty()) return true;
+  uint32_t stack[512];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = root_;
   while (top > 0) {
-    const BNode& nd = nodes_[stack[--top]];
-    if (box_box_distance2(nd, box) > r2) continue;
-    if (nd.count == 0) {
-      stack[top++] = nd.first;
-      stack[top++] = nd.first + 1;
+    const uint32_t ref = stack[--top];
+    if (ref & kLeafBit) {
+      const uint32_t leaf = ref & ~kLeafBit;
+      alignas(16) float d[8];
+      box_distance2_x4(&leaves_[leaf].lo[0][0], &leaves_[leaf].hi[0][0], 8, q, d);
+      box_distance2_x4(&leaves_[leaf].lo[0][4], &leaves_[leaf].hi[0][4], 8, q, d + 4);
+      for (uint32_t i = 0; i < kLeafSize; ++i)
+        if (double(d[i]) <= r2 && !away(tris_[kLeafSize * leaf + i])) return false;
       continue;
     }
-    for (uint32_t i = nd.first; i < nd.first + nd.count; ++i)
-      if (!away(tris_[i])) return false;
+    const Node4& nd = nodes_[ref];
+    alignas(16) float d[4];
+    children_distance2(nd, q, d);
+    for (int i = 0; i < 4; ++i)
+      if (double(d[i]) <= r2) stack[top++] = nd.child[i];
   }
   return true;
 }
@@ -268,7 +456,7 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;
-  if (hint && *hint < triangles_) {
+  if (hint && *hint < tris_.size() && tris_[*hint].id != kNoTriangle) {
     const LeafTriangle& t = tris_[*hint];
     best = nearest_on_triangle2(p, t.a, t.b, t.c);
     best.triangle = t.id;
@@ -280,8 +468,8 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   // hair above its distance and so prunes no triangle at the least distance, and among those
   // visited a tie goes to the lowest index.
   uint32_t slot = hint ? *hint : 0;
-  search(p, best2, [&](const LeafTriangle& t) {
-    if (box_distance2(t, p) >= best2) return;
+  search(p, best2, [&](const LeafTriangle& t, double box2) {
+    if (box2 >= best2) return;
     const Nearest n = nearest_on_triangle2(p, t.a, t.b, t.c);
     if (n.distance < best2 || (n.distance == best2 && t.id < best.triangle)) {
       best2 = n.distance;
@@ -296,12 +484,6 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
 }
 
 namespace {
-
-/// Surface area of a box (half of it: only ratios are compared).
-double half_area(const Vec3& lo, const Vec3& hi) {
-  const double x = std::max(0.0, hi[0] - lo[0]), y = std::max(0.0, hi[1] - lo[1]), z = std::max(0.0, hi[2] - lo[2]);
-  return x * y + y * z + z * x;
-}
 
 constexpr int kBins = 16;
 
@@ -372,7 +554,7 @@ void MeshDistance::build(std::vector<BNode>& out, uint32_t self, const Bounds& b
                          std::vector<uint32_t>& order, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
                          const std::vector<Vec3>& centre) {
   BNode nd;
-  for (int k = 0; k < 3; ++k) nd.lo[k] = round_down(box.lo[k]), nd.hi[k] = round_up(box.hi[k]);
+  nd.lo = box.lo, nd.hi = box.hi;
   if (last - first <= kLeafSize) {
     nd.first = first;
     nd.count = last - first;

@@ -46,21 +46,37 @@ class MeshDistance {
   Nearest nearest(const Vec3& p, uint32_t* hint = nullptr) const;
 
  private:
-  // Boxes in float, rounded outward: half the bytes per node, and a box only prunes.
-  struct BNode {
-    float lo[3], hi[3];
-    uint32_t first = 0;  // internal: children at first, first + 1; leaf: range in tris_
-    uint32_t count = 0;  // 0 = internal
+  // Boxes in float, rounded outward: a box only prunes, and four of them side by side (a
+  // node's children, half a leaf's triangles) are measured in one vector operation.
+  /// Four children's boxes, axis by axis; an unused slot's box is empty (lo +inf, hi -inf).
+  struct Node4 {
+    alignas(16) float lo[3][4], hi[3][4];
+    uint32_t child[4];  // kLeafBit set: a leaf's number, else a node's
+  };
+  /// What bounds a leaf's triangles' distances from below, slot by slot (slots past its count
+  /// empty): their boxes axis by axis, their planes (unit normal, offset) and, in each plane,
+  /// the lines of their three sides (unit normal pointing out of the triangle, offset). Its
+  /// triangles are tris_[kLeafSize * leaf, ...).
+  struct LeafBounds {
+    alignas(16) float lo[3][8], hi[3][8];
+    alignas(16) float plane[4][8];
+    alignas(16) float side[3][4][8];
   };
   struct LeafTriangle {
     Vec3 a, b, c;
-    float lo[3], hi[3];
-    uint32_t id;  // index in the mesh
+    uint32_t id;  // index in the mesh; kNoTriangle in a leaf's unused slots
   };
-  template <class Box>
-  static double box_distance2(const Box& box, const Vec3& p);
+  static constexpr uint32_t kLeafBit = 1u << 31;
+  static constexpr uint32_t kNoTriangle = ~uint32_t{0};
   /// Triangles per leaf at most.
   static constexpr uint32_t kLeafSize = 8;
+
+  /// The binary tree the surface area heuristic builds, collapsed into Node4s after.
+  struct BNode {
+    Vec3 lo, hi;
+    uint32_t first = 0;  // internal: children at first, first + 1; leaf: range in the order
+    uint32_t count = 0;  // 0 = internal
+  };
   struct Bounds {
     Vec3 lo, hi;
     void grow(const Vec3& l, const Vec3& h) {
@@ -82,12 +98,20 @@ class MeshDistance {
                      const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
   static Bounds bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                     const std::vector<Vec3>& hi);
+  /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended.
+  uint32_t collapse(const std::vector<BNode>& binary, uint32_t b, const TriMesh& mesh,
+                    const std::vector<uint32_t>& order, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
+  /// Slot i of l: triangle abc's plane and sides.
+  static void set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c);
 
   size_t triangles_ = 0;
-  std::vector<LeafTriangle> tris_;  // in leaf order
-  std::vector<BNode> nodes_;
+  uint32_t root_ = 0;
+  std::vector<Node4> nodes_;
+  std::vector<LeafBounds> leaves_;
+  float rounding_ = 0;  // how far the float planes of leaves_ may be off, at the origin
+  std::vector<LeafTriangle> tris_;  // kLeafSize slots per leaf
 };
 
 /// Signed distance to a closed 2-manifold mesh (negative inside). Keeps a reference to `mesh`.
