@@ -183,10 +183,37 @@ void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
   plane_distance2_x4(&l.plane[0][4], &l.side[0][0][4], q.x, q.slack, out + 4);
 }
 
-/// box_distance2_x4 for a node's four children.
+/// Lower bounds on the squared distances from q to a node's four children: the larger of
+/// their axis boxes' and their oriented boxes' (measured in floats along the stored axes, each
+/// gap less q's slack; the stored axes are orthonormal to float rounding, which kShrink covers).
 template <class Node>
-void children_distance2(const Node& n, const FloatBox& q, float* out) {
-  box_distance2_x4(&n.lo[0][0], &n.hi[0][0], 4, q, out);
+void children_distance2(const Node& n, const FloatPoint& q, float* out) {
+  box_distance2_x4(&n.lo[0][0], &n.hi[0][0], 4, q.box, out);
+  constexpr float kShrink = 1.0f - 1.0f / (1 << 18);
+#if defined(__SSE2__)
+  const __m128 px = _mm_set1_ps(q.x[0]), py = _mm_set1_ps(q.x[1]), pz = _mm_set1_ps(q.x[2]), zero = _mm_setzero_ps();
+  const __m128 slack = _mm_set1_ps(q.slack);
+  __m128 s = zero;
+  for (int k = 0; k < 3; ++k) {
+    __m128 x = _mm_mul_ps(_mm_load_ps(n.axis[k][0]), px);
+    x = _mm_add_ps(x, _mm_mul_ps(_mm_load_ps(n.axis[k][1]), py));
+    x = _mm_add_ps(x, _mm_mul_ps(_mm_load_ps(n.axis[k][2]), pz));
+    const __m128 gap = _mm_max_ps(_mm_sub_ps(_mm_load_ps(n.along[k][0]), x), _mm_sub_ps(x, _mm_load_ps(n.along[k][1])));
+    const __m128 d = _mm_max_ps(_mm_sub_ps(gap, slack), zero);
+    s = _mm_add_ps(s, _mm_mul_ps(d, d));
+  }
+  _mm_store_ps(out, _mm_max_ps(_mm_load_ps(out), _mm_mul_ps(s, _mm_set1_ps(kShrink))));
+#else
+  for (int i = 0; i < 4; ++i) {
+    float s = 0;
+    for (int k = 0; k < 3; ++k) {
+      const float x = n.axis[k][0][i] * q.x[0] + n.axis[k][1][i] * q.x[1] + n.axis[k][2][i] * q.x[2];
+      const float d = std::max(std::max(n.along[k][0][i] - x, x - n.along[k][1][i]) - q.slack, 0.0f);
+      s += d * d;
+    }
+    out[i] = std::max(out[i], s * kShrink);
+  }
+#endif
 }
 
 }  // namespace
@@ -215,11 +242,20 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
   double extent = 0;
   for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
   rounding_ = float(extent * kPlaneRounding);
-  root_ = collapse(binary, 0, mesh, order, lo, hi);
+  // Each binary node's run of the order (a subtree's triangles are contiguous in it).
+  std::vector<std::pair<uint32_t, uint32_t>> range(binary.size());
+  const auto runs = [&](auto&& self, uint32_t b) -> std::pair<uint32_t, uint32_t> {
+    const BNode& nd = binary[b];
+    if (nd.count > 0) return range[b] = {nd.first, nd.first + nd.count};
+    return range[b] = {self(self, nd.first).first, self(self, nd.first + 1).second};
+  };
+  runs(runs, 0);
+  root_ = collapse(binary, range, 0, mesh, order, lo, hi);
 }
 
-uint32_t MeshDistance::collapse(const std::vector<BNode>& binary, uint32_t b, const TriMesh& mesh,
-                                const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
+                                const std::vector<std::pair<uint32_t, uint32_t>>& range, uint32_t b,
+                                const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                                 const std::vector<Vec3>& hi) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const BNode& nd = binary[b];
@@ -259,15 +295,65 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary, uint32_t b, co
   const uint32_t self = uint32_t(nodes_.size());
   nodes_.emplace_back();
   Node4 out;
-  for (int k = 0; k < 3; ++k) std::fill_n(out.lo[k], 4, kInf), std::fill_n(out.hi[k], 4, -kInf);
+  for (int k = 0; k < 3; ++k) {
+    std::fill_n(out.lo[k], 4, kInf), std::fill_n(out.hi[k], 4, -kInf);
+    for (int j = 0; j < 3; ++j) std::fill_n(out.axis[k][j], 4, k == j ? 1.0f : 0.0f);
+    std::fill_n(out.along[k][0], 4, kInf), std::fill_n(out.along[k][1], 4, -kInf);
+  }
   for (int i = 0; i < 4; ++i) out.child[i] = 0;
   for (int i = 0; i < count; ++i) {
     const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
     for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
-    out.child[i] = collapse(binary, kids[i], mesh, order, lo, hi);
+    set_oriented_box(out, i, mesh, order, range[kids[i]].first, range[kids[i]].second);
+    out.child[i] = collapse(binary, range, kids[i], mesh, order, lo, hi);
   }
   nodes_[self] = out;
   return self;
+}
+
+void MeshDistance::set_oriented_box(Node4& n, int i, const TriMesh& mesh, const std::vector<uint32_t>& order,
+                                    uint32_t first, uint32_t last) {
+  const auto& P = mesh.positions;
+  // The normal: the triangles' normals weighted by area; across it, the principal direction
+  // of their centres' spread in its plane.
+  Vec3 normal{0, 0, 0}, mean{0, 0, 0};
+  for (uint32_t i = first; i < last; ++i) {
+    const auto& t = mesh.triangles[order[i]];
+    normal = add3(normal, cross3(sub3(P[t[1]], P[t[0]]), sub3(P[t[2]], P[t[0]])));
+    mean = add3(mean, scale3(add3(add3(P[t[0]], P[t[1]]), P[t[2]]), 1.0 / 3));
+  }
+  const double len = norm3(normal);
+  normal = len > kTinyDivisor ? scale3(normal, 1 / len) : Vec3{0, 0, 1};
+  mean = scale3(mean, 1.0 / double(last - first));
+  const int least = std::abs(normal[0]) <= std::abs(normal[1]) && std::abs(normal[0]) <= std::abs(normal[2]) ? 0
+                    : std::abs(normal[1]) <= std::abs(normal[2])                                           ? 1
+                                                                                                           : 2;
+  Vec3 e{0, 0, 0};
+  e[least] = 1;
+  const Vec3 t1 = scale3(cross3(normal, e), 1 / norm3(cross3(normal, e))), t2 = cross3(normal, t1);
+  double c11 = 0, c12 = 0, c22 = 0;
+  for (uint32_t i = first; i < last; ++i) {
+    const auto& t = mesh.triangles[order[i]];
+    const Vec3 d = sub3(scale3(add3(add3(P[t[0]], P[t[1]]), P[t[2]]), 1.0 / 3), mean);
+    const double x = dot3(d, t1), y = dot3(d, t2);
+    c11 += x * x, c12 += x * y, c22 += y * y;
+  }
+  const double angle = 0.5 * std::atan2(2 * c12, c11 - c22);
+  const Vec3 u = add3(scale3(t1, std::cos(angle)), scale3(t2, std::sin(angle))), v = cross3(normal, u);
+  // The axes as stored (floats); the extents along them, in doubles from those, rounded out.
+  const Vec3* axes[3] = {&normal, &u, &v};
+  Vec3 stored[3];
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) stored[k][j] = double(n.axis[k][j][i] = float((*axes[k])[j]));
+  for (int k = 0; k < 3; ++k) {
+    double lo = kHuge, hi = -kHuge;
+    for (uint32_t t = first; t < last; ++t)
+      for (uint32_t corner : mesh.triangles[order[t]]) {
+        const double x = dot3(stored[k], P[corner]);
+        lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+    n.along[k][0][i] = round_down(lo), n.along[k][1][i] = round_up(hi);
+  }
 }
 
 void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -324,7 +410,7 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
     }
     const Node4& nd = nodes_[e.ref];
     alignas(16) float d[4];
-    children_distance2(nd, q.box, d);
+    children_distance2(nd, q, d);
     // The children within best2, the nearest last so that it is opened next.
     const int first = top;
     for (int i = 0; i < 4; ++i) {
@@ -446,7 +532,7 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
     }
     const Node4& nd = nodes_[ref];
     alignas(16) float d[4];
-    children_distance2(nd, q, d);
+    box_distance2_x4(&nd.lo[0][0], &nd.hi[0][0], 4, q, d);
     for (int i = 0; i < 4; ++i)
       if (double(d[i]) <= r2) stack[top++] = nd.child[i];
   }

@@ -49,8 +49,13 @@ class MeshDistance {
   // Boxes in float, rounded outward: a box only prunes, and four of them side by side (a
   // node's children, half a leaf's triangles) are measured in one vector operation.
   /// Four children's boxes, axis by axis; an unused slot's box is empty (lo +inf, hi -inf).
+  /// Each child has a second box, oriented to its triangles: one axis along their mean normal
+  /// and two across it, so that a flat or gently curved patch fills it closely (an axis box
+  /// holds a tilted patch loosely, and a point above it is near the box but far from the patch).
   struct Node4 {
     alignas(16) float lo[3][4], hi[3][4];
+    alignas(16) float axis[3][3][4];     // oriented box: axis k's component j
+    alignas(16) float along[3][2][4];    // its extent along axis k: [0] low, [1] high
     uint32_t child[4];  // kLeafBit set: a leaf's number, else a node's
   };
   /// What bounds a leaf's triangles' distances from below, slot by slot (slots past its count
@@ -99,8 +104,12 @@ class MeshDistance {
   static Bounds bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                     const std::vector<Vec3>& hi);
   /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended.
-  uint32_t collapse(const std::vector<BNode>& binary, uint32_t b, const TriMesh& mesh,
-                    const std::vector<uint32_t>& order, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
+  uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
+                    uint32_t b, const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                    const std::vector<Vec3>& hi);
+  /// Slot i of n: the oriented box of the triangles order[first, last).
+  static void set_oriented_box(Node4& n, int i, const TriMesh& mesh, const std::vector<uint32_t>& order,
+                               uint32_t first, uint32_t last);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
   /// Slot i of l: triangle abc's plane and sides.
