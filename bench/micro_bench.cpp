@@ -19,6 +19,11 @@
 //   BM_DipoleTreeQuery/near      the same decisions by a dipole tree of all the triangles, one
 //                                query at a time
 //   BM_OffsetSpot/depth:D        spot grown by 0.05 (2.6 % of its size), the octree only
+//   BM_NearestAtOffset/K         nearest-point queries one after another, each hinted by the
+//                                last answer, as the offset's sampler asks them: points 2.6 % of
+//                                the model's size out from each triangle's centre along its
+//                                normal, in the mesh's order; 0 = spot, 1 = the Stanford bunny
+//                                (69k small triangles: many near-ties at that distance)
 //   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
 //                                punched (winding), 2 = the Stanford bunny (open base, winding),
 //                                3 = the bunny with its holes closed by fans (parity): the per-PIC
@@ -45,6 +50,7 @@
 #include "pic/primitives.h"
 #include "geometry/qef.h"
 #include "octree/cell.h"
+#include "geometry/mesh_distance.h"
 #include "geometry/winding.h"
 #include "mesh/clean.h"
 #include "sample/sources.h"
@@ -386,6 +392,32 @@ void BM_OffsetSpot(benchmark::State& state) {
   state.counters["queries"] = static_cast<double>(st.evaluations);
 }
 BENCHMARK(BM_OffsetSpot)->ArgName("depth")->Arg(10)->Arg(12)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_NearestAtOffset(benchmark::State& state) {
+  const pic::TriMesh& m = mesh_of(state.range(0) == 0 ? "spot.obj" : "stanford-bunny.obj");
+  const double d = state.range(0) == 0 ? 0.05 : 0.004;
+  const pic::detail::MeshDistance md(m);
+  std::vector<pic::Vec3> at;
+  for (const auto& t : m.triangles) {
+    const pic::Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+    pic::Vec3 n{(b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+                (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
+                (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) continue;
+    pic::Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = (a[k] + b[k] + c[k]) / 3 + d * n[k] / len;
+    at.push_back(p);
+  }
+  for (auto _ : state) {
+    uint32_t hint = 0;
+    double sum = 0;
+    for (const pic::Vec3& p : at) sum += md.nearest(p, &hint).distance;
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(at.size()));
+}
+BENCHMARK(BM_NearestAtOffset)->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
 
 // The allocator settings of the command-line tool, so both measure the same thing.
 int main(int argc, char** argv) {

@@ -1,5 +1,7 @@
 // Distances from points to a triangle mesh: the nearest point over a BVH split by the surface
-// area heuristic, leaves of up to 8 triangles (exact point-triangle distances), and for a
+// area heuristic and collapsed to four children a node, leaves of up to 8 triangles; lower
+// bounds (axis and oriented boxes, each triangle's plane and sides) measured in floats before
+// the exact point-triangle distance (docs/algorithms.md, distance queries); and for a
 // closed 2-manifold mesh the signed distance, its sign from the angle-weighted pseudonormal of
 // the nearest feature (Baerentzen and Aanaes 2005: exact for such a mesh, no ray and no
 // winding number).
