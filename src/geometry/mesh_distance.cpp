@@ -238,7 +238,6 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
   build(binary, 0, bounds(0, uint32_t(n), order, lo, hi), 0, static_cast<uint32_t>(n), order, lo, hi, centre);
   nodes_.reserve(binary.size() / 3 + 1);
   leaves_.reserve(binary.size() / 2 + 1);
-  tris_.reserve(kLeafSize * (binary.size() / 2 + 1));
   double extent = 0;
   for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
   rounding_ = float(extent * kPlaneRounding);
@@ -250,29 +249,47 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
     return range[b] = {self(self, nd.first).first, self(self, nd.first + 1).second};
   };
   runs(runs, 0);
-  root_ = collapse(binary, range, 0, mesh, order, lo, hi);
+  Pending pending;
+  root_ = collapse(binary, range, 0, pending);
+  // The triangles in the order, side by side, for the bounds filled in below.
+  std::vector<Vec3> corners(3 * n), normals(n), centroids(n);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const auto& t = mesh.triangles[order[i]];
+    for (int k = 0; k < 3; ++k) corners[3 * i + k] = mesh.positions[t[k]];
+    normals[i] = cross3(sub3(corners[3 * i + 1], corners[3 * i]), sub3(corners[3 * i + 2], corners[3 * i]));
+    centroids[i] = scale3(add3(add3(corners[3 * i], corners[3 * i + 1]), corners[3 * i + 2]), 1.0 / 3);
+  });
+  tris_.assign(kLeafSize * leaves_.size(), LeafTriangle{{}, {}, {}, kNoTriangle});
+  tbb::parallel_for(size_t{0}, pending.leaves.size(), [&](size_t j) {
+    const auto [leaf, first, last] = pending.leaves[j];
+    LeafBounds& l = leaves_[leaf];
+    for (uint32_t i = 0; i < last - first; ++i) {
+      const uint32_t at = first + i;
+      const FloatBox box(lo[order[at]], hi[order[at]]);
+      for (int k = 0; k < 3; ++k) l.lo[k][i] = box.lo[k], l.hi[k][i] = box.hi[k];
+      LeafTriangle& tri = tris_[kLeafSize * leaf + i];
+      tri = {corners[3 * at], corners[3 * at + 1], corners[3 * at + 2], order[at]};
+      set_planes(l, i, tri.a, tri.b, tri.c);
+    }
+  });
+  tbb::parallel_for(size_t{0}, pending.boxes.size(), [&](size_t j) {
+    const auto [node, slot, first, last] = pending.boxes[j];
+    set_oriented_box(nodes_[node], slot, &corners[3 * size_t(first)], &normals[first], &centroids[first], last - first);
+  });
 }
 
 uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
                                 const std::vector<std::pair<uint32_t, uint32_t>>& range, uint32_t b,
-                                const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
-                                const std::vector<Vec3>& hi) {
+                                Pending& pending) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const BNode& nd = binary[b];
   if (nd.count > 0) {
     const uint32_t leaf = uint32_t(leaves_.size());
-    LeafBounds boxes{};
-    for (int k = 0; k < 3; ++k) std::fill_n(boxes.lo[k], 8, kInf), std::fill_n(boxes.hi[k], 8, -kInf);
-    tris_.resize(tris_.size() + kLeafSize, LeafTriangle{{}, {}, {}, kNoTriangle});
-    for (uint32_t i = 0; i < nd.count; ++i) {
-      const uint32_t t = order[nd.first + i];
-      const FloatBox box(lo[t], hi[t]);
-      for (int k = 0; k < 3; ++k) boxes.lo[k][i] = box.lo[k], boxes.hi[k][i] = box.hi[k];
-      const auto& v = mesh.triangles[t];
-      const LeafTriangle& tri = tris_[kLeafSize * leaf + i] = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], t};
-      set_planes(boxes, i, tri.a, tri.b, tri.c);
-    }
-    leaves_.push_back(boxes);
+    LeafBounds& l = leaves_.emplace_back();
+    for (int k = 0; k < 3; ++k) std::fill_n(l.lo[k], 8, kInf), std::fill_n(l.hi[k], 8, -kInf);
+    // Unused slots' planes bound nothing (see set_planes).
+    for (int e = 0; e < 3; ++e) std::fill_n(l.side[e][3], 8, kInf);
+    pending.leaves.push_back({leaf, nd.first, nd.first + nd.count});
     return leaf | kLeafBit;
   }
   // Up to four descendants: the widest inner one opened until there are four (a query opens a
@@ -304,27 +321,22 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   for (int i = 0; i < count; ++i) {
     const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
     for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
-    set_oriented_box(out, i, mesh, order, range[kids[i]].first, range[kids[i]].second);
-    out.child[i] = collapse(binary, range, kids[i], mesh, order, lo, hi);
+    pending.boxes.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
+    out.child[i] = collapse(binary, range, kids[i], pending);
   }
   nodes_[self] = out;
   return self;
 }
 
-void MeshDistance::set_oriented_box(Node4& n, int i, const TriMesh& mesh, const std::vector<uint32_t>& order,
-                                    uint32_t first, uint32_t last) {
-  const auto& P = mesh.positions;
+void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, const Vec3* normals,
+                                    const Vec3* centroids, uint32_t count) {
   // The normal: the triangles' normals weighted by area; across it, the principal direction
-  // of their centres' spread in its plane.
+  // of their centroids' spread in its plane.
   Vec3 normal{0, 0, 0}, mean{0, 0, 0};
-  for (uint32_t i = first; i < last; ++i) {
-    const auto& t = mesh.triangles[order[i]];
-    normal = add3(normal, cross3(sub3(P[t[1]], P[t[0]]), sub3(P[t[2]], P[t[0]])));
-    mean = add3(mean, scale3(add3(add3(P[t[0]], P[t[1]]), P[t[2]]), 1.0 / 3));
-  }
+  for (uint32_t t = 0; t < count; ++t) normal = add3(normal, normals[t]), mean = add3(mean, centroids[t]);
   const double len = norm3(normal);
   normal = len > kTinyDivisor ? scale3(normal, 1 / len) : Vec3{0, 0, 1};
-  mean = scale3(mean, 1.0 / double(last - first));
+  mean = scale3(mean, 1.0 / double(count));
   const int least = std::abs(normal[0]) <= std::abs(normal[1]) && std::abs(normal[0]) <= std::abs(normal[2]) ? 0
                     : std::abs(normal[1]) <= std::abs(normal[2])                                           ? 1
                                                                                                            : 2;
@@ -332,9 +344,8 @@ void MeshDistance::set_oriented_box(Node4& n, int i, const TriMesh& mesh, const 
   e[least] = 1;
   const Vec3 t1 = scale3(cross3(normal, e), 1 / norm3(cross3(normal, e))), t2 = cross3(normal, t1);
   double c11 = 0, c12 = 0, c22 = 0;
-  for (uint32_t i = first; i < last; ++i) {
-    const auto& t = mesh.triangles[order[i]];
-    const Vec3 d = sub3(scale3(add3(add3(P[t[0]], P[t[1]]), P[t[2]]), 1.0 / 3), mean);
+  for (uint32_t t = 0; t < count; ++t) {
+    const Vec3 d = sub3(centroids[t], mean);
     const double x = dot3(d, t1), y = dot3(d, t2);
     c11 += x * x, c12 += x * y, c22 += y * y;
   }
@@ -345,15 +356,13 @@ void MeshDistance::set_oriented_box(Node4& n, int i, const TriMesh& mesh, const 
   Vec3 stored[3];
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j) stored[k][j] = double(n.axis[k][j][i] = float((*axes[k])[j]));
-  for (int k = 0; k < 3; ++k) {
-    double lo = kHuge, hi = -kHuge;
-    for (uint32_t t = first; t < last; ++t)
-      for (uint32_t corner : mesh.triangles[order[t]]) {
-        const double x = dot3(stored[k], P[corner]);
-        lo = std::min(lo, x), hi = std::max(hi, x);
-      }
-    n.along[k][0][i] = round_down(lo), n.along[k][1][i] = round_up(hi);
-  }
+  double lo[3] = {kHuge, kHuge, kHuge}, hi[3] = {-kHuge, -kHuge, -kHuge};
+  for (uint32_t c = 0; c < 3 * count; ++c)
+    for (int k = 0; k < 3; ++k) {
+      const double x = dot3(stored[k], corners[c]);
+      lo[k] = std::min(lo[k], x), hi[k] = std::max(hi[k], x);
+    }
+  for (int k = 0; k < 3; ++k) n.along[k][0][i] = round_down(lo[k]), n.along[k][1][i] = round_up(hi[k]);
 }
 
 void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -441,13 +450,17 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
     if (found) *found = std::sqrt(d2);
     return true;
   };
-  // The hint's triangles first: stored in leaf order, the slots around it lie close by.
-  constexpr uint32_t kAround = 8;
+  // The hint's leaf and the leaves on either side first: stored in leaf order, they lie close
+  // by.
   if (hint && *hint < tris_.size()) {
-    const uint32_t lo = *hint > kAround ? *hint - kAround : 0;
-    const uint32_t hi = std::min<uint32_t>(uint32_t(tris_.size()), *hint + kAround + 1);
-    for (uint32_t i = lo; i < hi; ++i)
-      if (tris_[i].id != kNoTriangle && reaches(tris_[i], 0)) return take(tris_[i]);
+    const FloatPoint q(p, rounding_);
+    const uint32_t leaf = *hint / kLeafSize, last = uint32_t(leaves_.size()) - 1;
+    for (uint32_t l = leaf > 0 ? leaf - 1 : 0; l <= std::min(leaf + 1, last); ++l) {
+      alignas(16) float d[8];
+      leaf_distance2(leaves_[l], q, d);
+      for (uint32_t i = 0; i < kLeafSize; ++i)
+        if (double(d[i]) <= r2 && reaches(tris_[kLeafSize * l + i], d[i])) return take(tris_[kLeafSize * l + i]);
+    }
   }
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the
   // bound drops below every distance and the search ends.

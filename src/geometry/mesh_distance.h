@@ -105,13 +105,20 @@ class MeshDistance {
                      const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
   static Bounds bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                     const std::vector<Vec3>& hi);
-  /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended.
+  /// What the collapse leaves to fill in afterwards, in parallel: a Node4 child's oriented box
+  /// (node, slot, its triangles' run of the order) and a leaf's triangles (leaf, run).
+  struct Pending {
+    std::vector<std::array<uint32_t, 4>> boxes;   // node, slot, first, last
+    std::vector<std::array<uint32_t, 3>> leaves;  // leaf, first, last
+  };
+  /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended with
+  /// their axis boxes; the rest of their bounds go to `pending`.
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
-                    uint32_t b, const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
-                    const std::vector<Vec3>& hi);
-  /// Slot i of n: the oriented box of the triangles order[first, last).
-  static void set_oriented_box(Node4& n, int i, const TriMesh& mesh, const std::vector<uint32_t>& order,
-                               uint32_t first, uint32_t last);
+                    uint32_t b, Pending& pending);
+  /// Slot i of n: the oriented box of `count` triangles (their corners, three each; their
+  /// normals times twice their area; their centroids).
+  static void set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, const Vec3* normals, const Vec3* centroids,
+                               uint32_t count);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
   /// Slot i of l: triangle abc's plane and sides.
