@@ -251,15 +251,9 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
   runs(runs, 0);
   Pending pending;
   root_ = collapse(binary, range, 0, pending);
-  // The triangles in the order, side by side, for the bounds filled in below.
-  std::vector<Vec3> corners(3 * n), normals(n), centroids(n);
-  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-    const auto& t = mesh.triangles[order[i]];
-    for (int k = 0; k < 3; ++k) corners[3 * i + k] = mesh.positions[t[k]];
-    normals[i] = cross3(sub3(corners[3 * i + 1], corners[3 * i]), sub3(corners[3 * i + 2], corners[3 * i]));
-    centroids[i] = scale3(add3(add3(corners[3 * i], corners[3 * i + 1]), corners[3 * i + 2]), 1.0 / 3);
-  });
-  tris_.assign(kLeafSize * leaves_.size(), LeafTriangle{{}, {}, {}, kNoTriangle});
+  // The triangles in the order, their leaves' bounds, then the nodes' oriented boxes from them
+  // (the build's own arrays freed first: a large mesh's peak memory).
+  tris_.resize(n);
   tbb::parallel_for(size_t{0}, pending.leaves.size(), [&](size_t j) {
     const auto [leaf, first, last] = pending.leaves[j];
     LeafBounds& l = leaves_[leaf];
@@ -267,14 +261,22 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
       const uint32_t at = first + i;
       const FloatBox box(lo[order[at]], hi[order[at]]);
       for (int k = 0; k < 3; ++k) l.lo[k][i] = box.lo[k], l.hi[k][i] = box.hi[k];
-      LeafTriangle& tri = tris_[kLeafSize * leaf + i];
-      tri = {corners[3 * at], corners[3 * at + 1], corners[3 * at + 2], order[at]};
+      const auto& t = mesh.triangles[order[at]];
+      LeafTriangle& tri = tris_[at];
+      tri = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]], order[at], leaf};
       set_planes(l, i, tri.a, tri.b, tri.c);
     }
   });
+  for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
+  std::vector<BNode>().swap(binary);
+  std::vector<Vec3> normals(n);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const LeafTriangle& t = tris_[i];
+    normals[i] = cross3(sub3(t.b, t.a), sub3(t.c, t.a));
+  });
   tbb::parallel_for(size_t{0}, pending.boxes.size(), [&](size_t j) {
     const auto [node, slot, first, last] = pending.boxes[j];
-    set_oriented_box(nodes_[node], slot, &corners[3 * size_t(first)], &normals[first], &centroids[first], last - first);
+    set_oriented_box(nodes_[node], slot, &tris_[first], &normals[first], last - first);
   });
 }
 
@@ -289,6 +291,7 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
     for (int k = 0; k < 3; ++k) std::fill_n(l.lo[k], 8, kInf), std::fill_n(l.hi[k], 8, -kInf);
     // Unused slots' planes bound nothing (see set_planes).
     for (int e = 0; e < 3; ++e) std::fill_n(l.side[e][3], 8, kInf);
+    l.first = nd.first, l.count = nd.count;
     pending.leaves.push_back({leaf, nd.first, nd.first + nd.count});
     return leaf | kLeafBit;
   }
@@ -328,12 +331,13 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   return self;
 }
 
-void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, const Vec3* normals,
-                                    const Vec3* centroids, uint32_t count) {
+void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tris, const Vec3* normals,
+                                    uint32_t count) {
+  const auto centroid = [&](uint32_t t) { return scale3(add3(add3(tris[t].a, tris[t].b), tris[t].c), 1.0 / 3); };
   // The normal: the triangles' normals weighted by area; across it, the principal direction
   // of their centroids' spread in its plane.
   Vec3 normal{0, 0, 0}, mean{0, 0, 0};
-  for (uint32_t t = 0; t < count; ++t) normal = add3(normal, normals[t]), mean = add3(mean, centroids[t]);
+  for (uint32_t t = 0; t < count; ++t) normal = add3(normal, normals[t]), mean = add3(mean, centroid(t));
   const double len = norm3(normal);
   normal = len > kTinyDivisor ? scale3(normal, 1 / len) : Vec3{0, 0, 1};
   mean = scale3(mean, 1.0 / double(count));
@@ -345,7 +349,7 @@ void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, c
   const Vec3 t1 = scale3(cross3(normal, e), 1 / norm3(cross3(normal, e))), t2 = cross3(normal, t1);
   double c11 = 0, c12 = 0, c22 = 0;
   for (uint32_t t = 0; t < count; ++t) {
-    const Vec3 d = sub3(centroids[t], mean);
+    const Vec3 d = sub3(centroid(t), mean);
     const double x = dot3(d, t1), y = dot3(d, t2);
     c11 += x * x, c12 += x * y, c22 += y * y;
   }
@@ -357,11 +361,12 @@ void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, c
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j) stored[k][j] = double(n.axis[k][j][i] = float((*axes[k])[j]));
   double lo[3] = {kHuge, kHuge, kHuge}, hi[3] = {-kHuge, -kHuge, -kHuge};
-  for (uint32_t c = 0; c < 3 * count; ++c)
-    for (int k = 0; k < 3; ++k) {
-      const double x = dot3(stored[k], corners[c]);
-      lo[k] = std::min(lo[k], x), hi[k] = std::max(hi[k], x);
-    }
+  for (uint32_t t = 0; t < count; ++t)
+    for (const Vec3* c : {&tris[t].a, &tris[t].b, &tris[t].c})
+      for (int k = 0; k < 3; ++k) {
+        const double x = dot3(stored[k], *c);
+        lo[k] = std::min(lo[k], x), hi[k] = std::max(hi[k], x);
+      }
   for (int k = 0; k < 3; ++k) n.along[k][0][i] = round_down(lo[k]), n.along[k][1][i] = round_up(hi[k]);
 }
 
@@ -413,8 +418,9 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
       const uint32_t leaf = e.ref & ~kLeafBit;
       alignas(16) float d[8];
       leaf_distance2(leaves_[leaf], q, d);
-      for (uint32_t i = 0; i < kLeafSize; ++i)
-        if (double(d[i]) < best2) visit(tris_[kLeafSize * leaf + i], double(d[i]));
+      const LeafBounds& l = leaves_[leaf];
+      for (uint32_t i = 0; i < l.count; ++i)
+        if (double(d[i]) < best2) visit(tris_[l.first + i], double(d[i]));
       continue;
     }
     const Node4& nd = nodes_[e.ref];
@@ -454,12 +460,13 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
   // by.
   if (hint && *hint < tris_.size()) {
     const FloatPoint q(p, rounding_);
-    const uint32_t leaf = *hint / kLeafSize, last = uint32_t(leaves_.size()) - 1;
+    const uint32_t leaf = tris_[*hint].leaf, last = uint32_t(leaves_.size()) - 1;
     for (uint32_t l = leaf > 0 ? leaf - 1 : 0; l <= std::min(leaf + 1, last); ++l) {
       alignas(16) float d[8];
       leaf_distance2(leaves_[l], q, d);
-      for (uint32_t i = 0; i < kLeafSize; ++i)
-        if (double(d[i]) <= r2 && reaches(tris_[kLeafSize * l + i], d[i])) return take(tris_[kLeafSize * l + i]);
+      const uint32_t first = leaves_[l].first;
+      for (uint32_t i = 0; i < leaves_[l].count; ++i)
+        if (double(d[i]) <= r2 && reaches(tris_[first + i], d[i])) return take(tris_[first + i]);
     }
   }
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the
@@ -539,8 +546,8 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
       alignas(16) float d[8];
       box_distance2_x4(&leaves_[leaf].lo[0][0], &leaves_[leaf].hi[0][0], 8, q, d);
       box_distance2_x4(&leaves_[leaf].lo[0][4], &leaves_[leaf].hi[0][4], 8, q, d + 4);
-      for (uint32_t i = 0; i < kLeafSize; ++i)
-        if (double(d[i]) <= r2 && !away(tris_[kLeafSize * leaf + i])) return false;
+      for (uint32_t i = 0; i < leaves_[leaf].count; ++i)
+        if (double(d[i]) <= r2 && !away(tris_[leaves_[leaf].first + i])) return false;
       continue;
     }
     const Node4& nd = nodes_[ref];
@@ -555,7 +562,7 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;
-  if (hint && *hint < tris_.size() && tris_[*hint].id != kNoTriangle) {
+  if (hint && *hint < tris_.size()) {
     const LeafTriangle& t = tris_[*hint];
     best = nearest_on_triangle2(p, t.a, t.b, t.c);
     best.triangle = t.id;

@@ -63,18 +63,19 @@ class MeshDistance {
   /// What bounds a leaf's triangles' distances from below, slot by slot (slots past its count
   /// empty): their boxes axis by axis, their planes (unit normal, offset) and, in each plane,
   /// the lines of their three sides (unit normal pointing out of the triangle, offset). Its
-  /// triangles are tris_[kLeafSize * leaf, ...).
+  /// triangles are tris_[first, first + count).
   struct LeafBounds {
     alignas(16) float lo[3][8], hi[3][8];
     alignas(16) float plane[4][8];
     alignas(16) float side[3][4][8];
+    uint32_t first = 0, count = 0;
   };
   struct LeafTriangle {
     Vec3 a, b, c;
-    uint32_t id;  // index in the mesh; kNoTriangle in a leaf's unused slots
+    uint32_t id;    // index in the mesh
+    uint32_t leaf;  // the leaf holding it
   };
   static constexpr uint32_t kLeafBit = 1u << 31;
-  static constexpr uint32_t kNoTriangle = ~uint32_t{0};
   /// Triangles per leaf at most.
   static constexpr uint32_t kLeafSize = 8;
 
@@ -115,10 +116,9 @@ class MeshDistance {
   /// their axis boxes; the rest of their bounds go to `pending`.
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
                     uint32_t b, Pending& pending);
-  /// Slot i of n: the oriented box of `count` triangles (their corners, three each; their
-  /// normals times twice their area; their centroids).
-  static void set_oriented_box(Node4& n, uint32_t i, const Vec3* corners, const Vec3* normals, const Vec3* centroids,
-                               uint32_t count);
+  /// Slot i of n: the oriented box of `count` triangles (`normals`: theirs times twice their
+  /// area).
+  static void set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tris, const Vec3* normals, uint32_t count);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
   /// Slot i of l: triangle abc's plane and sides.
