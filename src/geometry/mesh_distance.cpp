@@ -218,7 +218,7 @@ void children_distance2(const Node& n, const FloatPoint& q, float* out) {
 
 }  // namespace
 
-MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size()) {
+MeshDistance::MeshDistance(const TriMesh& mesh) {
   const size_t n = mesh.triangles.size();
   std::vector<uint32_t> order(n);
   std::iota(order.begin(), order.end(), uint32_t{0});
@@ -241,7 +241,17 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
   double extent = 0;
   for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
   rounding_ = float(extent * kPlaneRounding);
-  // Each binary node's run of the order (a subtree's triangles are contiguous in it).
+  std::vector<std::array<uint32_t, 4>> oriented;  // Node4 children whose oriented boxes are due
+  root_ = collapse(binary, runs_of(binary), 0, oriented);
+  fill_leaves(mesh, order, lo, hi);
+  // The build's own arrays freed before the oriented boxes: a large mesh's peak memory.
+  for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
+  std::vector<BNode>().swap(binary);
+  fill_oriented_boxes(oriented);
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> MeshDistance::runs_of(const std::vector<BNode>& binary) {
+  // A subtree's triangles are contiguous in the order.
   std::vector<std::pair<uint32_t, uint32_t>> range(binary.size());
   const auto runs = [&](auto&& self, uint32_t b) -> std::pair<uint32_t, uint32_t> {
     const BNode& nd = binary[b];
@@ -249,40 +259,41 @@ MeshDistance::MeshDistance(const TriMesh& mesh) : triangles_(mesh.triangles.size
     return range[b] = {self(self, nd.first).first, self(self, nd.first + 1).second};
   };
   runs(runs, 0);
-  Pending pending;
-  root_ = collapse(binary, range, 0, pending);
-  // The triangles in the order, their leaves' bounds, then the nodes' oriented boxes from them
-  // (the build's own arrays freed first: a large mesh's peak memory).
-  tris_.resize(n);
-  tbb::parallel_for(size_t{0}, pending.leaves.size(), [&](size_t j) {
-    const auto [leaf, first, last] = pending.leaves[j];
+  return range;
+}
+
+void MeshDistance::fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                               const std::vector<Vec3>& hi) {
+  tris_.resize(order.size());
+  tbb::parallel_for(size_t{0}, leaves_.size(), [&](size_t leaf) {
     LeafBounds& l = leaves_[leaf];
-    for (uint32_t i = 0; i < last - first; ++i) {
-      const uint32_t at = first + i;
+    for (uint32_t i = 0; i < l.count; ++i) {
+      const uint32_t at = l.first + i;
       const FloatBox box(lo[order[at]], hi[order[at]]);
       for (int k = 0; k < 3; ++k) l.lo[k][i] = box.lo[k], l.hi[k][i] = box.hi[k];
       const auto& t = mesh.triangles[order[at]];
       LeafTriangle& tri = tris_[at];
-      tri = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]], order[at], leaf};
+      tri = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]], order[at], uint32_t(leaf)};
       set_planes(l, i, tri.a, tri.b, tri.c);
     }
   });
-  for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
-  std::vector<BNode>().swap(binary);
-  std::vector<Vec3> normals(n);
-  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+}
+
+void MeshDistance::fill_oriented_boxes(const std::vector<std::array<uint32_t, 4>>& due) {
+  std::vector<Vec3> normals(tris_.size());
+  tbb::parallel_for(size_t{0}, tris_.size(), [&](size_t i) {
     const LeafTriangle& t = tris_[i];
     normals[i] = cross3(sub3(t.b, t.a), sub3(t.c, t.a));
   });
-  tbb::parallel_for(size_t{0}, pending.boxes.size(), [&](size_t j) {
-    const auto [node, slot, first, last] = pending.boxes[j];
+  tbb::parallel_for(size_t{0}, due.size(), [&](size_t j) {
+    const auto [node, slot, first, last] = due[j];
     set_oriented_box(nodes_[node], slot, &tris_[first], &normals[first], last - first);
   });
 }
 
 uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
                                 const std::vector<std::pair<uint32_t, uint32_t>>& range, uint32_t b,
-                                Pending& pending) {
+                                std::vector<std::array<uint32_t, 4>>& oriented) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const BNode& nd = binary[b];
   if (nd.count > 0) {
@@ -292,7 +303,6 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
     // Unused slots' planes bound nothing (see set_planes).
     for (int e = 0; e < 3; ++e) std::fill_n(l.side[e][3], 8, kInf);
     l.first = nd.first, l.count = nd.count;
-    pending.leaves.push_back({leaf, nd.first, nd.first + nd.count});
     return leaf | kLeafBit;
   }
   // Up to four descendants: the widest inner one opened until there are four (a query opens a
@@ -324,8 +334,8 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   for (int i = 0; i < count; ++i) {
     const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
     for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
-    pending.boxes.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
-    out.child[i] = collapse(binary, range, kids[i], pending);
+    oriented.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
+    out.child[i] = collapse(binary, range, kids[i], oriented);
   }
   nodes_[self] = out;
   return self;

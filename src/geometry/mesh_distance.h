@@ -106,16 +106,18 @@ class MeshDistance {
                      const std::vector<Vec3>& hi, const std::vector<Vec3>& centre);
   static Bounds bounds(uint32_t first, uint32_t last, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                     const std::vector<Vec3>& hi);
-  /// What the collapse leaves to fill in afterwards, in parallel: a Node4 child's oriented box
-  /// (node, slot, its triangles' run of the order) and a leaf's triangles (leaf, run).
-  struct Pending {
-    std::vector<std::array<uint32_t, 4>> boxes;   // node, slot, first, last
-    std::vector<std::array<uint32_t, 3>> leaves;  // leaf, first, last
-  };
+  /// Each binary node's run of the order: [first, last).
+  static std::vector<std::pair<uint32_t, uint32_t>> runs_of(const std::vector<BNode>& binary);
   /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended with
-  /// their axis boxes; the rest of their bounds go to `pending`.
+  /// their axis boxes and runs; each Node4 child's oriented box is due later, listed in
+  /// `oriented` (node, slot, its run of the order).
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
-                    uint32_t b, Pending& pending);
+                    uint32_t b, std::vector<std::array<uint32_t, 4>>& oriented);
+  /// tris_ in the order, and every leaf's triangles' boxes, planes and sides.
+  void fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
+                   const std::vector<Vec3>& hi);
+  /// The oriented boxes listed by collapse, from tris_.
+  void fill_oriented_boxes(const std::vector<std::array<uint32_t, 4>>& due);
   /// Slot i of n: the oriented box of `count` triangles (`normals`: theirs times twice their
   /// area).
   static void set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tris, const Vec3* normals, uint32_t count);
@@ -124,12 +126,11 @@ class MeshDistance {
   /// Slot i of l: triangle abc's plane and sides.
   static void set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c);
 
-  size_t triangles_ = 0;
   uint32_t root_ = 0;
   std::vector<Node4> nodes_;
   std::vector<LeafBounds> leaves_;
   float rounding_ = 0;  // how far the float planes of leaves_ may be off, at the origin
-  std::vector<LeafTriangle> tris_;  // kLeafSize slots per leaf
+  std::vector<LeafTriangle> tris_;  // in the tree's order: each leaf's run contiguous
 };
 
 /// Signed distance to a closed 2-manifold mesh (negative inside). Keeps a reference to `mesh`.
