@@ -517,18 +517,22 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
   // degenerate triangles (a repeated vertex, three on a line); points on the surface, a hair
   // off it, at offset distances and far away, asked with the last answer as the hint and
   // with none: the distance must be a scan's over every triangle, the triangle one at that
-  // distance whatever the hint, and `within` must agree.
-  TriMesh base = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
-  const uint32_t n0 = uint32_t(base.positions.size());
-  base.positions.push_back({0.1, 0.2, 0.3});
-  base.positions.push_back({0.4, 0.2, 0.3});
-  base.positions.push_back({0.7, 0.2, 0.3});
-  base.triangles.push_back({n0, n0, n0 + 1});
-  base.triangles.push_back({n0, n0 + 1, n0 + 2});
+  // distance whatever the hint, and `within` must agree. A lone triangle too (the tree is
+  // one leaf).
+  TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  const uint32_t n0 = uint32_t(spot.positions.size());
+  spot.positions.push_back({0.1, 0.2, 0.3});
+  spot.positions.push_back({0.4, 0.2, 0.3});
+  spot.positions.push_back({0.7, 0.2, 0.3});
+  spot.triangles.push_back({n0, n0, n0 + 1});
+  spot.triangles.push_back({n0, n0 + 1, n0 + 2});
+  TriMesh lone;
+  lone.positions = {{0, 0, 0}, {1, 0.2, 0}, {0.3, 0.9, 0.1}};
+  lone.triangles = {{0, 1, 2}};
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (const double shift : {0.0, 1e4}) {
-    TriMesh mesh = base;
+  for (const auto& [base, shift] : {std::pair{&spot, 0.0}, std::pair{&spot, 1e4}, std::pair{&lone, 0.0}}) {
+    TriMesh mesh = *base;
     for (Vec3& x : mesh.positions) x = {x[0] + shift, x[1] - shift, x[2] + shift};
     const detail::MeshDistance md(mesh);
     uint32_t hint = 0;
