@@ -518,7 +518,8 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
   // off it, at offset distances and far away, asked with the last answer as the hint and
   // with none: the distance must be a scan's over every triangle, the triangle one at that
   // distance whatever the hint, and `within` must agree. A lone triangle too (the tree is
-  // one leaf).
+  // one leaf), slivers apart (a sliver's computed plane can miss its own corners), and a point
+  // 10^20 away (float squares of such gaps overflow).
   TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
   const uint32_t n0 = uint32_t(spot.positions.size());
   spot.positions.push_back({0.1, 0.2, 0.3});
@@ -529,9 +530,19 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
   TriMesh lone;
   lone.positions = {{0, 0, 0}, {1, 0.2, 0}, {0.3, 0.9, 0.1}};
   lone.triangles = {{0, 1, 2}};
+  TriMesh slivers;
+  for (const double h : {1e-15, 1e-13, 1e-11, 1e-9}) {
+    const uint32_t v = uint32_t(slivers.positions.size());
+    const double z = double(v);
+    slivers.positions.push_back({0.1, 0.3, z});
+    slivers.positions.push_back({1.7, 0.9, z + 0.2});
+    slivers.positions.push_back({0.9 + h, 0.6 - h, z + 0.1 + h});
+    slivers.triangles.push_back({v, v + 1, v + 2});
+  }
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (const auto& [base, shift] : {std::pair{&spot, 0.0}, std::pair{&spot, 1e4}, std::pair{&lone, 0.0}}) {
+  for (const auto& [base, shift] :
+       {std::pair{&spot, 0.0}, std::pair{&spot, 1e4}, std::pair{&lone, 0.0}, std::pair{&slivers, 0.0}}) {
     TriMesh mesh = *base;
     for (Vec3& x : mesh.positions) x = {x[0] + shift, x[1] - shift, x[2] + shift};
     const detail::MeshDistance md(mesh);
@@ -544,6 +555,7 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
         p[k] = w0 * mesh.positions[t[0]][k] + w1 * mesh.positions[t[1]][k] + (1 - w0 - w1) * mesh.positions[t[2]][k];
       const double off = std::array{0.0, 1e-9, 1e-4, 0.05, 0.5, 3.0}[i % 6];
       for (int k = 0; k < 3; ++k) p[k] += off * u(rng);
+      if (i == 3999) p = {1e20, -3e19, 2e19};
       double least = detail::kHuge;
       for (const auto& g : mesh.triangles)
         least = std::min(least, detail::nearest_on_triangle(p, mesh.positions[g[0]], mesh.positions[g[1]],

@@ -95,31 +95,49 @@ struct FloatBox {
   }
 };
 
+/// The float bounds below are taken only where every coordinate, the query's and the mesh's,
+/// is at most kFar in size: no square of a gap then overflows. Beyond, a query bounds nothing
+/// (every box is opened: slow, exact). Each sum of squares loses its relative rounding and
+/// then kTinySquare, more than a square below the floats' normal range can round up by.
+constexpr double kFar = 1e18;
+constexpr float kTinySquare = 1e-44f;
+
+#if defined(__SSE2__)
+/// The gap g as the bounds square it: NaN and negative gaps 0.
+__m128 clamped_gap(__m128 g) { return _mm_max_ps(g, _mm_setzero_ps()); }
+/// A sum of squared gaps as a lower bound.
+__m128 lower_sum(__m128 s, float shrink) {
+  return _mm_sub_ps(_mm_mul_ps(s, _mm_set1_ps(shrink)), _mm_set1_ps(kTinySquare));
+}
+#else
+float clamped_gap(float g) { return g > 0 ? g : 0.0f; }
+float lower_sum(float s, float shrink) { return s * shrink - kTinySquare; }
+#endif
+
 /// Squared distances from the box q to four boxes side by side (axis k's bounds at lo + k *
 /// stride, hi + k * stride) into out, each at most the exact distance between the boxes: q's
 /// bounds are rounded outward, and the float rounding of the differences, squares and sums (a
-/// few units in 2^-24, relative) is taken off by kShrink. An empty box (lo +inf, hi -inf) is
-/// infinitely far.
+/// few units in 2^-24, relative) is taken off by the shrink.
 void box_distance2_x4(const float* lo, const float* hi, size_t stride, const FloatBox& q, float* out) {
   constexpr float kShrink = 1.0f - 1.0f / (1 << 20);
 #if defined(__SSE2__)
-  const __m128 zero = _mm_setzero_ps();
-  __m128 s = zero;
+  __m128 s = _mm_setzero_ps();
   for (size_t k = 0; k < 3; ++k) {
     const __m128 below = _mm_sub_ps(_mm_load_ps(lo + k * stride), _mm_set1_ps(q.hi[k]));
     const __m128 above = _mm_sub_ps(_mm_set1_ps(q.lo[k]), _mm_load_ps(hi + k * stride));
-    const __m128 d = _mm_max_ps(_mm_max_ps(below, above), zero);
+    const __m128 d = clamped_gap(_mm_max_ps(below, above));
     s = _mm_add_ps(s, _mm_mul_ps(d, d));
   }
-  _mm_store_ps(out, _mm_mul_ps(s, _mm_set1_ps(kShrink)));
+  _mm_store_ps(out, lower_sum(s, kShrink));
 #else
   for (int i = 0; i < 4; ++i) {
     float s = 0;
     for (size_t k = 0; k < 3; ++k) {
-      const float d = std::max({lo[k * stride + i] - q.hi[k], q.lo[k] - hi[k * stride + i], 0.0f});
+      const float below = lo[k * stride + i] - q.hi[k], above = q.lo[k] - hi[k * stride + i];
+      const float d = clamped_gap(below > above ? below : above);
       s += d * d;
     }
-    out[i] = s * kShrink;
+    out[i] = lower_sum(s, kShrink);
   }
 #endif
 }
@@ -137,7 +155,7 @@ constexpr double kPlaneRounding = 1.0 / (1 << 18);
 void plane_distance2_x4(const float* plane, const float* side, const float (&x)[3], float slack, float* out) {
   constexpr float kShrink = 1.0f - 1.0f / (1 << 20);
 #if defined(__SSE2__)
-  const __m128 px = _mm_set1_ps(x[0]), py = _mm_set1_ps(x[1]), pz = _mm_set1_ps(x[2]), zero = _mm_setzero_ps();
+  const __m128 px = _mm_set1_ps(x[0]), py = _mm_set1_ps(x[1]), pz = _mm_set1_ps(x[2]);
   const auto along = [&](const float* row) {  // n . x - offset for a row block (n: 3 rows, offset: 1)
     __m128 v = _mm_mul_ps(_mm_load_ps(row), px);
     v = _mm_add_ps(v, _mm_mul_ps(_mm_load_ps(row + 8), py));
@@ -145,22 +163,44 @@ void plane_distance2_x4(const float* plane, const float* side, const float (&x)[
     return _mm_sub_ps(v, _mm_load_ps(row + 24));
   };
   const __m128 h = along(plane);
-  const __m128 height = _mm_max_ps(_mm_max_ps(h, _mm_sub_ps(zero, h)), zero);
+  const __m128 height = _mm_max_ps(h, _mm_sub_ps(_mm_setzero_ps(), h));
   const __m128 out_of = _mm_max_ps(_mm_max_ps(along(side), along(side + 32)), along(side + 64));
   const __m128 s = _mm_set1_ps(slack);
-  const __m128 a = _mm_max_ps(_mm_sub_ps(height, s), zero), b = _mm_max_ps(_mm_sub_ps(out_of, s), zero);
-  const __m128 d2 = _mm_mul_ps(_mm_add_ps(_mm_mul_ps(a, a), _mm_mul_ps(b, b)), _mm_set1_ps(kShrink));
+  const __m128 a = clamped_gap(_mm_sub_ps(height, s)), b = clamped_gap(_mm_sub_ps(out_of, s));
+  const __m128 d2 = lower_sum(_mm_add_ps(_mm_mul_ps(a, a), _mm_mul_ps(b, b)), kShrink);
   _mm_store_ps(out, _mm_max_ps(_mm_load_ps(out), d2));
 #else
   for (int i = 0; i < 4; ++i) {
     const auto along = [&](const float* row) { return row[i] * x[0] + row[8 + i] * x[1] + row[16 + i] * x[2] - row[24 + i]; };
-    const float height = std::abs(along(plane));
-    const float out_of = std::max({along(side), along(side + 32), along(side + 64)});
-    const float a = std::max(height - slack, 0.0f), b = std::max(out_of - slack, 0.0f);
-    out[i] = std::max(out[i], (a * a + b * b) * kShrink);
+    const float h = along(plane), height = h > -h ? h : -h;
+    float out_of = along(side);
+    for (const float o : {along(side + 32), along(side + 64)}) out_of = out_of > o ? out_of : o;
+    const float a = clamped_gap(height - slack), b = clamped_gap(out_of - slack);
+    const float d2 = lower_sum(a * a + b * b, kShrink);
+    out[i] = out[i] > d2 ? out[i] : d2;
   }
 #endif
 }
+
+/// A traversal's stack: each node opened leaves at most three of its children behind, so a
+/// tree `depth` Node4 levels deep needs 3 * depth + 4 entries -- on the caller's stack for the
+/// usual trees, on the heap for a deep one.
+template <class T>
+class TraversalStack {
+ public:
+  explicit TraversalStack(uint32_t depth) {
+    const size_t need = 3 * size_t(depth) + 4;
+    if (need > kLocal) heap_.resize(need);
+    data_ = heap_.empty() ? local_ : heap_.data();
+  }
+  T& operator[](int i) { return data_[i]; }
+
+ private:
+  static constexpr size_t kLocal = 256;
+  T local_[kLocal];
+  std::vector<T> heap_;
+  T* data_;
+};
 
 /// A query point as the vector tests take it: rounded outward to a box of floats, rounded to
 /// floats, and the slack of the leaves' planes there (see kPlaneRounding).
@@ -168,15 +208,21 @@ struct FloatPoint {
   FloatBox box;
   float x[3];
   float slack;
-  FloatPoint(const Vec3& p, float rounding)
+  bool far;  // beyond kFar, or the mesh is: bounds nothing
+  FloatPoint(const Vec3& p, float rounding, bool mesh_far)
       : box(p, p),
         x{float(p[0]), float(p[1]), float(p[2])},
-        slack(rounding + float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) * kPlaneRounding)) {}
+        slack(rounding + float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) * kPlaneRounding)),
+        far(mesh_far || !(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) <= kFar)) {}
 };
 
 /// Lower bounds on the squared distances from q to a leaf's eight triangles, into out.
 template <class Leaf>
 void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
+  if (q.far) {
+    std::fill_n(out, 8, 0.0f);
+    return;
+  }
   box_distance2_x4(&l.lo[0][0], &l.hi[0][0], 8, q.box, out);
   box_distance2_x4(&l.lo[0][4], &l.hi[0][4], 8, q.box, out + 4);
   plane_distance2_x4(&l.plane[0][0], &l.side[0][0][0], q.x, q.slack, out);
@@ -188,30 +234,36 @@ void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
 /// gap less q's slack; the stored axes are orthonormal to float rounding, which kShrink covers).
 template <class Node>
 void children_distance2(const Node& n, const FloatPoint& q, float* out) {
+  if (q.far) {
+    std::fill_n(out, 4, 0.0f);
+    return;
+  }
   box_distance2_x4(&n.lo[0][0], &n.hi[0][0], 4, q.box, out);
   constexpr float kShrink = 1.0f - 1.0f / (1 << 18);
 #if defined(__SSE2__)
-  const __m128 px = _mm_set1_ps(q.x[0]), py = _mm_set1_ps(q.x[1]), pz = _mm_set1_ps(q.x[2]), zero = _mm_setzero_ps();
+  const __m128 px = _mm_set1_ps(q.x[0]), py = _mm_set1_ps(q.x[1]), pz = _mm_set1_ps(q.x[2]);
   const __m128 slack = _mm_set1_ps(q.slack);
-  __m128 s = zero;
+  __m128 s = _mm_setzero_ps();
   for (int k = 0; k < 3; ++k) {
     __m128 x = _mm_mul_ps(_mm_load_ps(n.axis[k][0]), px);
     x = _mm_add_ps(x, _mm_mul_ps(_mm_load_ps(n.axis[k][1]), py));
     x = _mm_add_ps(x, _mm_mul_ps(_mm_load_ps(n.axis[k][2]), pz));
     const __m128 gap = _mm_max_ps(_mm_sub_ps(_mm_load_ps(n.along[k][0]), x), _mm_sub_ps(x, _mm_load_ps(n.along[k][1])));
-    const __m128 d = _mm_max_ps(_mm_sub_ps(gap, slack), zero);
+    const __m128 d = clamped_gap(_mm_sub_ps(gap, slack));
     s = _mm_add_ps(s, _mm_mul_ps(d, d));
   }
-  _mm_store_ps(out, _mm_max_ps(_mm_load_ps(out), _mm_mul_ps(s, _mm_set1_ps(kShrink))));
+  _mm_store_ps(out, _mm_max_ps(_mm_load_ps(out), lower_sum(s, kShrink)));
 #else
   for (int i = 0; i < 4; ++i) {
     float s = 0;
     for (int k = 0; k < 3; ++k) {
       const float x = n.axis[k][0][i] * q.x[0] + n.axis[k][1][i] * q.x[1] + n.axis[k][2][i] * q.x[2];
-      const float d = std::max(std::max(n.along[k][0][i] - x, x - n.along[k][1][i]) - q.slack, 0.0f);
+      const float below = n.along[k][0][i] - x, above = x - n.along[k][1][i];
+      const float d = clamped_gap((below > above ? below : above) - q.slack);
       s += d * d;
     }
-    out[i] = std::max(out[i], s * kShrink);
+    const float d2 = lower_sum(s, kShrink);
+    out[i] = out[i] > d2 ? out[i] : d2;
   }
 #endif
 }
@@ -241,8 +293,9 @@ MeshDistance::MeshDistance(const TriMesh& mesh) {
   double extent = 0;
   for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
   rounding_ = float(extent * kPlaneRounding);
+  far_ = !(extent <= kFar);
   std::vector<std::array<uint32_t, 4>> oriented;  // Node4 children whose oriented boxes are due
-  root_ = collapse(binary, runs_of(binary), 0, oriented);
+  root_ = collapse(binary, runs_of(binary), 0, 0, oriented);
   fill_leaves(mesh, order, lo, hi);
   // The build's own arrays freed before the oriented boxes: a large mesh's peak memory.
   for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
@@ -274,7 +327,7 @@ void MeshDistance::fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>&
       const auto& t = mesh.triangles[order[at]];
       LeafTriangle& tri = tris_[at];
       tri = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]], order[at], uint32_t(leaf)};
-      set_planes(l, i, tri.a, tri.b, tri.c);
+      set_planes(l, i, tri.a, tri.b, tri.c, rounding_ / 2);
     }
   });
 }
@@ -292,15 +345,17 @@ void MeshDistance::fill_oriented_boxes(const std::vector<std::array<uint32_t, 4>
 }
 
 uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
-                                const std::vector<std::pair<uint32_t, uint32_t>>& range, uint32_t b,
+                                const std::vector<std::pair<uint32_t, uint32_t>>& range, uint32_t b, uint32_t depth,
                                 std::vector<std::array<uint32_t, 4>>& oriented) {
+  depth_ = std::max(depth_, depth);
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const BNode& nd = binary[b];
   if (nd.count > 0) {
     const uint32_t leaf = uint32_t(leaves_.size());
     LeafBounds& l = leaves_.emplace_back();
     for (int k = 0; k < 3; ++k) std::fill_n(l.lo[k], 8, kInf), std::fill_n(l.hi[k], 8, -kInf);
-    // Unused slots' planes bound nothing (see set_planes).
+    // Every slot starts bounding nothing: zero planes (emplace_back zeroes them), sides' offsets
+    // +inf (see set_planes).
     for (int e = 0; e < 3; ++e) std::fill_n(l.side[e][3], 8, kInf);
     l.first = nd.first, l.count = nd.count;
     return leaf | kLeafBit;
@@ -330,12 +385,12 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
     for (int j = 0; j < 3; ++j) std::fill_n(out.axis[k][j], 4, k == j ? 1.0f : 0.0f);
     std::fill_n(out.along[k][0], 4, kInf), std::fill_n(out.along[k][1], 4, -kInf);
   }
-  for (int i = 0; i < 4; ++i) out.child[i] = 0;
+  for (int i = 0; i < 4; ++i) out.child[i] = kNoChild;
   for (int i = 0; i < count; ++i) {
     const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
     for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
     oriented.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
-    out.child[i] = collapse(binary, range, kids[i], oriented);
+    out.child[i] = collapse(binary, range, kids[i], depth + 1, oriented);
   }
   nodes_[self] = out;
   return self;
@@ -380,45 +435,54 @@ void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tr
   for (int k = 0; k < 3; ++k) n.along[k][0][i] = round_down(lo[k]), n.along[k][1][i] = round_up(hi[k]);
 }
 
-void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c) {
-  // A degenerate triangle bounds nothing: zero normals, every side's offset +inf (p is then
-  // -inf outside each side).
-  const Vec3 n = cross3(sub3(b, a), sub3(c, a));
-  const double area2 = norm3(n);
+void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c,
+                              double tolerance) {
+  // Slot i starts bounding nothing (zero plane, every side's offset +inf: p is -inf outside
+  // each side); a plane or side is kept only where the corners, measured against it as
+  // stored, lie on it (or inside it) within `tolerance`. A sliver's cross product is mostly
+  // rounding: its plane can miss its own corners by far more than the slack a query allows.
   const Vec3 corner[3] = {a, b, c};
-  if (!(area2 > kTinyDivisor)) {
-    for (int e = 0; e < 3; ++e) l.side[e][3][i] = std::numeric_limits<float>::infinity();
-    return;
-  }
-  const Vec3 u = scale3(n, 1 / area2);
-  for (int k = 0; k < 3; ++k) l.plane[k][i] = float(u[k]);
-  l.plane[3][i] = float(dot3(u, a));
+  const Vec3 n = cross3(sub3(b, a), sub3(c, a));
+  const double twice_area = norm3(n);
+  if (!(twice_area > kTinyDivisor)) return;
+  const Vec3 u = scale3(n, 1 / twice_area);
+  const auto stored = [&](const Vec3& v, double offset, Vec3& out) {
+    for (int k = 0; k < 3; ++k) out[k] = double(float(v[k]));
+    return double(float(offset));
+  };
+  Vec3 un;
+  const double uc = stored(u, dot3(u, a), un);
+  for (const Vec3& x : corner)
+    if (!(std::abs(dot3(un, x) - uc) <= tolerance)) return;
+  for (int k = 0; k < 3; ++k) l.plane[k][i] = float(un[k]);
+  l.plane[3][i] = float(uc);
   for (int e = 0; e < 3; ++e) {
-    const Vec3 m = cross3(sub3(corner[(e + 1) % 3], corner[e]), u);  // in the plane, away from the third corner
+    // In the plane, perpendicular to the side, away from the third corner.
+    const Vec3 m = cross3(sub3(corner[(e + 1) % 3], corner[e]), u);
     const double len = norm3(m);
-    if (!(len > kTinyDivisor)) {
-      l.side[e][3][i] = std::numeric_limits<float>::infinity();
-      continue;
-    }
-    for (int k = 0; k < 3; ++k) l.side[e][k][i] = float(m[k] / len);
-    l.side[e][3][i] = float(dot3(m, corner[e]) / len);
+    if (!(len > kTinyDivisor)) continue;
+    Vec3 mn;
+    const double mc = stored(scale3(m, 1 / len), dot3(m, corner[e]) / len, mn);
+    const double o0 = dot3(mn, corner[e]) - mc, o1 = dot3(mn, corner[(e + 1) % 3]) - mc,
+                 o2 = dot3(mn, corner[(e + 2) % 3]) - mc;
+    if (!(std::abs(o0) <= tolerance && std::abs(o1) <= tolerance && o2 <= tolerance)) continue;
+    for (int k = 0; k < 3; ++k) l.side[e][k][i] = float(mn[k]);
+    l.side[e][3][i] = float(mc);
   }
 }
 
-
-/// Visits the triangles whose boxes may be nearer than best2 (squared), nearer boxes first,
-/// with the box's squared distance (a lower bound); `visit` lowers best2 as it finds nearer
-/// triangles. Which boxes are opened depends on best2, their order does not.
+/// Visits the triangles whose bounds may be nearer than best2 (squared), the nearest child of
+/// each node opened next, with the triangle's squared lower bound; `visit` lowers best2 as it
+/// finds nearer triangles. Which boxes are opened depends on best2, their order does not.
 template <class Visit>
 void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
   if (tris_.empty()) return;
-  const FloatPoint q(p, rounding_);
+  const FloatPoint q(p, rounding_, far_);
   struct Entry {
     uint32_t ref;
     double d2;
   };
-  // Each node opened pushes at most four: three per level of depth stay on the stack.
-  Entry stack[512];
+  TraversalStack<Entry> stack(depth_);
   int top = 0;
   stack[top++] = {root_, 0};
   while (top > 0) {
@@ -438,7 +502,7 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
     children_distance2(nd, q, d);
     // The children within best2, the nearest last so that it is opened next.
     const int first = top;
-    for (int i = 0; i < 4; ++i) {
+    for (int i = 0; i < 4 && nd.child[i] != kNoChild; ++i) {
       if (!(double(d[i]) < best2)) continue;
       stack[top] = {nd.child[i], double(d[i])};
       if (top > first && stack[top].d2 > stack[top - 1].d2) std::swap(stack[top], stack[top - 1]);
@@ -449,8 +513,8 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
 
 double MeshDistance::distance(const Vec3& p) const {
   double best2 = std::numeric_limits<double>::infinity();
-  search(p, best2, [&](const LeafTriangle& t, double box2) {
-    if (box2 < best2) best2 = std::min(best2, point_triangle_distance2(p, t.a, t.b, t.c));
+  search(p, best2, [&](const LeafTriangle& t, double lower2) {
+    if (lower2 < best2) best2 = std::min(best2, point_triangle_distance2(p, t.a, t.b, t.c));
   });
   return std::sqrt(best2);
 }
@@ -458,8 +522,8 @@ double MeshDistance::distance(const Vec3& p) const {
 bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found) const {
   const double r2 = r * r;
   double d2 = 0;
-  auto reaches = [&](const LeafTriangle& t, double box2) {
-    return box2 <= r2 && (d2 = point_triangle_distance2(p, t.a, t.b, t.c)) <= r2;
+  auto reaches = [&](const LeafTriangle& t, double lower2) {
+    return lower2 <= r2 && (d2 = point_triangle_distance2(p, t.a, t.b, t.c)) <= r2;
   };
   auto take = [&](const LeafTriangle& t) {
     if (hint) *hint = static_cast<uint32_t>(&t - tris_.data());
@@ -469,7 +533,7 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
   // The hint's leaf and the leaves on either side first: stored in leaf order, they lie close
   // by.
   if (hint && *hint < tris_.size()) {
-    const FloatPoint q(p, rounding_);
+    const FloatPoint q(p, rounding_, far_);
     const uint32_t leaf = tris_[*hint].leaf, last = uint32_t(leaves_.size()) - 1;
     for (uint32_t l = leaf > 0 ? leaf - 1 : 0; l <= std::min(leaf + 1, last); ++l) {
       alignas(16) float d[8];
@@ -482,8 +546,8 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the
   // bound drops below every distance and the search ends.
   double bound2 = std::nextafter(r2, std::numeric_limits<double>::infinity());
-  search(p, bound2, [&](const LeafTriangle& t, double box2) {
-    if (bound2 >= 0 && reaches(t, box2)) {
+  search(p, bound2, [&](const LeafTriangle& t, double lower2) {
+    if (bound2 >= 0 && reaches(t, lower2)) {
       bound2 = -1;
       take(t);
     }
@@ -546,24 +610,29 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
     return triangle_farther(box, t.a, t.b, t.c, len > 0 ? scale3(n, 1 / len) : Vec3{0, 0, 0}, r, kOctantDepth);
   };
   if (tris_.empty()) return true;
-  uint32_t stack[512];
+  // Beyond kFar the float boxes prune nothing (see kFar): every triangle is asked.
+  const bool far = far_ || !(std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]),
+                                       std::abs(hi[1]), std::abs(hi[2])}) <= kFar);
+  TraversalStack<uint32_t> stack(depth_);
   int top = 0;
   stack[top++] = root_;
   while (top > 0) {
     const uint32_t ref = stack[--top];
     if (ref & kLeafBit) {
       const uint32_t leaf = ref & ~kLeafBit;
-      alignas(16) float d[8];
-      box_distance2_x4(&leaves_[leaf].lo[0][0], &leaves_[leaf].hi[0][0], 8, q, d);
-      box_distance2_x4(&leaves_[leaf].lo[0][4], &leaves_[leaf].hi[0][4], 8, q, d + 4);
+      alignas(16) float d[8] = {};
+      if (!far) {
+        box_distance2_x4(&leaves_[leaf].lo[0][0], &leaves_[leaf].hi[0][0], 8, q, d);
+        box_distance2_x4(&leaves_[leaf].lo[0][4], &leaves_[leaf].hi[0][4], 8, q, d + 4);
+      }
       for (uint32_t i = 0; i < leaves_[leaf].count; ++i)
         if (double(d[i]) <= r2 && !away(tris_[leaves_[leaf].first + i])) return false;
       continue;
     }
     const Node4& nd = nodes_[ref];
-    alignas(16) float d[4];
-    box_distance2_x4(&nd.lo[0][0], &nd.hi[0][0], 4, q, d);
-    for (int i = 0; i < 4; ++i)
+    alignas(16) float d[4] = {};
+    if (!far) box_distance2_x4(&nd.lo[0][0], &nd.hi[0][0], 4, q, d);
+    for (int i = 0; i < 4 && nd.child[i] != kNoChild; ++i)
       if (double(d[i]) <= r2) stack[top++] = nd.child[i];
   }
   return true;
@@ -580,12 +649,13 @@ Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
     if (std::isfinite(best.distance)) best2 = best.distance * (1 + kHintSlack) + kTinyDivisor;
   }
   // The same answer whatever the hint, so a point asked twice gets one value (its feature, and
-  // so its sign): the boxes visit in an order the hint does not change, the hint's bound is a
-  // hair above its distance and so prunes no triangle at the least distance, and among those
-  // visited a tie goes to the lowest index.
+  // so its sign): the boxes visit in an order the hint does not change, and the hint's bound is
+  // a hair above its distance, so no triangle at the least distance is pruned before the first
+  // of them in that order is found; that one is the answer (a later one at the same distance
+  // takes it only with a lower index, and once the distance is 0 none is looked at).
   uint32_t slot = hint ? *hint : 0;
-  search(p, best2, [&](const LeafTriangle& t, double box2) {
-    if (box2 >= best2) return;
+  search(p, best2, [&](const LeafTriangle& t, double lower2) {
+    if (lower2 >= best2) return;
     const Nearest n = nearest_on_triangle2(p, t.a, t.b, t.c);
     if (n.distance < best2 || (n.distance == best2 && t.id < best.triangle)) {
       best2 = n.distance;

@@ -76,8 +76,10 @@ class MeshDistance {
     uint32_t leaf;  // the leaf holding it
   };
   static constexpr uint32_t kLeafBit = 1u << 31;
-  /// Triangles per leaf at most.
+  static constexpr uint32_t kNoChild = ~uint32_t{0};  // a Node4's unused slots (the last ones)
+  /// Triangles per leaf at most: LeafBounds' eight slots.
   static constexpr uint32_t kLeafSize = 8;
+  static_assert(sizeof(LeafBounds::plane[0]) == kLeafSize * sizeof(float));
 
   /// The binary tree the surface area heuristic builds, collapsed into Node4s after.
   struct BNode {
@@ -112,7 +114,7 @@ class MeshDistance {
   /// their axis boxes and runs; each Node4 child's oriented box is due later, listed in
   /// `oriented` (node, slot, its run of the order).
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
-                    uint32_t b, std::vector<std::array<uint32_t, 4>>& oriented);
+                    uint32_t b, uint32_t depth, std::vector<std::array<uint32_t, 4>>& oriented);
   /// tris_ in the order, and every leaf's triangles' boxes, planes and sides.
   void fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                    const std::vector<Vec3>& hi);
@@ -123,13 +125,18 @@ class MeshDistance {
   static void set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tris, const Vec3* normals, uint32_t count);
   template <class Visit>
   void search(const Vec3& p, double& best2, Visit&& visit) const;
-  /// Slot i of l: triangle abc's plane and sides.
-  static void set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c);
+  /// Slot i of l (which bounds nothing yet): triangle abc's plane and sides, each one its
+  /// corners lie on within `tolerance`.
+  static void set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c, double tolerance);
 
   uint32_t root_ = 0;
   std::vector<Node4> nodes_;
   std::vector<LeafBounds> leaves_;
-  float rounding_ = 0;  // how far the float planes of leaves_ may be off, at the origin
+  uint32_t depth_ = 0;  // Node4 levels below the root
+  // The mesh's share of every query's slack: kPlaneRounding times its largest coordinate (the
+  // query point adds its own).
+  float rounding_ = 0;
+  bool far_ = false;  // a coordinate beyond kFar: the float bounds are not used
   std::vector<LeafTriangle> tris_;  // in the tree's order: each leaf's run contiguous
 };
 

@@ -44,9 +44,8 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
                                                   plan.refine ? &plan.refine : nullptr);
     converged = islands == 0 && fix.flipped == 0;
     kept_two = fix.remaining > 0;
-    // A round that still removed islands is followed by one more, to be quiet: a quiet round
-    // keeps the erosions below around the capped leaves (a whole tree's coarse boundaries
-    // checked again cost a Thingi10K offset a quarter of its time, for no flip).
+    // Rounds repeat until one changes no sign: only then may the erosions below stay around
+    // the capped leaves instead of checking every coarse boundary of the scope again.
     if (converged) break;
   }
   // The guarantee's erosions: where the rounds ran out, over the whole scope; else around the
