@@ -204,6 +204,16 @@ class TraversalStack {
 
 /// A query point as the vector tests take it: rounded outward to a box of floats, rounded to
 /// floats, and the slack of the leaves' planes there (see kPlaneRounding).
+/// The largest coordinate of x in size.
+double largest_coordinate(const Vec3& x) { return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])}); }
+
+/// The axis boxes of a leaf's eight triangles measured from the box q, into out.
+template <class Leaf>
+void leaf_boxes_distance2(const Leaf& l, const FloatBox& q, float* out) {
+  box_distance2_x4(&l.lo[0][0], &l.hi[0][0], 8, q, out);
+  box_distance2_x4(&l.lo[0][4], &l.hi[0][4], 8, q, out + 4);
+}
+
 struct FloatPoint {
   FloatBox box;
   float x[3];
@@ -212,8 +222,8 @@ struct FloatPoint {
   FloatPoint(const Vec3& p, float rounding, bool mesh_far)
       : box(p, p),
         x{float(p[0]), float(p[1]), float(p[2])},
-        slack(rounding + float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) * kPlaneRounding)),
-        far(mesh_far || !(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) <= kFar)) {}
+        slack(rounding + float(largest_coordinate(p) * kPlaneRounding)),
+        far(mesh_far || !(largest_coordinate(p) <= kFar)) {}
 };
 
 /// Lower bounds on the squared distances from q to a leaf's eight triangles, into out.
@@ -223,8 +233,7 @@ void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
     std::fill_n(out, 8, 0.0f);
     return;
   }
-  box_distance2_x4(&l.lo[0][0], &l.hi[0][0], 8, q.box, out);
-  box_distance2_x4(&l.lo[0][4], &l.hi[0][4], 8, q.box, out + 4);
+  leaf_boxes_distance2(l, q.box, out);
   plane_distance2_x4(&l.plane[0][0], &l.side[0][0][0], q.x, q.slack, out);
   plane_distance2_x4(&l.plane[0][4], &l.side[0][0][4], q.x, q.slack, out + 4);
 }
@@ -291,7 +300,7 @@ MeshDistance::MeshDistance(const TriMesh& mesh) {
   nodes_.reserve(binary.size() / 3 + 1);
   leaves_.reserve(binary.size() / 2 + 1);
   double extent = 0;
-  for (const Vec3& x : mesh.positions) extent = std::max({extent, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
+  for (const Vec3& x : mesh.positions) extent = std::max(extent, largest_coordinate(x));
   rounding_ = float(extent * kPlaneRounding);
   far_ = !(extent <= kFar);
   std::vector<std::array<uint32_t, 4>> oriented;  // Node4 children whose oriented boxes are due
@@ -611,8 +620,7 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
   };
   if (tris_.empty()) return true;
   // Beyond kFar the float boxes prune nothing (see kFar): every triangle is asked.
-  const bool far = far_ || !(std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]),
-                                       std::abs(hi[1]), std::abs(hi[2])}) <= kFar);
+  const bool far = far_ || !(std::max(largest_coordinate(lo), largest_coordinate(hi)) <= kFar);
   TraversalStack<uint32_t> stack(depth_);
   int top = 0;
   stack[top++] = root_;
@@ -621,10 +629,7 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
     if (ref & kLeafBit) {
       const uint32_t leaf = ref & ~kLeafBit;
       alignas(16) float d[8] = {};
-      if (!far) {
-        box_distance2_x4(&leaves_[leaf].lo[0][0], &leaves_[leaf].hi[0][0], 8, q, d);
-        box_distance2_x4(&leaves_[leaf].lo[0][4], &leaves_[leaf].hi[0][4], 8, q, d + 4);
-      }
+      if (!far) leaf_boxes_distance2(leaves_[leaf], q, d);
       for (uint32_t i = 0; i < leaves_[leaf].count; ++i)
         if (double(d[i]) <= r2 && !away(tris_[leaves_[leaf].first + i])) return false;
       continue;
