@@ -110,29 +110,42 @@ struct Scratch {
   std::vector<double> star_shift, new_off;
   std::vector<MovedPoint> moved_points;
   uint32_t hint = 0;  // where the last point near the raw contour found it
+  bool left_block = false;  // the last vertex tried had a collapse refused for leaving the block
 };
 
-/// Blocks of a fixed grid over the mesh's box, each vertex in the one holding it: collapses whose
-/// two stars lie in one block touch nothing another block's collapses do.
+/// Blocks of fixed grids over the mesh's box, each vertex in the one holding it: collapses whose
+/// two stars lie in one block touch nothing another block's collapses do. The first grid has
+/// kBlocksPerAxis blocks a side; the second is shifted by half a block, so that its blocks hold
+/// the bands along the first one's faces; the third has blocks twice as wide, shifted by an
+/// eighth of theirs, so that no two grids share a face and the long triangles of a coarse
+/// mesh fit in its blocks.
 constexpr int kBlocksPerAxis = 8;
-std::vector<uint16_t> block_of_vertices(const std::vector<Vec3>& pos) {
+struct GridLayout {
+  int per_axis;
+  double offset;  // in blocks
+  int side() const { return per_axis + (offset > 0); }
+  size_t count() const { return size_t(side()) * side() * side(); }
+};
+constexpr GridLayout kGrids[] = {{kBlocksPerAxis, 0}, {kBlocksPerAxis, 0.5}, {kBlocksPerAxis / 2, 0.125}};
+
+struct BlockGrid {
   Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
-  for (const Vec3& p : pos)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  std::vector<uint16_t> block(pos.size());
-  for (size_t i = 0; i < pos.size(); ++i) {
+  explicit BlockGrid(const std::vector<Vec3>& pos) {
+    for (const Vec3& p : pos)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], p[k]);
+        hi[k] = std::max(hi[k], p[k]);
+      }
+  }
+  uint16_t block(const Vec3& p, const GridLayout& g) const {
     int b = 0;
     for (int k = 0; k < 3; ++k) {
-      const double t = hi[k] > lo[k] ? (pos[i][k] - lo[k]) / (hi[k] - lo[k]) : 0;
-      b = b * kBlocksPerAxis + std::clamp(int(t * kBlocksPerAxis), 0, kBlocksPerAxis - 1);
+      const double t = hi[k] > lo[k] ? (p[k] - lo[k]) / (hi[k] - lo[k]) : 0;
+      b = b * g.side() + std::clamp(int(t * g.per_axis + g.offset), 0, g.side() - 1);
     }
-    block[i] = uint16_t(b);
+    return uint16_t(b);
   }
-  return block;
-}
+};
 
 class Simplifier {
  public:
@@ -143,7 +156,7 @@ class Simplifier {
       : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
         quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
         next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
-        merged_into_(pos_.size()), frozen_(frozen) {
+        merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0) {
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
@@ -160,20 +173,23 @@ class Simplifier {
     // triangle's corner: at distance 0).
     for (uint32_t v = 0; v < pos_.size(); ++v)
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
-    block_ = block_of_vertices(pos_);
-    members_.resize(size_t(kBlocksPerAxis) * kBlocksPerAxis * kBlocksPerAxis);
+    block_.resize(pos_.size());
+    for (uint32_t u = 0; u < pos_.size(); ++u) block_[u] = grid_.block(pos_[u], kGrids[0]);
+    members_.resize(kGrids[0].count());
     for (uint32_t u = 0; u < pos_.size(); ++u) members_[block_[u]].push_back(u);
   }
 
-  /// First each block of a fixed grid on its own, in parallel, collapsing only where both stars
-  /// lie in the block (simplify_blocks); then the whole mesh from the vertices next to another
-  /// block's (join_blocks). The blocks do not depend on the thread count, so neither does the
-  /// result.
+  /// First each block of the first grid on its own, in parallel, collapsing only where both
+  /// stars lie in the block (simplify_blocks); then the blocks of the other grids, in parallel,
+  /// from the vertices whose collapses left their block before; then the whole mesh from
+  /// those the last grid left (join_blocks). The blocks do not depend on the thread count, so
+  /// neither does the result.
   size_t blocks() const { return members_.size(); }
   uint16_t block(uint32_t u) const { return block_[u]; }
 
   /// Simplifies the blocks `redo` says, in parallel.
   void simplify_blocks(const std::vector<uint8_t>& redo) {
+    current_ = block_;
     tbb::parallel_for(size_t{0}, members_.size(), [&](size_t b) {
       if (!redo[b]) return;
       Scratch s;
@@ -181,39 +197,98 @@ class Simplifier {
     });
   }
 
+  /// What a later round takes over from this round's blocks: the merges and where each
+  /// original point is answered for, and the vertices and triangles still alive.
+  struct BlocksState {
+    std::vector<uint32_t> merged_into, next_point;
+    std::vector<double> near;
+    std::vector<uint8_t> deferred, alive;
+    std::vector<uint32_t> live_vertices;  // and per live vertex:
+    std::vector<Vec3> pos;
+    std::vector<Quadric> quadric;
+    std::vector<std::vector<uint32_t>> faces;
+    std::vector<uint32_t> live_triangles;  // and per live triangle:
+    std::vector<std::array<uint32_t, 3>> tris;
+    std::vector<double> off;
+    std::vector<uint32_t> first_point;
+  };
+  BlocksState blocks_state() const {
+    BlocksState st{merged_into_, next_point_, near_, deferred_, alive_, {}, {}, {}, {}, {}, {}, {}, {}};
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (!faces_[u].empty()) {
+        st.live_vertices.push_back(u);
+        st.pos.push_back(pos_[u]);
+        st.quadric.push_back(quadric_[u]);
+        st.faces.push_back(faces_[u]);
+      }
+    for (uint32_t f = 0; f < tris_.size(); ++f)
+      if (alive_[f]) {
+        st.live_triangles.push_back(f);
+        st.tris.push_back(tris_[f]);
+        st.off.push_back(off_[f]);
+        st.first_point.push_back(first_point_[f]);
+      }
+    return st;
+  }
+
   /// Takes the state of each block but those `redo` says from `done` (the same mesh, its
   /// blocks simplified): a block's collapses touch only its own vertices, the triangles whose
   /// corners all lie in it and the original points those answer for, so a block whose frozen
   /// vertices did not change would come out the same.
-  void adopt_blocks(const Simplifier& done, const std::vector<uint8_t>& redo) {
+  void adopt_blocks(const BlocksState& done, const std::vector<uint8_t>& redo) {
     for (uint32_t u = 0; u < pos_.size(); ++u) {
       if (redo[block_[u]]) continue;
-      pos_[u] = done.pos_[u];
-      quadric_[u] = done.quadric_[u];
-      faces_[u] = done.faces_[u];
-      merged_into_[u] = done.merged_into_[u];
-      next_point_[u] = done.next_point_[u];
-      near_[u] = done.near_[u];
+      merged_into_[u] = done.merged_into[u];
+      next_point_[u] = done.next_point[u];
+      near_[u] = done.near[u];
+      deferred_[u] = done.deferred[u];
+      faces_[u].clear();
     }
+    for (size_t i = 0; i < done.live_vertices.size(); ++i) {
+      const uint32_t u = done.live_vertices[i];
+      if (redo[block_[u]]) continue;
+      pos_[u] = done.pos[i];
+      quadric_[u] = done.quadric[i];
+      faces_[u] = done.faces[i];
+    }
+    // The triangles as in the input here: those with every corner in one adopted block.
+    std::vector<uint8_t> adopted(tris_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
-      const auto& t = tris_[f];  // as in the input here
+      const auto& t = tris_[f];
       const uint16_t b = block_[t[0]];
       if (redo[b] || block_[t[1]] != b || block_[t[2]] != b) continue;
-      tris_[f] = done.tris_[f];
-      alive_[f] = done.alive_[f];
-      off_[f] = done.off_[f];
-      first_point_[f] = done.first_point_[f];
+      adopted[f] = 1;
+      alive_[f] = done.alive[f];
+      first_point_[f] = kNoPoint;
+    }
+    for (size_t i = 0; i < done.live_triangles.size(); ++i) {
+      const uint32_t f = done.live_triangles[i];
+      if (!adopted[f]) continue;
+      tris_[f] = done.tris[i];
+      off_[f] = done.off[i];
+      first_point_[f] = done.first_point[i];
     }
   }
 
-  /// The whole mesh, from the vertices next to another block's.
+  /// The collapses the first grid's blocks left, in the other grids' blocks in parallel, then
+  /// over the whole mesh.
   void join_blocks() {
+    for (size_t g = 1; g < std::size(kGrids); ++g) {
+      std::vector<std::vector<uint32_t>> members(kGrids[g].count());
+      for (uint32_t u = 0; u < pos_.size(); ++u)
+        if (!faces_[u].empty()) members[current_[u] = grid_.block(pos_[u], kGrids[g])].push_back(u);
+      tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+        std::vector<uint8_t> dirty(members[b].size());
+        for (size_t i = 0; i < dirty.size(); ++i) dirty[i] = std::exchange(deferred_[members[b][i]], 0);
+        Scratch s;
+        passes(members[b], std::move(dirty), s, int(b));
+      });
+    }
     std::vector<uint32_t> all(pos_.size());
     std::iota(all.begin(), all.end(), 0u);
     std::vector<uint8_t> dirty(pos_.size(), 0);
-    for (uint32_t u = 0; u < pos_.size(); ++u)
-      for (uint32_t f : faces_[u])
-        for (uint32_t w : tris_[f]) dirty[u] |= block_[w] != block_[u];
+    dirty.swap(deferred_);
+    deferred_.assign(pos_.size(), 0);
     Scratch s;
     passes(all, std::move(dirty), s, kAnyBlock);
   }
@@ -265,7 +340,10 @@ class Simplifier {
   std::vector<double> off_;              // per triangle: how far from the original it was found
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
+  BlockGrid grid_;
   std::vector<uint16_t> block_;                 // per vertex: its block of the grid
+  std::vector<uint16_t> current_;               // per vertex: its block of the grid in use
+  std::vector<uint8_t> deferred_;  // per vertex: a collapse of it was refused for leaving its block
   std::vector<std::vector<uint32_t>> members_;  // per block: its vertices, ascending
   static constexpr int kAnyBlock = -1;
 
@@ -273,6 +351,8 @@ class Simplifier {
   /// onto the neighbour that keeps the planes closest, until a pass collapses fewer than a
   /// thousandth of them; after the first, only vertices whose star changed are tried again.
   /// With a `block`, only collapses whose two stars lie in it.
+  /// A vertex whose collapses were refused for leaving the block, or whose star changed after
+  /// its last try, is marked deferred_ for the next grid.
   void passes(const std::vector<uint32_t>& members, std::vector<uint8_t> dirty, Scratch& s, int block) {
     std::vector<uint8_t> next(members.size(), 0);
     const auto local = [&](uint32_t w) {
@@ -280,22 +360,28 @@ class Simplifier {
     };
     for (int pass = 0; pass < 32; ++pass) {
       size_t done = 0;
-      for (size_t i = 0; i < members.size(); ++i)
-        if (dirty[i] && !faces_[members[i]].empty() && collapse_cheapest(members[i], s, block)) {
-          for (uint32_t w : s.ring_u) next[local(w)] = 1;
-          ++done;
-        }
+      for (size_t i = 0; i < members.size(); ++i) {
+        const uint32_t u = members[i];
+        if (!dirty[i] || faces_[u].empty()) continue;
+        const bool collapsed = collapse_cheapest(u, s, block);
+        deferred_[u] = !collapsed && s.left_block;
+        if (!collapsed) continue;
+        for (uint32_t w : s.ring_u) next[local(w)] = 1;
+        ++done;
+      }
       if (done * 1000 < members.size()) break;
       dirty.swap(next);
       std::fill(next.begin(), next.end(), 0);
     }
+    for (size_t i = 0; i < members.size(); ++i)
+      if (next[i] || dirty[i]) deferred_[members[i]] |= !faces_[members[i]].empty();
   }
 
-  /// Whether every vertex of `ring` lies in `block` (always, for kAnyBlock).
+  /// Whether every vertex of `ring` lies in `block` of the grid in use (always, for kAnyBlock).
   bool in_block(const std::vector<uint32_t>& ring, int block) const {
     if (block == kAnyBlock) return true;
     for (uint32_t w : ring)
-      if (block_[w] != block) return false;
+      if (current_[w] != block) return false;
     return true;
   }
 
@@ -331,9 +417,10 @@ class Simplifier {
   /// Merges u with the neighbour that keeps the planes closest, among those that may take it:
   /// both at the planes' point, or u onto the neighbour where it stands.
   bool collapse_cheapest(uint32_t u, Scratch& s, int block) {
+    s.left_block = false;
     if (frozen_[u]) return false;
     ring(u, s.ring_u);
-    if (!in_block(s.ring_u, block)) return false;
+    if (!in_block(s.ring_u, block)) return s.left_block = true, false;
     s.candidates.clear();
     double error = 0;
     for (uint32_t v : s.ring_u)
@@ -372,7 +459,7 @@ class Simplifier {
     }
     if (shared != 2 || across[0] == across[1]) return false;
     ring(v, s.ring_v);
-    if (!in_block(s.ring_v, block)) return false;
+    if (!in_block(s.ring_v, block)) return s.left_block = true, false;
     size_t common = 0;
     for (uint32_t w : s.ring_u)
       if (std::binary_search(s.ring_v.begin(), s.ring_v.end(), w)) ++common;
@@ -546,10 +633,10 @@ size_t simplify(TriMesh& mesh, double tolerance) {
   // simplified again (a few rounds; the raw contour when crossings remain).
   constexpr int kRounds = 6;
   std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
-  const detail::MeshDistance surface(mesh);
+  const detail::MeshDistance surface(mesh, detail::Pruning::Boxes);
   // A round's state after its blocks: the next round redoes only the blocks where vertices
   // were frozen since.
-  std::optional<Simplifier> blocks_done;
+  std::optional<Simplifier::BlocksState> blocks_done;
   for (int round = 0; round < kRounds; ++round) {
     Simplifier s(mesh, surface, tolerance, frozen);
     std::vector<uint8_t> redo(s.blocks(), 1);
@@ -559,7 +646,7 @@ size_t simplify(TriMesh& mesh, double tolerance) {
       s.adopt_blocks(*blocks_done, redo);
     }
     s.simplify_blocks(redo);
-    blocks_done.emplace(s);
+    blocks_done = s.blocks_state();
     frozen_before = frozen;
     s.join_blocks();
     std::vector<uint32_t> kept;

@@ -148,7 +148,7 @@ void box_distance2_x4(const float* lo, const float* hi, size_t stride, const Flo
 constexpr double kPlaneRounding = 1.0 / (1 << 18);
 
 /// Raises out[0..3] to lower bounds on the squared distances from p (in floats: x) to four
-/// triangles side by side (`plane`, `side`: LeafBounds' arrays at the first one's slot, rows
+/// triangles side by side (`plane`, `side`: LeafPlanes' arrays at the first one's slot, rows
 /// of 8): a triangle lies in its plane and, within it, inside each side's line, so its distance
 /// is at least that of the half-plane beyond its farthest side, sqrt(h^2 + o^2) for p at height
 /// h over the plane and o outside that side. `slack` covers the floats' rounding.
@@ -226,28 +226,31 @@ struct FloatPoint {
         far(mesh_far || !(largest_coordinate(p) <= kFar)) {}
 };
 
-/// Lower bounds on the squared distances from q to a leaf's eight triangles, into out.
-template <class Leaf>
-void leaf_distance2(const Leaf& l, const FloatPoint& q, float* out) {
+/// Lower bounds on the squared distances from q to a leaf's eight triangles, into out
+/// (`planes`: theirs, or none).
+template <class Boxes, class Planes>
+void leaf_distance2(const Boxes& l, const Planes* planes, const FloatPoint& q, float* out) {
   if (q.far) {
     std::fill_n(out, 8, 0.0f);
     return;
   }
   leaf_boxes_distance2(l, q.box, out);
-  plane_distance2_x4(&l.plane[0][0], &l.side[0][0][0], q.x, q.slack, out);
-  plane_distance2_x4(&l.plane[0][4], &l.side[0][0][4], q.x, q.slack, out + 4);
+  if (!planes) return;
+  plane_distance2_x4(&planes->plane[0][0], &planes->side[0][0][0], q.x, q.slack, out);
+  plane_distance2_x4(&planes->plane[0][4], &planes->side[0][0][4], q.x, q.slack, out + 4);
 }
 
-/// Lower bounds on the squared distances from q to a node's four children: the larger of
-/// their axis boxes' and their oriented boxes' (measured in floats along the stored axes, each
+/// Lower bounds on the squared distances from q to a node's four children: their axis boxes',
+/// or with `oriented` the larger of those and their oriented boxes' (measured in floats along the stored axes, each
 /// gap less q's slack; the stored axes are orthonormal to float rounding, which kShrink covers).
 template <class Node>
-void children_distance2(const Node& n, const FloatPoint& q, float* out) {
+void children_distance2(const Node& n, const FloatPoint& q, bool oriented, float* out) {
   if (q.far) {
     std::fill_n(out, 4, 0.0f);
     return;
   }
   box_distance2_x4(&n.lo[0][0], &n.hi[0][0], 4, q.box, out);
+  if (!oriented) return;
   constexpr float kShrink = 1.0f - 1.0f / (1 << 18);
 #if defined(__SSE2__)
   const __m128 px = _mm_set1_ps(q.x[0]), py = _mm_set1_ps(q.x[1]), pz = _mm_set1_ps(q.x[2]);
@@ -279,7 +282,7 @@ void children_distance2(const Node& n, const FloatPoint& q, float* out) {
 
 }  // namespace
 
-MeshDistance::MeshDistance(const TriMesh& mesh) {
+MeshDistance::MeshDistance(const TriMesh& mesh, Pruning pruning) : pruning_(pruning) {
   const size_t n = mesh.triangles.size();
   std::vector<uint32_t> order(n);
   std::iota(order.begin(), order.end(), uint32_t{0});
@@ -309,7 +312,7 @@ MeshDistance::MeshDistance(const TriMesh& mesh) {
   // The build's own arrays freed before the oriented boxes: a large mesh's peak memory.
   for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
   std::vector<BNode>().swap(binary);
-  fill_oriented_boxes(oriented);
+  if (pruning_ == Pruning::Full) fill_oriented_boxes(oriented);
 }
 
 std::vector<std::pair<uint32_t, uint32_t>> MeshDistance::runs_of(const std::vector<BNode>& binary) {
@@ -327,8 +330,15 @@ std::vector<std::pair<uint32_t, uint32_t>> MeshDistance::runs_of(const std::vect
 void MeshDistance::fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                                const std::vector<Vec3>& hi) {
   tris_.resize(order.size());
+  if (pruning_ == Pruning::Full) {
+    // Every slot starts bounding nothing: zero planes, sides' offsets +inf (see set_planes).
+    planes_.resize(leaves_.size());
+    tbb::parallel_for(size_t{0}, planes_.size(), [&](size_t leaf) {
+      for (int e = 0; e < 3; ++e) std::fill_n(planes_[leaf].side[e][3], 8, std::numeric_limits<float>::infinity());
+    });
+  }
   tbb::parallel_for(size_t{0}, leaves_.size(), [&](size_t leaf) {
-    LeafBounds& l = leaves_[leaf];
+    LeafBoxes& l = leaves_[leaf];
     for (uint32_t i = 0; i < l.count; ++i) {
       const uint32_t at = l.first + i;
       const FloatBox box(lo[order[at]], hi[order[at]]);
@@ -336,7 +346,7 @@ void MeshDistance::fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>&
       const auto& t = mesh.triangles[order[at]];
       LeafTriangle& tri = tris_[at];
       tri = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]], order[at], uint32_t(leaf)};
-      set_planes(l, i, tri.a, tri.b, tri.c, rounding_ / 2);
+      if (!planes_.empty()) set_planes(planes_[leaf], i, tri.a, tri.b, tri.c, rounding_ / 2);
     }
   });
 }
@@ -361,11 +371,8 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   const BNode& nd = binary[b];
   if (nd.count > 0) {
     const uint32_t leaf = uint32_t(leaves_.size());
-    LeafBounds& l = leaves_.emplace_back();
+    LeafBoxes& l = leaves_.emplace_back();
     for (int k = 0; k < 3; ++k) std::fill_n(l.lo[k], 8, kInf), std::fill_n(l.hi[k], 8, -kInf);
-    // Every slot starts bounding nothing: zero planes (emplace_back zeroes them), sides' offsets
-    // +inf (see set_planes).
-    for (int e = 0; e < 3; ++e) std::fill_n(l.side[e][3], 8, kInf);
     l.first = nd.first, l.count = nd.count;
     return leaf | kLeafBit;
   }
@@ -444,7 +451,7 @@ void MeshDistance::set_oriented_box(Node4& n, uint32_t i, const LeafTriangle* tr
   for (int k = 0; k < 3; ++k) n.along[k][0][i] = round_down(lo[k]), n.along[k][1][i] = round_up(hi[k]);
 }
 
-void MeshDistance::set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c,
+void MeshDistance::set_planes(LeafPlanes& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c,
                               double tolerance) {
   // Slot i starts bounding nothing (zero plane, every side's offset +inf: p is -inf outside
   // each side); a plane or side is kept only where the corners, measured against it as
@@ -500,15 +507,15 @@ void MeshDistance::search(const Vec3& p, double& best2, Visit&& visit) const {
     if (e.ref & kLeafBit) {
       const uint32_t leaf = e.ref & ~kLeafBit;
       alignas(16) float d[8];
-      leaf_distance2(leaves_[leaf], q, d);
-      const LeafBounds& l = leaves_[leaf];
+      leaf_distance2(leaves_[leaf], planes_of(leaf), q, d);
+      const LeafBoxes& l = leaves_[leaf];
       for (uint32_t i = 0; i < l.count; ++i)
         if (double(d[i]) < best2) visit(tris_[l.first + i], double(d[i]));
       continue;
     }
     const Node4& nd = nodes_[e.ref];
     alignas(16) float d[4];
-    children_distance2(nd, q, d);
+    children_distance2(nd, q, pruning_ == Pruning::Full, d);
     // The children within best2, the nearest last so that it is opened next.
     const int first = top;
     for (int i = 0; i < 4 && nd.child[i] != kNoChild; ++i) {
@@ -546,7 +553,7 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
     const uint32_t leaf = tris_[*hint].leaf, last = uint32_t(leaves_.size()) - 1;
     for (uint32_t l = leaf > 0 ? leaf - 1 : 0; l <= std::min(leaf + 1, last); ++l) {
       alignas(16) float d[8];
-      leaf_distance2(leaves_[l], q, d);
+      leaf_distance2(leaves_[l], planes_of(l), q, d);
       const uint32_t first = leaves_[l].first;
       for (uint32_t i = 0; i < leaves_[l].count; ++i)
         if (double(d[i]) <= r2 && reaches(tris_[first + i], d[i])) return take(tris_[first + i]);

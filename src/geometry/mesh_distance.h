@@ -29,9 +29,20 @@ struct Nearest {
 /// The point of triangle abc nearest p, and which feature holds it.
 Nearest nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+/// Which lower bounds a MeshDistance keeps.
+enum class Pruning : uint8_t {
+  /// Axis and oriented boxes, planes and sides: for queries at a distance from the surface
+  /// (offsets), where near-ties need more than boxes to tell apart.
+  Full,
+  /// Axis boxes only: a third of the memory and a fraction of the build, for queries on or
+  /// next to the surface within a small radius (a simplification's `within` of its raw
+  /// contour), where the small triangles' boxes already hold them closely.
+  Boxes,
+};
+
 class MeshDistance {
  public:
-  explicit MeshDistance(const TriMesh& mesh);
+  explicit MeshDistance(const TriMesh& mesh, Pruning pruning = Pruning::Full);
   /// Unsigned distance from p to the mesh (infinity for an empty mesh).
   double distance(const Vec3& p) const;
   /// Whether some triangle lies within r of p (the search ends at the first one found).
@@ -60,15 +71,17 @@ class MeshDistance {
     alignas(16) float along[3][2][4];    // its extent along axis k: [0] low, [1] high
     uint32_t child[4];  // kLeafBit set: a leaf's number, else a node's
   };
-  /// What bounds a leaf's triangles' distances from below, slot by slot (slots past its count
-  /// empty): their boxes axis by axis, their planes (unit normal, offset) and, in each plane,
-  /// the lines of their three sides (unit normal pointing out of the triangle, offset). Its
+  /// A leaf's triangles' boxes axis by axis, slot by slot (slots past its count empty). Its
   /// triangles are tris_[first, first + count).
-  struct LeafBounds {
+  struct LeafBoxes {
     alignas(16) float lo[3][8], hi[3][8];
+    uint32_t first = 0, count = 0;
+  };
+  /// The same triangles' planes (unit normal, offset) and, in each plane, the lines of their
+  /// three sides (unit normal pointing out of the triangle, offset).
+  struct LeafPlanes {
     alignas(16) float plane[4][8];
     alignas(16) float side[3][4][8];
-    uint32_t first = 0, count = 0;
   };
   struct LeafTriangle {
     Vec3 a, b, c;
@@ -77,9 +90,9 @@ class MeshDistance {
   };
   static constexpr uint32_t kLeafBit = 1u << 31;
   static constexpr uint32_t kNoChild = ~uint32_t{0};  // a Node4's unused slots (the last ones)
-  /// Triangles per leaf at most: LeafBounds' eight slots.
+  /// Triangles per leaf at most: a leaf's eight slots.
   static constexpr uint32_t kLeafSize = 8;
-  static_assert(sizeof(LeafBounds::plane[0]) == kLeafSize * sizeof(float));
+  static_assert(sizeof(LeafPlanes::plane[0]) == kLeafSize * sizeof(float));
 
   /// The binary tree the surface area heuristic builds, collapsed into Node4s after.
   struct BNode {
@@ -115,7 +128,7 @@ class MeshDistance {
   /// `oriented` (node, slot, its run of the order).
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
                     uint32_t b, uint32_t depth, std::vector<std::array<uint32_t, 4>>& oriented);
-  /// tris_ in the order, and every leaf's triangles' boxes, planes and sides.
+  /// tris_ in the order, and every leaf's triangles' boxes (and planes and sides, for Full).
   void fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                    const std::vector<Vec3>& hi);
   /// The oriented boxes listed by collapse, from tris_.
@@ -127,11 +140,15 @@ class MeshDistance {
   void search(const Vec3& p, double& best2, Visit&& visit) const;
   /// Slot i of l (which bounds nothing yet): triangle abc's plane and sides, each one its
   /// corners lie on within `tolerance`.
-  static void set_planes(LeafBounds& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c, double tolerance);
+  static void set_planes(LeafPlanes& l, uint32_t i, const Vec3& a, const Vec3& b, const Vec3& c, double tolerance);
 
+  const LeafPlanes* planes_of(uint32_t leaf) const { return planes_.empty() ? nullptr : &planes_[leaf]; }
+
+  Pruning pruning_;
   uint32_t root_ = 0;
   std::vector<Node4> nodes_;
-  std::vector<LeafBounds> leaves_;
+  std::vector<LeafBoxes> leaves_;
+  std::vector<LeafPlanes> planes_;  // per leaf (Full), or none
   uint32_t depth_ = 0;  // Node4 levels below the root
   // The mesh's share of every query's slack: kPlaneRounding times its largest coordinate (the
   // query point adds its own).
