@@ -546,9 +546,11 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
     TriMesh mesh = *base;
     for (Vec3& x : mesh.positions) x = {x[0] + shift, x[1] - shift, x[2] + shift};
     const detail::MeshDistance md(mesh);
+    const detail::MeshDistance boxes(mesh, detail::Pruning::Boxes);  // the same answers, fewer bounds
     uint32_t hint = 0;
     for (int i = 0; i < 4000; ++i) {
-      const auto& t = mesh.triangles[rng() % mesh.triangles.size()];
+      const uint32_t ti = uint32_t(rng() % mesh.triangles.size());
+      const auto& t = mesh.triangles[ti];
       const double w0 = (u(rng) + 1) / 2, w1 = (1 - w0) * (u(rng) + 1) / 2;
       Vec3 p;
       for (int k = 0; k < 3; ++k)
@@ -574,6 +576,15 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
       ASSERT_NEAR(md.distance(p), least, margin);
       if (least > margin) ASSERT_FALSE(md.within(p, least - margin)) << "shift " << shift << " point " << i;
       ASSERT_TRUE(md.within(p, least + margin)) << "shift " << shift << " point " << i;
+      ASSERT_EQ(boxes.nearest(p).distance, least) << "shift " << shift << " point " << i;
+      // within() from the triangle the point was made on: what it finds lies within the radius.
+      uint32_t slot = boxes.hint_of(ti);
+      double found = -1;
+      if (least > margin) ASSERT_FALSE(boxes.within(p, least - margin, &slot)) << "shift " << shift << " point " << i;
+      slot = boxes.hint_of(ti);
+      ASSERT_TRUE(boxes.within(p, least + margin, &slot, &found)) << "shift " << shift << " point " << i;
+      ASSERT_GE(found, least - margin);
+      ASSERT_LE(found, least + margin);
     }
   }
 }

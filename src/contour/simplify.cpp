@@ -109,7 +109,7 @@ struct Scratch {
   std::vector<std::array<Vec3, 3>> star_corners;
   std::vector<double> star_shift, new_off;
   std::vector<MovedPoint> moved_points;
-  uint32_t hint = 0;  // where the last point near the raw contour found it
+  std::vector<uint32_t> new_near_raw;  // per triangle of that star: where the original was found
   bool left_block = false;  // the last vertex tried had a collapse refused for leaving the block
 };
 
@@ -156,7 +156,8 @@ class Simplifier {
       : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
         quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
         next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
-        merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0) {
+        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0) {
+    for (uint32_t f = 0; f < tris_.size(); ++f) near_raw_[f] = surface.hint_of(f);
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
@@ -210,10 +211,10 @@ class Simplifier {
     std::vector<uint32_t> live_triangles;  // and per live triangle:
     std::vector<std::array<uint32_t, 3>> tris;
     std::vector<double> off;
-    std::vector<uint32_t> first_point;
+    std::vector<uint32_t> first_point, near_raw;
   };
   BlocksState blocks_state() const {
-    BlocksState st{merged_into_, next_point_, near_, deferred_, alive_, {}, {}, {}, {}, {}, {}, {}, {}};
+    BlocksState st{merged_into_, next_point_, near_, deferred_, alive_, {}, {}, {}, {}, {}, {}, {}, {}, {}};
     for (uint32_t u = 0; u < pos_.size(); ++u)
       if (!faces_[u].empty()) {
         st.live_vertices.push_back(u);
@@ -227,6 +228,7 @@ class Simplifier {
         st.tris.push_back(tris_[f]);
         st.off.push_back(off_[f]);
         st.first_point.push_back(first_point_[f]);
+        st.near_raw.push_back(near_raw_[f]);
       }
     return st;
   }
@@ -267,6 +269,7 @@ class Simplifier {
       tris_[f] = done.tris[i];
       off_[f] = done.off[i];
       first_point_[f] = done.first_point[i];
+      near_raw_[f] = done.near_raw[i];
     }
   }
 
@@ -338,6 +341,7 @@ class Simplifier {
   std::vector<double> near_;  // per original point: at most this far from its triangle
   std::vector<uint8_t> alive_;
   std::vector<double> off_;              // per triangle: how far from the original it was found
+  std::vector<uint32_t> near_raw_;       // per triangle: where the original was found near it (a hint)
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
   BlockGrid grid_;
@@ -501,6 +505,7 @@ class Simplifier {
     // (where it stays), then the others. A triangle that one corner leaves by s moves no
     // point of it farther than s: a point that was near enough before and still is by that
     // bound (`near_`) needs no new distance.
+    size_t last = star.size();
     auto check = [&](uint32_t f) {
       const size_t own = size_t(std::find(star.begin(), star.end(), f) - star.begin());
       for (uint32_t p = first_point_[f]; p != kNoPoint; p = next_point_[p]) {
@@ -511,8 +516,11 @@ class Simplifier {
         size_t at = star.size();
         double d2 = 0;
         if (own < star.size() && (d2 = distance2(p, own)) <= tol2) at = own;
+        // The triangle the last point moved to first: the points of one triangle lie close.
+        if (at == star.size() && last != own && last < star.size() && (d2 = distance2(p, last)) <= tol2) at = last;
         for (size_t k = 0; k < star.size() && at == star.size(); ++k)
-          if (k != own && (d2 = distance2(p, k)) <= tol2) at = k;
+          if (k != own && k != last && (d2 = distance2(p, k)) <= tol2) at = k;
+        if (at != own) last = at;
         if (at == star.size()) return false;
         moved.push_back({p, star[at], std::sqrt(d2)});
       }
@@ -538,23 +546,25 @@ class Simplifier {
     const auto& star = s.star;
     const auto& corners = s.star_corners;
     auto& new_off = s.new_off;
-    uint32_t& hint = s.hint;
     auto bound_by = [&](const Vec3& m, uint32_t f) {
       const auto& t = tris_[f];
       return off_[f] + std::sqrt(detail::point_triangle_distance2(m, pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     };
     // `own`: the triangle whose new shape the point lies on, tried first (the nearest, mostly).
     // Within half the tolerance it will do: the bound stays low enough for the next collapse.
-    // Else the original surface is asked, and its nearer triangle found sets the bound.
-    auto bound = [&](const Vec3& m, uint32_t own) {
+    // Else the original surface is asked, from where that triangle found it last (`near_raw_`:
+    // its neighbourhood holds the answer mostly), and the nearer triangle found sets the bound.
+    auto bound = [&](const Vec3& m, uint32_t own, uint32_t& hint) {
       const double by_own = bound_by(m, own);
       if (by_own <= tol_ / 2) return by_own;
       double found = 0;
       return original_surface_.within(m, tol_, &hint, &found) ? std::min(found, by_own) : detail::kHuge;
     };
     double at_x = 0;
+    uint32_t hint = star.empty() ? 0 : near_raw_[star[0]];
     if (!original_surface_.within(x, tol_, &hint, &at_x)) return false;
     new_off.clear();
+    s.new_near_raw.clear();
     for (size_t i = 0; i < star.size(); ++i) {
       const auto& c = corners[i];
       const Vec3 m{(c[0][0] + c[1][0] + c[2][0]) / 3, (c[0][1] + c[1][1] + c[2][1]) / 3, (c[0][2] + c[1][2] + c[2][2]) / 3};
@@ -563,11 +573,13 @@ class Simplifier {
       const int k = c[0] == x ? 0 : c[1] == x ? 1 : 2;
       const Vec3& y = c[(k + 1) % 3];
       const Vec3 e{(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2};
-      const double at_m = bound(m, star[i]);
+      uint32_t near = near_raw_[star[i]];
+      const double at_m = bound(m, star[i], near);
       if (at_m > tol_) return false;
-      const double at_e = bound(e, star[i]);
+      const double at_e = bound(e, star[i], near);
       if (at_e > tol_) return false;
       new_off.push_back(std::max({at_x, at_m, at_e}));
+      s.new_near_raw.push_back(near);
     }
     return true;
   }
@@ -603,7 +615,7 @@ class Simplifier {
       answer_for(m.point, m.triangle);
       near_[m.point] = m.near;
     }
-    for (size_t k = 0; k < s.star.size(); ++k) off_[s.star[k]] = s.new_off[k];
+    for (size_t k = 0; k < s.star.size(); ++k) off_[s.star[k]] = s.new_off[k], near_raw_[s.star[k]] = s.new_near_raw[k];
     pos_[v] = x;
     merged_into_[u] = v;
     for (uint32_t f : faces_[u]) {

@@ -330,6 +330,8 @@ std::vector<std::pair<uint32_t, uint32_t>> MeshDistance::runs_of(const std::vect
 void MeshDistance::fill_leaves(const TriMesh& mesh, const std::vector<uint32_t>& order, const std::vector<Vec3>& lo,
                                const std::vector<Vec3>& hi) {
   tris_.resize(order.size());
+  slot_of_.resize(order.size());
+  for (uint32_t at = 0; at < order.size(); ++at) slot_of_[order[at]] = at;
   if (pruning_ == Pruning::Full) {
     // Every slot starts bounding nothing: zero planes, sides' offsets +inf (see set_planes).
     planes_.resize(leaves_.size());
@@ -547,16 +549,23 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
     return true;
   };
   // The hint's leaf and the leaves on either side first: stored in leaf order, they lie close
-  // by.
+  // by. The nearest of their triangles, not the first: a caller keeping `found` as a bound on
+  // the point's distance (the simplifier) keeps it low.
   if (hint && *hint < tris_.size()) {
     const FloatPoint q(p, rounding_, far_);
     const uint32_t leaf = tris_[*hint].leaf, last = uint32_t(leaves_.size()) - 1;
+    double best2 = r2;
+    const LeafTriangle* best = nullptr;
     for (uint32_t l = leaf > 0 ? leaf - 1 : 0; l <= std::min(leaf + 1, last); ++l) {
       alignas(16) float d[8];
       leaf_distance2(leaves_[l], planes_of(l), q, d);
       const uint32_t first = leaves_[l].first;
       for (uint32_t i = 0; i < leaves_[l].count; ++i)
-        if (double(d[i]) <= r2 && reaches(tris_[first + i], d[i])) return take(tris_[first + i]);
+        if (double(d[i]) <= best2 && reaches(tris_[first + i], d[i]) && d2 <= best2) best2 = d2, best = &tris_[first + i];
+    }
+    if (best) {
+      d2 = best2;
+      return take(*best);
     }
   }
   // Just above r^2, so that a box at exactly r is still opened; once a triangle is found the

@@ -45,10 +45,13 @@ class MeshDistance {
   explicit MeshDistance(const TriMesh& mesh, Pruning pruning = Pruning::Full);
   /// Unsigned distance from p to the mesh (infinity for an empty mesh).
   double distance(const Vec3& p) const;
-  /// Whether some triangle lies within r of p (the search ends at the first one found).
-  /// `hint` (opaque, optional): where a point close by found one; set to this one's.
-  /// `found` (optional): the distance to the triangle found, at most r.
+  /// Whether some triangle lies within r of p. `hint` (opaque, optional): where a point close
+  /// by found one; the triangles of its leaf and the leaves beside it are looked at first, and
+  /// the nearest of them within r is taken; else the search ends at the first one found. The
+  /// hint is set to the triangle taken, `found` (optional) to its distance, at most r.
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
+  /// The hint that names the mesh's triangle t (for a point next to it).
+  uint32_t hint_of(uint32_t t) const { return slot_of_[t]; }
   /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when
   /// unsure: a triangle's bounds, its plane and its distance from the box's centre or its
   /// octants' centres each may prove it away).
@@ -155,6 +158,7 @@ class MeshDistance {
   float rounding_ = 0;
   bool far_ = false;  // a coordinate beyond kFar: the float bounds are not used
   std::vector<LeafTriangle> tris_;  // in the tree's order: each leaf's run contiguous
+  std::vector<uint32_t> slot_of_;   // per mesh triangle: its place in tris_
 };
 
 /// Signed distance to a closed 2-manifold mesh (negative inside). Keeps a reference to `mesh`.
