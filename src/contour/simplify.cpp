@@ -116,9 +116,9 @@ struct Scratch {
 /// Blocks of fixed grids over the mesh's box, each vertex in the one holding it: collapses whose
 /// two stars lie in one block touch nothing another block's collapses do. The first grid has
 /// kBlocksPerAxis blocks a side; the second is shifted by half a block, so that its blocks hold
-/// the bands along the first one's faces; the third has blocks twice as wide, shifted by an
-/// eighth of theirs, so that no two grids share a face and the long triangles of a coarse
-/// mesh fit in its blocks.
+/// the bands along the first one's faces; the third and fourth have blocks twice and four
+/// times as wide, shifted by an eighth and three sixteenths of theirs, so that no two grids
+/// share a face and the long triangles of a coarse mesh fit in their blocks.
 constexpr int kBlocksPerAxis = 8;
 struct GridLayout {
   int per_axis;
@@ -126,7 +126,8 @@ struct GridLayout {
   int side() const { return per_axis + (offset > 0); }
   size_t count() const { return size_t(side()) * side() * side(); }
 };
-constexpr GridLayout kGrids[] = {{kBlocksPerAxis, 0}, {kBlocksPerAxis, 0.5}, {kBlocksPerAxis / 2, 0.125}};
+constexpr GridLayout kGrids[] = {
+    {kBlocksPerAxis, 0}, {kBlocksPerAxis, 0.5}, {kBlocksPerAxis / 2, 0.125}, {kBlocksPerAxis / 4, 0.1875}};
 
 struct BlockGrid {
   Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
