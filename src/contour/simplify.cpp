@@ -13,12 +13,12 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
-#include <optional>
 #include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
+#include "contour/simplify.h"
 #include "geometry/lattice.h"
 #include "geometry/mesh_distance.h"
 #include "geometry/qef.h"
@@ -111,6 +111,8 @@ struct Scratch {
   std::vector<MovedPoint> moved_points;
   std::vector<uint32_t> new_near_raw;  // per triangle of that star: where the original was found
   bool left_block = false;  // the last vertex tried had a collapse refused for leaving the block
+  bool log_moves = false;
+  std::vector<uint32_t> moved_log;  // every original point the collapses moved, if log_moves
 };
 
 /// Blocks of fixed grids over the mesh's box, each vertex in the one holding it: collapses whose
@@ -157,7 +159,7 @@ class Simplifier {
       : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
         quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
         next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
-        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0) {
+        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0), logged_(pos_.size(), 0) {
     for (uint32_t f = 0; f < tris_.size(); ++f) near_raw_[f] = surface.hint_of(f);
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
@@ -177,34 +179,27 @@ class Simplifier {
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
     block_.resize(pos_.size());
     for (uint32_t u = 0; u < pos_.size(); ++u) block_[u] = grid_.block(pos_[u], kGrids[0]);
-    members_.resize(kGrids[0].count());
-    for (uint32_t u = 0; u < pos_.size(); ++u) members_[block_[u]].push_back(u);
   }
 
-  /// First each block of the first grid on its own, in parallel, collapsing only where both
-  /// stars lie in the block (simplify_blocks); then the blocks of the other grids, in parallel,
-  /// from the vertices whose collapses left their block before; then the whole mesh from
-  /// those the last grid left (join_blocks). The blocks do not depend on the thread count, so
-  /// neither does the result.
-  size_t blocks() const { return members_.size(); }
-  uint16_t block(uint32_t u) const { return block_[u]; }
-
-  /// Simplifies the blocks `redo` says, in parallel.
-  void simplify_blocks(const std::vector<uint8_t>& redo) {
-    current_ = block_;
-    tbb::parallel_for(size_t{0}, members_.size(), [&](size_t b) {
-      if (!redo[b]) return;
-      Scratch s;
-      passes(members_[b], std::vector<uint8_t>(members_[b].size(), 1), s, int(b));
-    });
-  }
+  /// The grids' blocks one grid after another, each grid's in parallel: first each block of the
+  /// first grid on its own, collapsing only where both stars lie in the block; then the blocks
+  /// of the other grids, from the vertices whose collapses left their block before (phase);
+  /// then the whole mesh from those the last grid left (finish). The blocks do not depend on
+  /// the thread count, so neither does the result.
+  static constexpr uint16_t kNoBlock = UINT16_MAX;
 
   /// What a later round takes over from this round's blocks: the merges and where each
   /// original point is answered for, and the vertices and triangles still alive.
   struct BlocksState {
+    // Per vertex and original point (the same numbers): their merge, the next point on their
+    // triangle's list, how near it, whether deferred; for all, or (a later grid's phase, which
+    // changes few) only for those `touched`, in its order.
+    std::vector<uint32_t> touched;
+    bool partial = false;
     std::vector<uint32_t> merged_into, next_point;
     std::vector<double> near;
-    std::vector<uint8_t> deferred, alive;
+    std::vector<uint8_t> deferred;
+    std::vector<uint8_t> alive;  // per triangle
     std::vector<uint32_t> live_vertices;  // and per live vertex:
     std::vector<Vec3> pos;
     std::vector<Quadric> quadric;
@@ -214,80 +209,60 @@ class Simplifier {
     std::vector<double> off;
     std::vector<uint32_t> first_point, near_raw;
   };
-  BlocksState blocks_state() const {
-    BlocksState st{merged_into_, next_point_, near_, deferred_, alive_, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+  /// One grid's phase of a round: each live vertex's block when it began, the state at its end.
+  struct PhaseRecord {
+    std::vector<uint16_t> membership;
+    BlocksState after;
+  };
+
+  /// Grid g's phase. `previous`: the same phase of the last round (none in the first), whose
+  /// blocks are taken over where no vertex of theirs, then or now, may have changed
+  /// (`changed`, per vertex; the vertices of the blocks run here are added to it): a block's
+  /// collapses touch only its own vertices, the triangles whose corners all lie in it and the
+  /// original points those answer for, so it would come out the same.
+  PhaseRecord phase(size_t g, const PhaseRecord* previous, std::vector<uint8_t>& changed) {
+    PhaseRecord record;
+    record.membership.assign(pos_.size(), kNoBlock);
+    std::vector<std::vector<uint32_t>> members(kGrids[g].count());
     for (uint32_t u = 0; u < pos_.size(); ++u)
       if (!faces_[u].empty()) {
-        st.live_vertices.push_back(u);
-        st.pos.push_back(pos_[u]);
-        st.quadric.push_back(quadric_[u]);
-        st.faces.push_back(faces_[u]);
+        const uint16_t b = g == 0 ? block_[u] : grid_.block(pos_[u], kGrids[g]);
+        record.membership[u] = b;
+        members[b].push_back(u);
       }
-    for (uint32_t f = 0; f < tris_.size(); ++f)
-      if (alive_[f]) {
-        st.live_triangles.push_back(f);
-        st.tris.push_back(tris_[f]);
-        st.off.push_back(off_[f]);
-        st.first_point.push_back(first_point_[f]);
-        st.near_raw.push_back(near_raw_[f]);
-      }
-    return st;
-  }
-
-  /// Takes the state of each block but those `redo` says from `done` (the same mesh, its
-  /// blocks simplified): a block's collapses touch only its own vertices, the triangles whose
-  /// corners all lie in it and the original points those answer for, so a block whose frozen
-  /// vertices did not change would come out the same.
-  void adopt_blocks(const BlocksState& done, const std::vector<uint8_t>& redo) {
-    for (uint32_t u = 0; u < pos_.size(); ++u) {
-      if (redo[block_[u]]) continue;
-      merged_into_[u] = done.merged_into[u];
-      next_point_[u] = done.next_point[u];
-      near_[u] = done.near[u];
-      deferred_[u] = done.deferred[u];
-      faces_[u].clear();
-    }
-    for (size_t i = 0; i < done.live_vertices.size(); ++i) {
-      const uint32_t u = done.live_vertices[i];
-      if (redo[block_[u]]) continue;
-      pos_[u] = done.pos[i];
-      quadric_[u] = done.quadric[i];
-      faces_[u] = done.faces[i];
-    }
-    // The triangles as in the input here: those with every corner in one adopted block.
-    std::vector<uint8_t> adopted(tris_.size(), 0);
-    for (uint32_t f = 0; f < tris_.size(); ++f) {
-      const auto& t = tris_[f];
-      const uint16_t b = block_[t[0]];
-      if (redo[b] || block_[t[1]] != b || block_[t[2]] != b) continue;
-      adopted[f] = 1;
-      alive_[f] = done.alive[f];
-      first_point_[f] = kNoPoint;
-    }
-    for (size_t i = 0; i < done.live_triangles.size(); ++i) {
-      const uint32_t f = done.live_triangles[i];
-      if (!adopted[f]) continue;
-      tris_[f] = done.tris[i];
-      off_[f] = done.off[i];
-      first_point_[f] = done.first_point[i];
-      near_raw_[f] = done.near_raw[i];
-    }
-  }
-
-  /// The collapses the first grid's blocks left, in the other grids' blocks in parallel, then
-  /// over the whole mesh.
-  void join_blocks() {
-    for (size_t g = 1; g < std::size(kGrids); ++g) {
-      std::vector<std::vector<uint32_t>> members(kGrids[g].count());
+    std::vector<uint8_t> run(members.size(), previous == nullptr);
+    if (previous)
       for (uint32_t u = 0; u < pos_.size(); ++u)
-        if (!faces_[u].empty()) members[current_[u] = grid_.block(pos_[u], kGrids[g])].push_back(u);
-      tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
-        std::vector<uint8_t> dirty(members[b].size());
+        if (changed[u])
+          for (uint16_t b : {record.membership[u], previous->membership[u]})
+            if (b != kNoBlock) run[b] = 1;
+    std::vector<uint32_t> touched = previous ? adopt(previous->after, record.membership, run) : std::vector<uint32_t>{};
+    current_ = record.membership;
+    std::vector<std::vector<uint32_t>> moved(members.size());
+    tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+      if (!run[b]) return;
+      std::vector<uint8_t> dirty(members[b].size(), 1);
+      if (g > 0)
         for (size_t i = 0; i < dirty.size(); ++i) dirty[i] = std::exchange(deferred_[members[b][i]], 0);
-        Scratch s;
-        passes(members[b], std::move(dirty), s, int(b));
-      });
+      Scratch s;
+      s.log_moves = g > 0;
+      passes(members[b], std::move(dirty), s, int(b));
+      moved[b] = std::move(s.moved_log);
+    });
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (record.membership[u] != kNoBlock && run[record.membership[u]]) changed[u] = 1, touched.push_back(u);
+    for (const auto& m : moved) {
+      touched.insert(touched.end(), m.begin(), m.end());
+      for (uint32_t p : m) logged_[p] = 0;
     }
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    record.after = state(g == 0 ? nullptr : &touched);
+    return record;
+  }
+
+  /// The collapses the last grid's blocks left, over the whole mesh.
+  void finish() {
     std::vector<uint32_t> all(pos_.size());
     std::iota(all.begin(), all.end(), 0u);
     std::vector<uint8_t> dirty(pos_.size(), 0);
@@ -349,8 +324,99 @@ class Simplifier {
   std::vector<uint16_t> block_;                 // per vertex: its block of the grid
   std::vector<uint16_t> current_;               // per vertex: its block of the grid in use
   std::vector<uint8_t> deferred_;  // per vertex: a collapse of it was refused for leaving its block
-  std::vector<std::vector<uint32_t>> members_;  // per block: its vertices, ascending
+  std::vector<uint8_t> logged_;    // per original point: in a block's moved_log this phase
   static constexpr int kAnyBlock = -1;
+
+  /// The state now; with `touched`, the vertices' and points' only for those.
+  BlocksState state(const std::vector<uint32_t>* touched) const {
+    BlocksState st;
+    if (touched) {
+      st.partial = true;
+      st.touched = *touched;
+      for (uint32_t i : *touched) {
+        st.merged_into.push_back(merged_into_[i]);
+        st.next_point.push_back(next_point_[i]);
+        st.near.push_back(near_[i]);
+        st.deferred.push_back(deferred_[i]);
+      }
+    } else {
+      st.merged_into = merged_into_, st.next_point = next_point_, st.near = near_, st.deferred = deferred_;
+    }
+    st.alive = alive_;
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (!faces_[u].empty()) {
+        st.live_vertices.push_back(u);
+        st.pos.push_back(pos_[u]);
+        st.quadric.push_back(quadric_[u]);
+        st.faces.push_back(faces_[u]);
+      }
+    for (uint32_t f = 0; f < tris_.size(); ++f)
+      if (alive_[f]) {
+        st.live_triangles.push_back(f);
+        st.tris.push_back(tris_[f]);
+        st.off.push_back(off_[f]);
+        st.first_point.push_back(first_point_[f]);
+        st.near_raw.push_back(near_raw_[f]);
+      }
+    return st;
+  }
+
+  /// Takes from `done` the state of the blocks of `membership` that `run` leaves out: their
+  /// vertices, the live triangles with every corner in one of them and the points those answer
+  /// for. Returns the vertices and points a partial `done` changed there.
+  std::vector<uint32_t> adopt(const BlocksState& done, const std::vector<uint16_t>& membership,
+                              const std::vector<uint8_t>& run) {
+    const auto adopted = [&](uint32_t u) { return membership[u] != kNoBlock && !run[membership[u]]; };
+    std::vector<uint8_t> taken(tris_.size(), 0), point_taken(done.partial ? pos_.size() : 0, 0);
+    for (uint32_t f = 0; f < tris_.size(); ++f) {
+      const auto& t = tris_[f];
+      if (!alive_[f] || !adopted(t[0]) || membership[t[1]] != membership[t[0]] || membership[t[2]] != membership[t[0]])
+        continue;
+      taken[f] = 1;
+      for (uint32_t p = first_point_[f]; p != kNoPoint;) {
+        const uint32_t next = next_point_[p];
+        if (done.partial) {
+          point_taken[p] = 1;
+        } else {
+          next_point_[p] = done.next_point[p];
+          near_[p] = done.near[p];
+        }
+        p = next;
+      }
+      alive_[f] = done.alive[f];
+      first_point_[f] = kNoPoint;
+    }
+    std::vector<uint32_t> changed_here;
+    if (done.partial)
+      for (size_t k = 0; k < done.touched.size(); ++k) {
+        const uint32_t i = done.touched[k];
+        const bool vertex = adopted(i), point = point_taken[i];
+        if (vertex) merged_into_[i] = done.merged_into[k], deferred_[i] = done.deferred[k];
+        if (point) next_point_[i] = done.next_point[k], near_[i] = done.near[k];
+        if (vertex || point) changed_here.push_back(i);
+      }
+    for (size_t i = 0; i < done.live_triangles.size(); ++i) {
+      const uint32_t f = done.live_triangles[i];
+      if (!taken[f]) continue;
+      tris_[f] = done.tris[i];
+      off_[f] = done.off[i];
+      first_point_[f] = done.first_point[i];
+      near_raw_[f] = done.near_raw[i];
+    }
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (adopted(u)) {
+        if (!done.partial) merged_into_[u] = done.merged_into[u], deferred_[u] = done.deferred[u];
+        faces_[u].clear();
+      }
+    for (size_t i = 0; i < done.live_vertices.size(); ++i) {
+      const uint32_t u = done.live_vertices[i];
+      if (!adopted(u)) continue;
+      pos_[u] = done.pos[i];
+      quadric_[u] = done.quadric[i];
+      faces_[u] = done.faces[i];
+    }
+    return changed_here;
+  }
 
   /// Passes over `members` (ascending vertex numbers, `dirty` per member), each vertex moving
   /// onto the neighbour that keeps the planes closest, until a pass collapses fewer than a
@@ -609,12 +675,14 @@ class Simplifier {
   }
 
   /// Carries out the collapse keeps_points() last accepted (of u into v at x).
-  void collapse(uint32_t u, uint32_t v, const Vec3& x, const Scratch& s) {
+  void collapse(uint32_t u, uint32_t v, const Vec3& x, Scratch& s) {
     for (uint32_t w : {u, v})
       for (uint32_t f : faces_[w]) first_point_[f] = kNoPoint;
     for (const MovedPoint& m : s.moved_points) {
       answer_for(m.point, m.triangle);
       near_[m.point] = m.near;
+      // Each point once a phase: a block's points are its own, so the flags do not race.
+      if (s.log_moves && !std::exchange(logged_[m.point], 1)) s.moved_log.push_back(m.point);
     }
     for (size_t k = 0; k < s.star.size(); ++k) off_[s.star[k]] = s.new_off[k], near_raw_[s.star[k]] = s.new_near_raw[k];
     pos_[v] = x;
@@ -638,7 +706,9 @@ class Simplifier {
 
 }  // namespace
 
-size_t simplify(TriMesh& mesh, double tolerance) {
+size_t simplify(TriMesh& mesh, double tolerance) { return detail::simplify_in_rounds(mesh, tolerance, true); }
+
+size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_over) {
   if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
@@ -647,21 +717,22 @@ size_t simplify(TriMesh& mesh, double tolerance) {
   constexpr int kRounds = 6;
   std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
   const detail::MeshDistance surface(mesh, detail::Pruning::Boxes);
-  // A round's state after its blocks: the next round redoes only the blocks where vertices
-  // were frozen since.
-  std::optional<Simplifier::BlocksState> blocks_done;
+  // Each phase of a round as it ended: the next round redoes only the blocks where vertices
+  // were frozen since, and those their changes reach in the later grids.
+  std::vector<Simplifier::PhaseRecord> last;
   for (int round = 0; round < kRounds; ++round) {
     Simplifier s(mesh, surface, tolerance, frozen);
-    std::vector<uint8_t> redo(s.blocks(), 1);
-    if (blocks_done) {
-      std::fill(redo.begin(), redo.end(), 0);
-      for (uint32_t u = 0; u < frozen.size(); ++u) redo[s.block(u)] |= frozen[u] != frozen_before[u];
-      s.adopt_blocks(*blocks_done, redo);
+    std::vector<uint8_t> changed(mesh.positions.size(), 0);
+    if (round > 0)
+      for (uint32_t u = 0; u < frozen.size(); ++u) changed[u] = frozen[u] != frozen_before[u];
+    std::vector<Simplifier::PhaseRecord> now;
+    for (size_t g = 0; g < std::size(kGrids); ++g) {
+      now.push_back(s.phase(g, last.empty() || !take_over ? nullptr : &last[g], changed));
+      if (!last.empty()) last[g] = {};  // its memory before the next phase's record
     }
-    s.simplify_blocks(redo);
-    blocks_done = s.blocks_state();
+    last = std::move(now);
     frozen_before = frozen;
-    s.join_blocks();
+    s.finish();
     std::vector<uint32_t> kept;
     TriMesh out = s.result(kept);
     if (out.triangles.size() == mesh.triangles.size()) return 0;
