@@ -155,12 +155,19 @@ TEST(Simplify, CrossingsSettleBeforeTheRoundsRunOut) {
   EXPECT_EQ(count_self_intersections(m), 0u);
   // Its later rounds take over the blocks the newly kept vertices do not reach: the same mesh
   // as redoing every block.
-  TriMesh taken = raw, redone = raw;
-  detail::simplify_in_rounds(taken, kCompactSimplify * t.cube.size / double(1 << t.max_depth), true);
-  detail::simplify_in_rounds(redone, kCompactSimplify * t.cube.size / double(1 << t.max_depth), false);
+  const double tolerance = kCompactSimplify * t.cube.size / double(1 << t.max_depth);
+  TriMesh taken = raw, redone = raw, one = raw;
+  detail::simplify_in_rounds(taken, tolerance, true);
+  detail::simplify_in_rounds(redone, tolerance, false);
   EXPECT_TRUE(taken.positions == m.positions && taken.triangles == m.triangles);
   EXPECT_TRUE(taken.positions == redone.positions);
   EXPECT_TRUE(taken.triangles == redone.triangles);
+  // And with one thread.
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    detail::simplify_in_rounds(one, tolerance, true);
+  }
+  EXPECT_TRUE(one.positions == taken.positions && one.triangles == taken.triangles);
 }
 
 }  // namespace

@@ -98,7 +98,7 @@ struct MovedPoint {
   uint32_t point, triangle;
   double near;  // at most this far from it
 };
-/// What trying one collapse needs for itself; each worker has its own.
+/// What trying one collapse needs for itself; each block (and the last pass) has its own.
 struct Scratch {
   std::vector<uint32_t> ring_u, ring_v;
   std::vector<Candidate> candidates;
@@ -181,19 +181,14 @@ class Simplifier {
     for (uint32_t u = 0; u < pos_.size(); ++u) block_[u] = grid_.block(pos_[u], kGrids[0]);
   }
 
-  /// The grids' blocks one grid after another, each grid's in parallel: first each block of the
-  /// first grid on its own, collapsing only where both stars lie in the block; then the blocks
-  /// of the other grids, from the vertices whose collapses left their block before (phase);
-  /// then the whole mesh from those the last grid left (finish). The blocks do not depend on
-  /// the thread count, so neither does the result.
   static constexpr uint16_t kNoBlock = UINT16_MAX;
 
   /// What a later round takes over from this round's blocks: the merges and where each
   /// original point is answered for, and the vertices and triangles still alive.
   struct BlocksState {
     // Per vertex and original point (the same numbers): their merge, the next point on their
-    // triangle's list, how near it, whether deferred; for all, or (a later grid's phase, which
-    // changes few) only for those `touched`, in its order.
+    // triangle's list, how near it, whether deferred; for all, or (a later grid's phase) only
+    // for those it touched (its blocks' vertices, the points it moved), in `touched`'s order.
     std::vector<uint32_t> touched;
     bool partial = false;
     std::vector<uint32_t> merged_into, next_point;
@@ -215,12 +210,19 @@ class Simplifier {
     BlocksState after;
   };
 
+  /// The grids' blocks one grid after another, each grid's in parallel: first each block of the
+  /// first grid on its own, collapsing only where both stars lie in the block; then the blocks
+  /// of the other grids, from the vertices whose collapses left their block before (phase);
+  /// then the whole mesh from those the last grid left (finish). The blocks do not depend on
+  /// the thread count, so neither does the result.
+  ///
   /// Grid g's phase. `previous`: the same phase of the last round (none in the first), whose
   /// blocks are taken over where no vertex of theirs, then or now, may have changed
   /// (`changed`, per vertex; the vertices of the blocks run here are added to it): a block's
   /// collapses touch only its own vertices, the triangles whose corners all lie in it and the
   /// original points those answer for, so it would come out the same.
-  PhaseRecord phase(size_t g, const PhaseRecord* previous, std::vector<uint8_t>& changed) {
+  /// `record`: whether a later round may take this phase over (its record is returned).
+  PhaseRecord phase(size_t g, const PhaseRecord* previous, std::vector<uint8_t>& changed, bool record_it) {
     PhaseRecord record;
     record.membership.assign(pos_.size(), kNoBlock);
     std::vector<std::vector<uint32_t>> members(kGrids[g].count());
@@ -257,7 +259,7 @@ class Simplifier {
     }
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    record.after = state(g == 0 ? nullptr : &touched);
+    if (record_it) record.after = state(g == 0 ? nullptr : &touched);
     return record;
   }
 
@@ -425,6 +427,7 @@ class Simplifier {
   /// A vertex whose collapses were refused for leaving the block, or whose star changed after
   /// its last try, is marked deferred_ for the next grid.
   void passes(const std::vector<uint32_t>& members, std::vector<uint8_t> dirty, Scratch& s, int block) {
+    bool stopped = false;
     std::vector<uint8_t> next(members.size(), 0);
     const auto local = [&](uint32_t w) {
       return block == kAnyBlock ? size_t(w) : size_t(std::lower_bound(members.begin(), members.end(), w) - members.begin());
@@ -440,12 +443,18 @@ class Simplifier {
         for (uint32_t w : s.ring_u) next[local(w)] = 1;
         ++done;
       }
-      if (done * 1000 < members.size()) break;
+      if (done * 1000 < members.size()) {
+        stopped = true;
+        break;
+      }
       dirty.swap(next);
       std::fill(next.begin(), next.end(), 0);
     }
+    // Not tried since their star changed: `next` when the passes stopped, else (out of passes)
+    // the last swap's `dirty`.
+    const std::vector<uint8_t>& untried = stopped ? next : dirty;
     for (size_t i = 0; i < members.size(); ++i)
-      if (next[i] || dirty[i]) deferred_[members[i]] |= !faces_[members[i]].empty();
+      if (untried[i]) deferred_[members[i]] |= !faces_[members[i]].empty();
   }
 
   /// Whether every vertex of `ring` lies in `block` of the grid in use (always, for kAnyBlock).
@@ -726,11 +735,16 @@ size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_ove
     if (round > 0)
       for (uint32_t u = 0; u < frozen.size(); ++u) changed[u] = frozen[u] != frozen_before[u];
     std::vector<Simplifier::PhaseRecord> now;
+    // Records only where a later round may take them over.
+    const bool record = take_over && round + 1 < kRounds;
     for (size_t g = 0; g < std::size(kGrids); ++g) {
-      now.push_back(s.phase(g, last.empty() || !take_over ? nullptr : &last[g], changed));
+      now.push_back(s.phase(g, last.empty() ? nullptr : &last[g], changed, record));
       if (!last.empty()) last[g] = {};  // its memory before the next phase's record
     }
-    last = std::move(now);
+    if (record)
+      last = std::move(now);
+    else
+      last.clear();
     frozen_before = frozen;
     s.finish();
     std::vector<uint32_t> kept;

@@ -401,7 +401,10 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   for (int k = 0; k < 3; ++k) {
     std::fill_n(out.lo[k], 4, kInf), std::fill_n(out.hi[k], 4, -kInf);
     for (int j = 0; j < 3; ++j) std::fill_n(out.axis[k][j], 4, k == j ? 1.0f : 0.0f);
-    std::fill_n(out.along[k][0], 4, kInf), std::fill_n(out.along[k][1], 4, -kInf);
+    // Unused slots' oriented boxes are empty; with Pruning::Boxes none is built, and each
+    // bounds nothing (were it ever measured).
+    const bool none = pruning_ == Pruning::Boxes;
+    std::fill_n(out.along[k][0], 4, none ? -kInf : kInf), std::fill_n(out.along[k][1], 4, none ? kInf : -kInf);
   }
   for (int i = 0; i < 4; ++i) out.child[i] = kNoChild;
   for (int i = 0; i < count; ++i) {

@@ -1,7 +1,8 @@
 // Distances from points to a triangle mesh: the nearest point over a BVH split by the surface
 // area heuristic and collapsed to four children a node, leaves of up to 8 triangles; lower
-// bounds (axis and oriented boxes, each triangle's plane and sides) measured in floats before
-// the exact point-triangle distance (docs/algorithms.md, distance queries); and for a
+// bounds (axis boxes, and with Pruning::Full oriented boxes and each triangle's plane and
+// sides) measured in floats before the exact point-triangle distance (docs/algorithms.md,
+// distance queries); and for a
 // closed 2-manifold mesh the signed distance, its sign from the angle-weighted pseudonormal of
 // the nearest feature (Baerentzen and Aanaes 2005: exact for such a mesh, no ray and no
 // winding number).
@@ -65,9 +66,10 @@ class MeshDistance {
   // Boxes in float, rounded outward: a box only prunes, and four of them side by side (a
   // node's children, half a leaf's triangles) are measured in one vector operation.
   /// Four children's boxes, axis by axis; an unused slot's box is empty (lo +inf, hi -inf).
-  /// Each child has a second box, oriented to its triangles: one axis along their mean normal
-  /// and two across it, so that a flat or gently curved patch fills it closely (an axis box
-  /// holds a tilted patch loosely, and a point above it is near the box but far from the patch).
+  /// With Pruning::Full each child has a second box, oriented to its triangles: one axis along
+  /// their mean normal and two across it, so that a flat or gently curved patch fills it
+  /// closely (an axis box holds a tilted patch loosely, and a point above it is near the box
+  /// but far from the patch).
   struct Node4 {
     alignas(16) float lo[3][4], hi[3][4];
     alignas(16) float axis[3][3][4];     // oriented box: axis k's component j
