@@ -221,17 +221,10 @@ class Simplifier {
   /// (`changed`, per vertex; the vertices of the blocks run here are added to it): a block's
   /// collapses touch only its own vertices, the triangles whose corners all lie in it and the
   /// original points those answer for, so it would come out the same.
-  /// `record`: whether a later round may take this phase over (its record is returned).
+  /// `record_it`: whether a later round may take this phase over (its record is returned).
   PhaseRecord phase(size_t g, const PhaseRecord* previous, std::vector<uint8_t>& changed, bool record_it) {
     PhaseRecord record;
-    record.membership.assign(pos_.size(), kNoBlock);
-    std::vector<std::vector<uint32_t>> members(kGrids[g].count());
-    for (uint32_t u = 0; u < pos_.size(); ++u)
-      if (!faces_[u].empty()) {
-        const uint16_t b = g == 0 ? block_[u] : grid_.block(pos_[u], kGrids[g]);
-        record.membership[u] = b;
-        members[b].push_back(u);
-      }
+    const std::vector<std::vector<uint32_t>> members = members_of(g, record.membership);
     std::vector<uint8_t> run(members.size(), previous == nullptr);
     if (previous)
       for (uint32_t u = 0; u < pos_.size(); ++u)
@@ -240,23 +233,9 @@ class Simplifier {
             if (b != kNoBlock) run[b] = 1;
     std::vector<uint32_t> touched = previous ? adopt(previous->after, record.membership, run) : std::vector<uint32_t>{};
     current_ = record.membership;
-    std::vector<std::vector<uint32_t>> moved(members.size());
-    tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
-      if (!run[b]) return;
-      std::vector<uint8_t> dirty(members[b].size(), 1);
-      if (g > 0)
-        for (size_t i = 0; i < dirty.size(); ++i) dirty[i] = std::exchange(deferred_[members[b][i]], 0);
-      Scratch s;
-      s.log_moves = g > 0;
-      passes(members[b], std::move(dirty), s, int(b));
-      moved[b] = std::move(s.moved_log);
-    });
+    run_blocks(g, members, run, touched);
     for (uint32_t u = 0; u < pos_.size(); ++u)
       if (record.membership[u] != kNoBlock && run[record.membership[u]]) changed[u] = 1, touched.push_back(u);
-    for (const auto& m : moved) {
-      touched.insert(touched.end(), m.begin(), m.end());
-      for (uint32_t p : m) logged_[p] = 0;
-    }
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     if (record_it) record.after = state(g == 0 ? nullptr : &touched);
@@ -328,6 +307,41 @@ class Simplifier {
   std::vector<uint8_t> deferred_;  // per vertex: a collapse of it was refused for leaving its block
   std::vector<uint8_t> logged_;    // per original point: in a block's moved_log this phase
   static constexpr int kAnyBlock = -1;
+
+  /// Grid g's blocks: each live vertex's (into `membership`, kNoBlock for the others) and
+  /// each block's vertices, ascending.
+  std::vector<std::vector<uint32_t>> members_of(size_t g, std::vector<uint16_t>& membership) const {
+    membership.assign(pos_.size(), kNoBlock);
+    std::vector<std::vector<uint32_t>> members(kGrids[g].count());
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (!faces_[u].empty()) {
+        const uint16_t b = g == 0 ? block_[u] : grid_.block(pos_[u], kGrids[g]);
+        membership[u] = b;
+        members[b].push_back(u);
+      }
+    return members;
+  }
+
+  /// The blocks `run` says, in parallel; the original points the later grids' collapses moved
+  /// are added to `touched`.
+  void run_blocks(size_t g, const std::vector<std::vector<uint32_t>>& members, const std::vector<uint8_t>& run,
+                  std::vector<uint32_t>& touched) {
+    std::vector<std::vector<uint32_t>> moved(members.size());
+    tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+      if (!run[b]) return;
+      std::vector<uint8_t> dirty(members[b].size(), 1);
+      if (g > 0)
+        for (size_t i = 0; i < dirty.size(); ++i) dirty[i] = std::exchange(deferred_[members[b][i]], 0);
+      Scratch s;
+      s.log_moves = g > 0;
+      passes(members[b], std::move(dirty), s, int(b));
+      moved[b] = std::move(s.moved_log);
+    });
+    for (const auto& m : moved) {
+      touched.insert(touched.end(), m.begin(), m.end());
+      for (uint32_t p : m) logged_[p] = 0;
+    }
+  }
 
   /// The state now; with `touched`, the vertices' and points' only for those.
   BlocksState state(const std::vector<uint32_t>* touched) const {
