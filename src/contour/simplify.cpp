@@ -159,7 +159,8 @@ class Simplifier {
       : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
         quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
         next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
-        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0), logged_(pos_.size(), 0) {
+        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0),
+        logged_(pos_.size(), 0) {
     for (uint32_t f = 0; f < tris_.size(); ++f) near_raw_[f] = surface.hint_of(f);
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
@@ -177,8 +178,6 @@ class Simplifier {
     // triangle's corner: at distance 0).
     for (uint32_t v = 0; v < pos_.size(); ++v)
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
-    block_.resize(pos_.size());
-    for (uint32_t u = 0; u < pos_.size(); ++u) block_[u] = grid_.block(pos_[u], kGrids[0]);
   }
 
   static constexpr uint16_t kNoBlock = UINT16_MAX;
@@ -302,7 +301,6 @@ class Simplifier {
   std::vector<uint32_t> merged_into_;  // per input vertex: the vertex it was merged into, or itself
   std::vector<uint8_t> frozen_;
   BlockGrid grid_;
-  std::vector<uint16_t> block_;                 // per vertex: its block of the grid
   std::vector<uint16_t> current_;               // per vertex: its block of the grid in use
   std::vector<uint8_t> deferred_;  // per vertex: a collapse of it was refused for leaving its block
   std::vector<uint8_t> logged_;    // per original point: in a block's moved_log this phase
@@ -315,7 +313,7 @@ class Simplifier {
     std::vector<std::vector<uint32_t>> members(kGrids[g].count());
     for (uint32_t u = 0; u < pos_.size(); ++u)
       if (!faces_[u].empty()) {
-        const uint16_t b = g == 0 ? block_[u] : grid_.block(pos_[u], kGrids[g]);
+        const uint16_t b = grid_.block(pos_[u], kGrids[g]);
         membership[u] = b;
         members[b].push_back(u);
       }

@@ -202,8 +202,6 @@ class TraversalStack {
   T* data_;
 };
 
-/// A query point as the vector tests take it: rounded outward to a box of floats, rounded to
-/// floats, and the slack of the leaves' planes there (see kPlaneRounding).
 /// The largest coordinate of x in size.
 double largest_coordinate(const Vec3& x) { return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])}); }
 
@@ -214,6 +212,8 @@ void leaf_boxes_distance2(const Leaf& l, const FloatBox& q, float* out) {
   box_distance2_x4(&l.lo[0][4], &l.hi[0][4], 8, q, out + 4);
 }
 
+/// A query point as the vector tests take it: rounded outward to a box of floats, rounded to
+/// floats, and the slack of the leaves' planes there (see kPlaneRounding).
 struct FloatPoint {
   FloatBox box;
   float x[3];
@@ -241,8 +241,9 @@ void leaf_distance2(const Boxes& l, const Planes* planes, const FloatPoint& q, f
 }
 
 /// Lower bounds on the squared distances from q to a node's four children: their axis boxes',
-/// or with `oriented` the larger of those and their oriented boxes' (measured in floats along the stored axes, each
-/// gap less q's slack; the stored axes are orthonormal to float rounding, which kShrink covers).
+/// or with `oriented` the larger of those and their oriented boxes' (measured in floats along
+/// the stored axes, each gap less q's slack; the stored axes are orthonormal to float
+/// rounding, which kShrink covers).
 template <class Node>
 void children_distance2(const Node& n, const FloatPoint& q, bool oriented, float* out) {
   if (q.far) {
@@ -307,7 +308,8 @@ MeshDistance::MeshDistance(const TriMesh& mesh, Pruning pruning) : pruning_(prun
   rounding_ = float(extent * kPlaneRounding);
   far_ = !(extent <= kFar);
   std::vector<std::array<uint32_t, 4>> oriented;  // Node4 children whose oriented boxes are due
-  root_ = collapse(binary, runs_of(binary), 0, 0, oriented);
+  const auto runs = pruning_ == Pruning::Full ? runs_of(binary) : std::vector<std::pair<uint32_t, uint32_t>>{};
+  root_ = collapse(binary, runs, 0, 0, oriented);
   fill_leaves(mesh, order, lo, hi);
   // The build's own arrays freed before the oriented boxes: a large mesh's peak memory.
   for (auto* v : {&lo, &hi, &centre}) std::vector<Vec3>().swap(*v);
@@ -410,7 +412,7 @@ uint32_t MeshDistance::collapse(const std::vector<BNode>& binary,
   for (int i = 0; i < count; ++i) {
     const FloatBox box(binary[kids[i]].lo, binary[kids[i]].hi);
     for (int k = 0; k < 3; ++k) out.lo[k][i] = box.lo[k], out.hi[k][i] = box.hi[k];
-    oriented.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
+    if (!range.empty()) oriented.push_back({self, uint32_t(i), range[kids[i]].first, range[kids[i]].second});
     out.child[i] = collapse(binary, range, kids[i], depth + 1, oriented);
   }
   nodes_[self] = out;
@@ -564,7 +566,8 @@ bool MeshDistance::within(const Vec3& p, double r, uint32_t* hint, double* found
       leaf_distance2(leaves_[l], planes_of(l), q, d);
       const uint32_t first = leaves_[l].first;
       for (uint32_t i = 0; i < leaves_[l].count; ++i)
-        if (double(d[i]) <= best2 && reaches(tris_[first + i], d[i]) && d2 <= best2) best2 = d2, best = &tris_[first + i];
+        if (double(d[i]) <= best2 && reaches(tris_[first + i], d[i]) && d2 <= best2)
+          best2 = d2, best = &tris_[first + i];
     }
     if (best) {
       d2 = best2;

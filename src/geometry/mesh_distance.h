@@ -130,7 +130,8 @@ class MeshDistance {
   static std::vector<std::pair<uint32_t, uint32_t>> runs_of(const std::vector<BNode>& binary);
   /// The reference (node or leaf) for binary node `b`, its Node4s and leaves appended with
   /// their axis boxes and runs; each Node4 child's oriented box is due later, listed in
-  /// `oriented` (node, slot, its run of the order).
+  /// `oriented` (node, slot, its run of the order from `range`; none listed when `range` is
+  /// empty: Pruning::Boxes).
   uint32_t collapse(const std::vector<BNode>& binary, const std::vector<std::pair<uint32_t, uint32_t>>& range,
                     uint32_t b, uint32_t depth, std::vector<std::array<uint32_t, 4>>& oriented);
   /// tris_ in the order, and every leaf's triangles' boxes (and planes and sides, for Full).
