@@ -6,7 +6,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "contour/merge_flat.h"
 #include "contour/simplify.h"
+#include "geometry/vec3.h"
 #include "pic/contour.h"
 #include "pic/csg.h"
 #include "pic/io.h"
@@ -83,6 +85,62 @@ TEST(Simplify, CreasesOffTheLatticeAxesCollapseToo) {
   EXPECT_LT(simple.triangles.size(), 5 * ball.triangles.size());
   std::printf("  [measure] box - faceted ball at depth 8: %zu -> %zu triangles\n", raw.triangles.size(),
               simple.triangles.size());
+}
+
+// Flat regions merged first: the surface stays where it was (within the drift allowed, both
+// ways, sampled over the triangles too), closed, 2-manifold and crossing-free, with the box's
+// corners and far fewer triangles.
+TEST(Simplify, FlatRegionsMergeWithoutMovingTheSurface) {
+  const Octree t = box_minus_ball(8);
+  const double cell = t.cube.size / double(1 << t.max_depth);
+  const TriMesh raw = contour(t);
+  TriMesh merged = raw;
+  std::vector<Vec3> away;
+  const double drift = 0.01 * cell;
+  const size_t removed = detail::merge_flat(merged, drift, &away);
+  EXPECT_EQ(removed, raw.triangles.size() - merged.triangles.size());
+  EXPECT_EQ(away.size(), raw.positions.size() - merged.positions.size());
+  EXPECT_LT(merged.triangles.size() * 4, raw.triangles.size() * 3);
+  ASSERT_TRUE(IsClosedManifold(merged));
+  EXPECT_EQ(count_self_intersections(merged), 0u);
+  EXPECT_LE(surface_distance(merged, raw, 20000).hausdorff, drift);
+  // The surface moved by at most the drift: the volume by at most the drift times its area.
+  double area = 0;
+  for (const auto& f : raw.triangles)
+    area += detail::norm3(detail::cross3(detail::sub3(raw.positions[f[1]], raw.positions[f[0]]),
+                                         detail::sub3(raw.positions[f[2]], raw.positions[f[0]]))) / 2;
+  EXPECT_NEAR(volume(merged), volume(raw), drift * area);
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? 0.6 : -0.6, c & 2 ? 0.6 : -0.6, c & 4 ? 0.6 : -0.6};
+    EXPECT_LE(test::nearest_vertex_distance(merged, p), 1e-6) << "corner " << c;
+  }
+  std::printf("  [measure] box - ball at depth 8, flat regions merged: %zu -> %zu triangles\n", raw.triangles.size(),
+              merged.triangles.size());
+}
+
+// A gently curved sheet: each star is flat within the drift, the whole is not. The merges'
+// movements add up along a chain, and the bound on them stops the chain before the sheet
+// goes flat.
+TEST(Simplify, FlatMergesDoNotFlattenAGentleCurve) {
+  constexpr int n = 64;
+  constexpr double radius = 10;
+  TriMesh sheet;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = -1 + 2.0 * i / n, y = -1 + 2.0 * j / n;
+      sheet.positions.push_back({x, y, -(x * x + y * y) / (2 * radius)});
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + n + 1, d = c + 1;
+      sheet.triangles.push_back({a, b, d});
+      sheet.triangles.push_back({a, d, c});
+    }
+  // A star's vertices lie about h^2 / (2 radius) = 5e-5 off its plane, the sheet 0.1 off.
+  const double drift = 2.5e-4;
+  TriMesh merged = sheet;
+  ASSERT_GT(detail::merge_flat(merged, drift), 0u);
+  EXPECT_LE(surface_distance(sheet, merged, 20000).hausdorff, drift);
 }
 
 // The blocks of the grid collapse in parallel: the mesh is the same with one thread.

@@ -16,9 +16,13 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "contour/simplify.h"
+#include "contour/blocks.h"
+#include "contour/merge_flat.h"
+#include "contour/triangle_shape.h"
 #include "geometry/lattice.h"
 #include "geometry/mesh_distance.h"
 #include "geometry/qef.h"
@@ -36,6 +40,13 @@ using detail::dot3;
 using detail::norm3;
 using detail::kKeptNormalCosine;
 using detail::kMinTriangleQuality;
+using detail::BlockGrid;
+using detail::kGrids;
+using detail::triangle_normal;
+using detail::triangle_quality;
+
+/// The share of the tolerance the flat regions' merge may move the surface.
+constexpr double kFlatMergeShare = 5e-2;
 
 /// A symmetric 4x4 quadric: the sum of squared distances to a set of planes.
 struct Quadric {
@@ -71,21 +82,10 @@ struct Quadric {
   }
 };
 
-Vec3 normal_of(const Vec3& a, const Vec3& b, const Vec3& c) {
-  return cross3({b[0] - a[0], b[1] - a[1], b[2] - a[2]}, {c[0] - a[0], c[1] - a[1], c[2] - a[2]});
-}
-
 double dist2(const Vec3& a, const Vec3& b) {
   const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
   return x * x + y * y + z * z;
 }
-
-/// 1 for an equilateral triangle, 0 for a flat one: 4 sqrt(3) area / (sum of squared sides).
-double quality(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const double s = dist2(a, b) + dist2(b, c) + dist2(c, a);
-  return s > 0 ? 2 * std::sqrt(3.0) * norm3(normal_of(a, b, c)) / s : 0;
-}
-
 
 /// A candidate for merging a vertex: the neighbour v, where both go, and the planes' error there.
 struct Candidate {
@@ -115,41 +115,6 @@ struct Scratch {
   std::vector<uint32_t> moved_log;  // every original point the collapses moved, if log_moves
 };
 
-/// Blocks of fixed grids over the mesh's box, each vertex in the one holding it: collapses whose
-/// two stars lie in one block touch nothing another block's collapses do. The first grid has
-/// kBlocksPerAxis blocks a side; the second is shifted by half a block, so that its blocks hold
-/// the bands along the first one's faces; the third and fourth have blocks twice and four
-/// times as wide, shifted by an eighth and three sixteenths of theirs, so that no two grids
-/// share a face and the long triangles of a coarse mesh fit in their blocks.
-constexpr int kBlocksPerAxis = 8;
-struct GridLayout {
-  int per_axis;
-  double offset;  // in blocks
-  int side() const { return per_axis + (offset > 0); }
-  size_t count() const { return size_t(side()) * side() * side(); }
-};
-constexpr GridLayout kGrids[] = {
-    {kBlocksPerAxis, 0}, {kBlocksPerAxis, 0.5}, {kBlocksPerAxis / 2, 0.125}, {kBlocksPerAxis / 4, 0.1875}};
-
-struct BlockGrid {
-  Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
-  explicit BlockGrid(const std::vector<Vec3>& pos) {
-    for (const Vec3& p : pos)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], p[k]);
-        hi[k] = std::max(hi[k], p[k]);
-      }
-  }
-  uint16_t block(const Vec3& p, const GridLayout& g) const {
-    int b = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double t = hi[k] > lo[k] ? (p[k] - lo[k]) / (hi[k] - lo[k]) : 0;
-      b = b * g.side() + std::clamp(int(t * g.per_axis + g.offset), 0, g.side() - 1);
-    }
-    return uint16_t(b);
-  }
-};
-
 class Simplifier {
  public:
   /// `frozen`: per vertex of `mesh`, whether it must stay where it is (empty: none).
@@ -166,7 +131,7 @@ class Simplifier {
     frozen_.resize(pos_.size(), 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       const auto& t = tris_[f];
-      const Vec3 n = normal_of(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
+      const Vec3 n = triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
       const double len = norm3(n);
       for (int k = 0; k < 3; ++k) faces_[t[k]].push_back(f);
       if (!(len > 0)) continue;
@@ -677,7 +642,7 @@ class Simplifier {
     double worst_before = 1;
     for (uint32_t f : faces_[a]) {
       const auto& t = tris_[f];
-      worst_before = std::min(worst_before, quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
     const double min_quality = std::min(kMinTriangleQuality, worst_before);
     for (uint32_t f : faces_[a]) {
@@ -685,12 +650,12 @@ class Simplifier {
       if (t[0] == b || t[1] == b || t[2] == b) continue;
       std::array<Vec3, 3> p;
       for (int k = 0; k < 3; ++k) p[k] = t[k] == a ? x : pos_[t[k]];
-      const Vec3 before = normal_of(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
-      const Vec3 after = normal_of(p[0], p[1], p[2]);
+      const Vec3 before = triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
+      const Vec3 after = triangle_normal(p[0], p[1], p[2]);
       const double lb = norm3(before), la = norm3(after);
       // Turned by less than about 25 degrees: the new fan covers the old star, folding nothing.
       if (!(la > 0) || !(lb > 0) || dot3(before, after) < kKeptNormalCosine * lb * la) return false;
-      if (quality(p[0], p[1], p[2]) < min_quality) return false;
+      if (triangle_quality(p[0], p[1], p[2]) < min_quality) return false;
     }
     return true;
   }
@@ -725,16 +690,35 @@ class Simplifier {
   }
 };
 
-}  // namespace
+/// The triangles of `mesh` (its `surface`) nearest the points farther than `tolerance` from
+/// `out`, once each.
+std::vector<uint32_t> left_behind(const TriMesh& out, const std::vector<Vec3>& points, double tolerance,
+                                  const detail::MeshDistance& surface) {
+  if (points.empty()) return {};
+  const detail::MeshDistance result(out, detail::Pruning::Boxes);
+  std::vector<uint8_t> far(points.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    uint32_t hint = 0;
+    for (size_t i = r.begin(); i < r.end(); ++i) far[i] = !result.within(points[i], tolerance, &hint);
+  });
+  std::vector<uint32_t> nearest;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (far[i]) nearest.push_back(surface.nearest(points[i]).triangle);
+  std::sort(nearest.begin(), nearest.end());
+  nearest.erase(std::unique(nearest.begin(), nearest.end()), nearest.end());
+  return nearest;
+}
 
-size_t simplify(TriMesh& mesh, double tolerance) { return detail::simplify_in_rounds(mesh, tolerance, true); }
-
-size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_over) {
-  if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
+/// The collapses that check original points, in rounds; false (and `mesh` as it was) when
+/// none could be taken. `also`: more points of the original surface, each within
+/// `also_tolerance` of `mesh`'s triangles, that the result must keep within `tolerance` plus
+/// that; where one is left farther, the round after keeps the triangle it lies on as it is.
+bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const std::vector<Vec3>& also,
+                        double also_tolerance) {
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
-  // simplified again (a few rounds; the raw contour when crossings remain).
+  // simplified again (a few rounds; none taken when crossings remain).
   constexpr int kRounds = 6;
   std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
   const detail::MeshDistance surface(mesh, detail::Pruning::Boxes);
@@ -761,12 +745,12 @@ size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_ove
     s.finish();
     std::vector<uint32_t> kept;
     TriMesh out = s.result(kept);
-    if (out.triangles.size() == mesh.triangles.size()) return 0;
+    if (out.triangles.size() == mesh.triangles.size()) return false;
     const auto crossings = self_intersecting_pairs(out);
-    if (crossings.empty()) {
-      const size_t removed = mesh.triangles.size() - out.triangles.size();
+    const std::vector<uint32_t> left = left_behind(out, also, tolerance + also_tolerance, surface);
+    if (crossings.empty() && left.empty()) {
       mesh = std::move(out);
-      return removed;
+      return true;
     }
     // The vertices of the crossing triangles, and from the second round on their neighbours
     // too: keeping only the crossing triangles raw can make the next collapses beside them
@@ -786,8 +770,31 @@ size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_ove
       if (at_crossing[v]) input_at[kept[v]] = 1;
     for (uint32_t u = 0; u < mesh.positions.size(); ++u)
       if (input_at[s.survivor(u)]) frozen[u] = 1;
+    for (uint32_t f : left)
+      for (uint32_t u : mesh.triangles[f]) frozen[u] = 1;
   }
-  return 0;
+  return false;
+}
+
+}  // namespace
+
+size_t simplify(TriMesh& mesh, double tolerance) { return detail::simplify_in_rounds(mesh, tolerance, true); }
+
+size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_over) {
+  if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
+  // Flat regions first, moving the surface by a small share of the tolerance: the collapses
+  // that check original points then start from far fewer of them.
+  const size_t before = mesh.triangles.size();
+  TriMesh merged = mesh;
+  const double drift = tolerance * kFlatMergeShare;
+  std::vector<Vec3> merged_away;
+  const size_t flat = merge_flat(merged, drift, &merged_away);
+  // Without the collapses, the merged mesh unless it crosses itself: then the input.
+  if (!collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift) &&
+      (flat == 0 || !self_intersecting_pairs(merged).empty()))
+    return 0;
+  mesh = std::move(merged);
+  return before - mesh.triangles.size();
 }
 
 }  // namespace pic

@@ -1,0 +1,255 @@
+// Flat regions merged without moving the surface. A vertex whose star lies in one plane goes
+// onto a neighbour: when every triangle of the fan from that neighbour keeps the plane's
+// orientation, the fan covers the same polygon the star did, so the surface as a point set
+// does not change (up to the star's distance from its plane). On a dual contour most vertices
+// are such (a flat face has a vertex per cell); merging them this way costs a star's
+// orientations, where the simplification proper checks every original point of two stars
+// against the new one.
+#include "contour/merge_flat.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "contour/blocks.h"
+#include "contour/triangle_shape.h"
+#include "geometry/tolerances.h"
+#include "geometry/vec3.h"
+
+namespace pic::detail {
+
+namespace {
+
+class FlatMerger {
+ public:
+  FlatMerger(TriMesh& mesh, double drift)
+      : pos_(mesh.positions), tris_(mesh.triangles), faces_(pos_.size()), alive_(tris_.size(), 1),
+        moved_(pos_.size(), 0.0), drift_(drift), deferred_(pos_.size(), 1) {
+    for (uint32_t f = 0; f < tris_.size(); ++f)
+      for (uint32_t w : tris_[f]) faces_[w].push_back(f);
+    had_triangles_.resize(pos_.size());
+    for (uint32_t u = 0; u < pos_.size(); ++u) had_triangles_[u] = !faces_[u].empty();
+  }
+
+  /// The blocks of the first two grids, each grid's in parallel, then what they left over the
+  /// whole mesh. The blocks do not depend on the thread count, so neither does the result.
+  void run() {
+    const BlockGrid grid(pos_);
+    for (size_t g = 0; g < 2; ++g) {
+      membership_.assign(pos_.size(), kNoBlock);
+      std::vector<std::vector<uint32_t>> members(kGrids[g].count());
+      for (uint32_t u = 0; u < pos_.size(); ++u)
+        if (!faces_[u].empty()) {
+          membership_[u] = grid.block(pos_[u], kGrids[g]);
+          members[membership_[u]].push_back(u);
+        }
+      tbb::parallel_for(size_t{0}, members.size(), [&](size_t b) {
+        std::vector<uint8_t> dirty(members[b].size());
+        for (size_t i = 0; i < dirty.size(); ++i) dirty[i] = std::exchange(deferred_[members[b][i]], 0);
+        passes(members[b], std::move(dirty), int(b));
+      });
+    }
+    std::vector<uint32_t> all(pos_.size());
+    std::iota(all.begin(), all.end(), 0u);
+    std::vector<uint8_t> dirty(deferred_.begin(), deferred_.end());
+    passes(all, std::move(dirty), kAnyBlock);
+  }
+
+  size_t removed() const { return size_t(std::count(alive_.begin(), alive_.end(), 0)); }
+
+  /// The vertices merged onto a neighbour (every vertex had a triangle before).
+  void merged_away(std::vector<Vec3>& out) const {
+    out.clear();
+    for (uint32_t u = 0; u < pos_.size(); ++u)
+      if (faces_[u].empty() && had_triangles_[u]) out.push_back(pos_[u]);
+  }
+
+  TriMesh result() const {
+    TriMesh out;
+    std::vector<uint32_t> remap(pos_.size(), UINT32_MAX);
+    for (uint32_t f = 0; f < tris_.size(); ++f) {
+      if (!alive_[f]) continue;
+      std::array<uint32_t, 3> t;
+      for (int k = 0; k < 3; ++k) {
+        uint32_t& r = remap[tris_[f][k]];
+        if (r == UINT32_MAX) {
+          r = uint32_t(out.positions.size());
+          out.positions.push_back(pos_[tris_[f][k]]);
+        }
+        t[k] = r;
+      }
+      out.triangles.push_back(t);
+    }
+    return out;
+  }
+
+ private:
+  static constexpr uint32_t kNone = UINT32_MAX;
+  const std::vector<Vec3>& pos_;
+  std::vector<std::array<uint32_t, 3>>& tris_;
+  std::vector<std::vector<uint32_t>> faces_;  // per vertex: its live triangles
+  std::vector<uint8_t> alive_, had_triangles_;
+  // Per vertex: how far the surface around it may have moved (every live triangle lies within
+  // the largest of its corners' bounds of the input, and the input there within it of them).
+  std::vector<double> moved_;
+  double drift_;
+  std::vector<uint8_t> deferred_;      // per vertex: to be tried again in the next grid
+  std::vector<uint16_t> membership_;  // per live vertex: its block of the grid in use
+  static constexpr uint16_t kNoBlock = UINT16_MAX;
+  static constexpr int kAnyBlock = -1;
+
+  /// Passes over `members` (ascending; `dirty` per member: to be tried) until a pass merges
+  /// fewer than a thousandth of them; after the first, only vertices whose star changed are
+  /// tried again. With a `block`, only vertices whose neighbours all lie in it; the others, and
+  /// those whose star changed after their last try, are marked deferred_.
+  void passes(const std::vector<uint32_t>& members, std::vector<uint8_t> dirty, int block) {
+    std::vector<uint8_t> next(members.size(), 0);
+    const auto local = [&](uint32_t w) {
+      return block == kAnyBlock ? size_t(w) : size_t(std::lower_bound(members.begin(), members.end(), w) - members.begin());
+    };
+    std::vector<uint32_t> ring;
+    bool stopped = false;
+    for (int pass = 0; pass < 32; ++pass) {
+      size_t done = 0;
+      for (size_t i = 0; i < members.size(); ++i) {
+        const uint32_t u = members[i];
+        if (!dirty[i] || faces_[u].empty()) continue;
+        bool left_block = false;
+        const uint32_t v = best_target(u, block, ring, left_block);
+        deferred_[u] = left_block;
+        if (v == kNone) continue;
+        for (uint32_t w : ring) next[local(w)] = 1;
+        collapse(u, v);
+        ++done;
+      }
+      if (done * 1000 < members.size()) {
+        stopped = true;
+        break;
+      }
+      dirty.swap(next);
+      std::fill(next.begin(), next.end(), 0);
+    }
+    const std::vector<uint8_t>& untried = stopped ? next : dirty;
+    for (size_t i = 0; i < members.size(); ++i)
+      if (untried[i] && !faces_[members[i]].empty()) deferred_[members[i]] = 1;
+  }
+
+  /// The neighbour u may go onto without moving the surface, the one leaving the best-shaped
+  /// triangles; kNone when u's star is not flat or no neighbour will do.
+  uint32_t best_target(uint32_t u, int block, std::vector<uint32_t>& ring, bool& left_block) {
+    ring.clear();
+    Vec3 n{0, 0, 0};
+    double worst_before = 1;
+    for (uint32_t f : faces_[u]) {
+      const auto& t = tris_[f];
+      for (uint32_t w : t)
+        if (w != u) ring.push_back(w);
+      n = add3(n, triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+    }
+    if (block != kAnyBlock)
+      for (uint32_t w : ring)
+        if (membership_[w] != block) return left_block = true, kNone;
+    // A closed disk: each neighbour on exactly two triangles of the star.
+    std::sort(ring.begin(), ring.end());
+    if (ring.size() < 8) return kNone;
+    for (size_t i = 0; i < ring.size(); i += 2)
+      if (ring[i] != ring[i + 1] || (i + 2 < ring.size() && ring[i + 2] == ring[i])) return kNone;
+    const double len = norm3(n);
+    if (!(len > 0)) return kNone;
+    n = scale3(n, 1 / len);
+    // Flat: every vertex of the star this near the plane through u, every triangle facing
+    // the plane's way (no pleat).
+    double off = 0, bound = moved_[u];
+    for (uint32_t w : ring) {
+      off = std::max(off, std::abs(dot3(n, sub3(pos_[w], pos_[u]))));
+      bound = std::max(bound, moved_[w]);
+    }
+    // The fan and the star both lie within `off` of the plane over the same polygon.
+    bound += 2 * off;
+    if (!(bound <= drift_)) return kNone;
+    for (uint32_t f : faces_[u]) {
+      const auto& t = tris_[f];
+      const Vec3 m = triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
+      if (!(dot3(m, n) >= kKeptNormalCosine * norm3(m))) return kNone;
+    }
+    const double min_quality = std::min(kMinTriangleQuality, worst_before);
+    uint32_t best = kNone;
+    double best_quality = -1;
+    for (size_t i = 0; i < ring.size(); i += 2) {
+      const uint32_t v = ring[i];
+      const double q = fan_quality(u, v, n);
+      if (q >= min_quality && q > best_quality && links_once(u, v, ring)) best = v, best_quality = q;
+    }
+    if (best != kNone) {
+      for (size_t i = 0; i < ring.size(); i += 2) moved_[ring[i]] = std::max(moved_[ring[i]], bound);
+      moved_[best] = std::max(moved_[best], bound);
+    }
+    return best;
+  }
+
+  /// The worst shape among u's triangles without v once u stands at v; -1 when one turns
+  /// away from the plane (the fan would fold).
+  double fan_quality(uint32_t u, uint32_t v, const Vec3& n) const {
+    double worst = 1;
+    for (uint32_t f : faces_[u]) {
+      const auto& t = tris_[f];
+      if (t[0] == v || t[1] == v || t[2] == v) continue;
+      std::array<Vec3, 3> p;
+      for (int k = 0; k < 3; ++k) p[k] = t[k] == u ? pos_[v] : pos_[t[k]];
+      const Vec3 m = triangle_normal(p[0], p[1], p[2]);
+      if (!(dot3(m, n) >= kKeptNormalCosine * norm3(m))) return -1;
+      worst = std::min(worst, triangle_quality(p[0], p[1], p[2]));
+    }
+    return worst;
+  }
+
+  /// The link condition: u and v share exactly the two neighbours across their edge, and
+  /// the mesh is not a tetrahedron about to fold flat.
+  bool links_once(uint32_t u, uint32_t v, const std::vector<uint32_t>& ring) const {
+    size_t common = 0, v_ring = 0;
+    for (uint32_t f : faces_[v])
+      for (uint32_t w : tris_[f])
+        if (w != v) {
+          ++v_ring;
+          if (w != u && std::binary_search(ring.begin(), ring.end(), w)) ++common;
+        }
+    // Each common neighbour is met twice around v (on two of its triangles), as around u.
+    return common == 4 && !(ring.size() <= 6 && v_ring <= 6);
+  }
+
+  void collapse(uint32_t u, uint32_t v) {
+    for (uint32_t f : faces_[u]) {
+      auto& t = tris_[f];
+      if (t[0] == v || t[1] == v || t[2] == v) {
+        alive_[f] = 0;
+        for (uint32_t w : t)
+          if (w != u) std::erase(faces_[w], f);
+        continue;
+      }
+      for (uint32_t& w : t)
+        if (w == u) w = v;
+      faces_[v].push_back(f);
+    }
+    faces_[u].clear();
+  }
+};
+
+}  // namespace
+
+size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away) {
+  if (!(drift > 0) || mesh.triangles.empty()) return 0;
+  FlatMerger m(mesh, drift);
+  m.run();
+  const size_t removed = m.removed();
+  if (merged_away) m.merged_away(*merged_away);
+  if (removed) mesh = m.result();
+  return removed;
+}
+
+}  // namespace pic::detail
