@@ -27,8 +27,8 @@ namespace {
 
 class FlatMerger {
  public:
-  FlatMerger(TriMesh& mesh, double drift)
-      : pos_(mesh.positions), tris_(mesh.triangles), faces_(pos_.size()), alive_(tris_.size(), 1),
+  FlatMerger(TriMesh& mesh, double drift, const std::vector<uint8_t>* keep)
+      : keep_(keep), pos_(mesh.positions), tris_(mesh.triangles), faces_(pos_.size()), alive_(tris_.size(), 1),
         moved_(pos_.size(), 0.0), drift_(drift), deferred_(pos_.size(), 1) {
     for (uint32_t f = 0; f < tris_.size(); ++f)
       for (uint32_t w : tris_[f]) faces_[w].push_back(f);
@@ -90,6 +90,7 @@ class FlatMerger {
 
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
+  const std::vector<uint8_t>* keep_;  // per vertex: its star stays as it is (none: all may merge)
   const std::vector<Vec3>& pos_;
   std::vector<std::array<uint32_t, 3>>& tris_;
   std::vector<std::vector<uint32_t>> faces_;  // per vertex: its live triangles
@@ -155,6 +156,11 @@ class FlatMerger {
     if (block != kAnyBlock)
       for (uint32_t w : ring)
         if (membership_[w] != block) return left_block = true, kNone;
+    if (keep_ && !keep_->empty()) {
+      if ((*keep_)[u]) return kNone;
+      for (uint32_t w : ring)
+        if ((*keep_)[w]) return kNone;
+    }
     // A closed disk: each neighbour on exactly two triangles of the star.
     std::sort(ring.begin(), ring.end());
     if (ring.size() < 8) return kNone;
@@ -242,9 +248,9 @@ class FlatMerger {
 
 }  // namespace
 
-size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away) {
+size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away, const std::vector<uint8_t>* keep) {
   if (!(drift > 0) || mesh.triangles.empty()) return 0;
-  FlatMerger m(mesh, drift);
+  FlatMerger m(mesh, drift, keep);
   m.run();
   const size_t removed = m.removed();
   if (merged_away) m.merged_away(*merged_away);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pic/types.h"
@@ -13,6 +14,8 @@ namespace pic::detail {
 /// kMinTriangleQuality (or the star's worst). Every point of the result lies within `drift`
 /// of the input and every point of the input within `drift` of the result. Returns the
 /// number of triangles removed; `merged_away` (optional): the input vertices that are gone.
-size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away = nullptr);
+/// `keep` (optional, per vertex): no triangle at these vertices changes.
+size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away = nullptr,
+                  const std::vector<uint8_t>* keep = nullptr);
 
 }  // namespace pic::detail

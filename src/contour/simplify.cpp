@@ -46,7 +46,7 @@ using detail::triangle_normal;
 using detail::triangle_quality;
 
 /// The share of the tolerance the flat regions' merge may move the surface.
-constexpr double kFlatMergeShare = 5e-2;
+constexpr double kFlatMergeShare = 1e-3;
 
 /// A symmetric 4x4 quadric: the sum of squared distances to a set of planes.
 struct Quadric {
@@ -709,12 +709,46 @@ std::vector<uint32_t> left_behind(const TriMesh& out, const std::vector<Vec3>& p
   return nearest;
 }
 
+/// The boxes of the crossing pairs whose two triangles are `mesh`'s own, unchanged
+/// (`kept`: the vertex of `mesh` that each vertex of `out` is): no round can undo those.
+std::vector<std::array<Vec3, 2>> crossings_of_the_input(const TriMesh& out, const std::vector<uint32_t>& kept,
+                                                        const TriMesh& mesh,
+                                                        const std::vector<std::pair<uint32_t, uint32_t>>& crossings) {
+  std::vector<std::array<uint32_t, 3>> input(mesh.triangles);
+  for (auto& t : input) std::sort(t.begin(), t.end());
+  std::sort(input.begin(), input.end());
+  const auto unchanged = [&](uint32_t f) {
+    std::array<uint32_t, 3> t;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = out.triangles[f][k];
+      if (out.positions[v] != mesh.positions[kept[v]]) return false;
+      t[k] = kept[v];
+    }
+    std::sort(t.begin(), t.end());
+    return std::binary_search(input.begin(), input.end(), t);
+  };
+  std::vector<std::array<Vec3, 2>> boxes;
+  for (const auto& [a, b] : crossings) {
+    if (!unchanged(a) || !unchanged(b)) continue;
+    std::array<Vec3, 2> box{out.positions[out.triangles[a][0]], out.positions[out.triangles[a][0]]};
+    for (uint32_t f : {a, b})
+      for (uint32_t v : out.triangles[f])
+        for (int k = 0; k < 3; ++k) {
+          box[0][k] = std::min(box[0][k], out.positions[v][k]);
+          box[1][k] = std::max(box[1][k], out.positions[v][k]);
+        }
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
 /// The collapses that check original points, in rounds; false (and `mesh` as it was) when
 /// none could be taken. `also`: more points of the original surface, each within
 /// `also_tolerance` of `mesh`'s triangles, that the result must keep within `tolerance` plus
 /// that; where one is left farther, the round after keeps the triangle it lies on as it is.
+/// `input_crossings`: where `mesh` itself crosses, when that is why none could be taken.
 bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const std::vector<Vec3>& also,
-                        double also_tolerance) {
+                        double also_tolerance, std::vector<std::array<Vec3, 2>>& input_crossings) {
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
@@ -752,6 +786,10 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
       mesh = std::move(out);
       return true;
     }
+    if (!crossings.empty()) {
+      input_crossings = crossings_of_the_input(out, kept, mesh, crossings);
+      if (!input_crossings.empty()) return false;
+    }
     // The vertices of the crossing triangles, and from the second round on their neighbours
     // too: keeping only the crossing triangles raw can make the next collapses beside them
     // cross again, and a wider raw patch settles in fewer rounds.
@@ -783,18 +821,33 @@ size_t simplify(TriMesh& mesh, double tolerance) { return detail::simplify_in_ro
 size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_over) {
   if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
   // Flat regions first, moving the surface by a small share of the tolerance: the collapses
-  // that check original points then start from far fewer of them.
-  const size_t before = mesh.triangles.size();
-  TriMesh merged = mesh;
+  // that check original points then start from far fewer of them. Two sheets closer than that
+  // share may cross once merged; then the merge is redone with the input kept as it is around
+  // the crossing (a few times; then the input is written).
+  constexpr int kMergeAttempts = 3;
   const double drift = tolerance * kFlatMergeShare;
-  std::vector<Vec3> merged_away;
-  const size_t flat = merge_flat(merged, drift, &merged_away);
-  // Without the collapses, the merged mesh unless it crosses itself: then the input.
-  if (!collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift) &&
-      (flat == 0 || !self_intersecting_pairs(merged).empty()))
-    return 0;
-  mesh = std::move(merged);
-  return before - mesh.triangles.size();
+  std::vector<uint8_t> keep(mesh.positions.size(), 0);
+  for (int attempt = 0; attempt < kMergeAttempts; ++attempt) {
+    TriMesh merged = mesh;
+    std::vector<Vec3> merged_away;
+    merge_flat(merged, drift, &merged_away, &keep);
+    std::vector<std::array<Vec3, 2>> merged_crossings;
+    if (collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift, merged_crossings)) {
+      const size_t removed = mesh.triangles.size() - merged.triangles.size();
+      mesh = std::move(merged);
+      return removed;
+    }
+    if (merged_crossings.empty()) return 0;
+    // Every input vertex in reach of the crossing triangles' boxes: the input triangles they
+    // cover have their corners there.
+    for (uint32_t u = 0; u < mesh.positions.size(); ++u)
+      for (const auto& [lo, hi] : merged_crossings) {
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) inside &= mesh.positions[u][k] >= lo[k] - drift && mesh.positions[u][k] <= hi[k] + drift;
+        if (inside) keep[u] = 1;
+      }
+  }
+  return 0;
 }
 
 }  // namespace pic
