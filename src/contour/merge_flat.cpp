@@ -30,6 +30,10 @@ class FlatMerger {
   FlatMerger(TriMesh& mesh, double drift, const std::vector<uint8_t>* keep)
       : keep_(keep), pos_(mesh.positions), tris_(mesh.triangles), faces_(pos_.size()), alive_(tris_.size(), 1),
         moved_(pos_.size(), 0.0), drift_(drift), deferred_(pos_.size(), 1) {
+    std::vector<uint32_t> degree(pos_.size(), 0);
+    for (const auto& t : tris_)
+      for (uint32_t w : t) ++degree[w];
+    for (uint32_t w = 0; w < pos_.size(); ++w) faces_[w].reserve(degree[w]);
     for (uint32_t f = 0; f < tris_.size(); ++f)
       for (uint32_t w : tris_[f]) faces_[w].push_back(f);
     had_triangles_.resize(pos_.size());
@@ -189,8 +193,9 @@ class FlatMerger {
     double best_quality = -1;
     for (size_t i = 0; i < ring.size(); i += 2) {
       const uint32_t v = ring[i];
-      const double q = fan_quality(u, v, n);
-      if (q >= min_quality && q > best_quality && links_once(u, v, ring)) best = v, best_quality = q;
+      double q = 0;
+      if (fan_keeps(u, v, n, std::max(min_quality, best_quality), q) && q > best_quality && links_once(u, v, ring))
+        best = v, best_quality = q;
     }
     if (best != kNone) {
       for (size_t i = 0; i < ring.size(); i += 2) moved_[ring[i]] = std::max(moved_[ring[i]], bound);
@@ -199,20 +204,22 @@ class FlatMerger {
     return best;
   }
 
-  /// The worst shape among u's triangles without v once u stands at v; -1 when one turns
-  /// away from the plane (the fan would fold).
-  double fan_quality(uint32_t u, uint32_t v, const Vec3& n) const {
-    double worst = 1;
+  /// Whether u's triangles without v, once u stands at v, all face the plane's way (n) and
+  /// are shaped at least `floor`; `worst` is set to the worst shape among them.
+  bool fan_keeps(uint32_t u, uint32_t v, const Vec3& n, double floor, double& worst) const {
+    worst = 1;
     for (uint32_t f : faces_[u]) {
       const auto& t = tris_[f];
       if (t[0] == v || t[1] == v || t[2] == v) continue;
       std::array<Vec3, 3> p;
       for (int k = 0; k < 3; ++k) p[k] = t[k] == u ? pos_[v] : pos_[t[k]];
       const Vec3 m = triangle_normal(p[0], p[1], p[2]);
-      if (!(dot3(m, n) >= kKeptNormalCosine * norm3(m))) return -1;
+      const double along = dot3(m, n);
+      if (!(along > 0 && along * along >= kKeptNormalCosine * kKeptNormalCosine * dot3(m, m))) return false;
       worst = std::min(worst, triangle_quality(p[0], p[1], p[2]));
+      if (worst < floor) return false;
     }
-    return worst;
+    return true;
   }
 
   /// The link condition: u and v share exactly the two neighbours across their edge, and
