@@ -49,10 +49,13 @@ TEST(Simplify, BoxMinusBallKeepsItsSurfaceWithFewerTriangles) {
   const SurfaceDistance d = surface_distance(simple, raw, 20000);
   EXPECT_LE(d.hausdorff, 0.25 * cell);
   EXPECT_NEAR(volume(simple), volume(raw), 1e-3 * volume(raw));
-  // The box's corners (outside the ball) stay sharp: each is a vertex.
+  // The box's corners (outside the ball) stay sharp: each is a vertex, within a hundredth of
+  // a cell (merged at the planes' point of a corner and a neighbour whose raw triangles lie a
+  // hair off the faces, one moves by a few thousandths; cut off within the tolerance, its
+  // nearest vertex could be a tenth of a cell away).
   for (int c = 0; c < 8; ++c) {
     const Vec3 p{c & 1 ? 0.6 : -0.6, c & 2 ? 0.6 : -0.6, c & 4 ? 0.6 : -0.6};
-    EXPECT_LE(test::nearest_vertex_distance(simple, p), 1e-6) << "corner " << c;
+    EXPECT_LE(test::nearest_vertex_distance(simple, p), 0.01 * cell) << "corner " << c;
   }
   std::printf("  [measure] box - ball at depth 8: %zu -> %zu triangles, Hausdorff %.3f cells\n",
               raw.triangles.size(), simple.triangles.size(), d.hausdorff / cell);

@@ -65,9 +65,11 @@ inline constexpr double kRingHeightMargin = 1e-9;
 /// degrees of where it was (the cosine): a fan that folds over its neighbours never passes.
 inline constexpr double kKeptNormalCosine = 0.9;
 /// Simplification makes no triangle worse than this (4 sqrt(3) area over the sum of squared
-/// sides: 1 equilateral, 0 flat) unless the ones it replaces were: long needles across a flat
-/// region cross their neighbours once positions are rounded to floats, and they shade badly.
-inline constexpr double kMinTriangleQuality = 0.15;
+/// sides: 1 equilateral, 0 flat) unless the ones it replaces were: about as thin as an exact
+/// kernel's facets of a twisted extrusion (Manifold's of OpenSCAD's linear_extrude example:
+/// 0.033 and more, median 0.064). Thinner needles shade badly and, rounded to floats, cross
+/// their neighbours more easily (the float writers check for that).
+inline constexpr double kMinTriangleQuality = 0.03;
 
 // ---- sample/ -------------------------------------------------------------------------------
 
