@@ -41,7 +41,9 @@ class FlatMerger {
   }
 
   /// The blocks of the first two grids, each grid's in parallel, then what they left over the
-  /// whole mesh. The blocks do not depend on the thread count, so neither does the result.
+  /// whole mesh (the merges are short-ranged: on example004 the second grid tries 5 % of the
+  /// vertices, the last pass 1 %). The blocks do not depend on the thread count, so neither
+  /// does the result.
   void run() {
     const BlockGrid grid(pos_);
     for (size_t g = 0; g < 2; ++g) {
@@ -66,7 +68,7 @@ class FlatMerger {
 
   size_t removed() const { return size_t(std::count(alive_.begin(), alive_.end(), 0)); }
 
-  /// The vertices merged onto a neighbour (every vertex had a triangle before).
+  /// The vertices merged onto a neighbour (not those that never had a triangle).
   void merged_away(std::vector<Vec3>& out) const {
     out.clear();
     for (uint32_t u = 0; u < pos_.size(); ++u)
@@ -117,7 +119,7 @@ class FlatMerger {
     const auto local = [&](uint32_t w) {
       return block == kAnyBlock ? size_t(w) : size_t(std::lower_bound(members.begin(), members.end(), w) - members.begin());
     };
-    std::vector<uint32_t> ring;
+    std::vector<uint32_t> ring, v_ring;
     bool stopped = false;
     for (int pass = 0; pass < 32; ++pass) {
       size_t done = 0;
@@ -125,11 +127,12 @@ class FlatMerger {
         const uint32_t u = members[i];
         if (!dirty[i] || faces_[u].empty()) continue;
         bool left_block = false;
-        const uint32_t v = best_target(u, block, ring, left_block);
+        double moved = 0;
+        const uint32_t v = best_target(u, block, ring, v_ring, left_block, moved);
         deferred_[u] = left_block;
         if (v == kNone) continue;
         for (uint32_t w : ring) next[local(w)] = 1;
-        collapse(u, v);
+        collapse(u, v, moved);
         ++done;
       }
       if (done * 1000 < members.size()) {
@@ -146,7 +149,8 @@ class FlatMerger {
 
   /// The neighbour u may go onto without moving the surface, the one leaving the best-shaped
   /// triangles; kNone when u's star is not flat or no neighbour will do.
-  uint32_t best_target(uint32_t u, int block, std::vector<uint32_t>& ring, bool& left_block) {
+  uint32_t best_target(uint32_t u, int block, std::vector<uint32_t>& ring, std::vector<uint32_t>& v_ring, bool& left_block,
+                       double& moved) {
     ring.clear();
     Vec3 n{0, 0, 0};
     double worst_before = 1;
@@ -165,11 +169,10 @@ class FlatMerger {
       for (uint32_t w : ring)
         if ((*keep_)[w]) return kNone;
     }
-    // A closed disk: each neighbour on exactly two triangles of the star.
+    // A closed disk: the link is one cycle through every neighbour once (each on exactly two
+    // triangles of the star).
+    if (!one_cycle(u)) return kNone;
     std::sort(ring.begin(), ring.end());
-    if (ring.size() < 8) return kNone;
-    for (size_t i = 0; i < ring.size(); i += 2)
-      if (ring[i] != ring[i + 1] || (i + 2 < ring.size() && ring[i + 2] == ring[i])) return kNone;
     const double len = norm3(n);
     if (!(len > 0)) return kNone;
     n = scale3(n, 1 / len);
@@ -194,14 +197,33 @@ class FlatMerger {
     for (size_t i = 0; i < ring.size(); i += 2) {
       const uint32_t v = ring[i];
       double q = 0;
-      if (fan_keeps(u, v, n, std::max(min_quality, best_quality), q) && q > best_quality && links_once(u, v, ring))
+      if (fan_keeps(u, v, n, std::max(min_quality, best_quality), q) && q > best_quality &&
+          link_condition(u, v, ring, v_ring))
         best = v, best_quality = q;
     }
-    if (best != kNone) {
-      for (size_t i = 0; i < ring.size(); i += 2) moved_[ring[i]] = std::max(moved_[ring[i]], bound);
-      moved_[best] = std::max(moved_[best], bound);
-    }
+    moved = bound;
     return best;
+  }
+
+  /// Whether u's star is a disk: following each triangle's side opposite u from one end to
+  /// the other (they keep the star's orientation) goes once round every triangle.
+  bool one_cycle(uint32_t u) const {
+    const auto& star = faces_[u];
+    if (star.size() < 4) return false;  // a valence-3 vertex: the tetrahedron's, kept
+    const auto side = [&](uint32_t f) {
+      const auto& t = tris_[f];
+      const int k = t[0] == u ? 0 : t[1] == u ? 1 : 2;
+      return std::pair{t[(k + 1) % 3], t[(k + 2) % 3]};
+    };
+    uint32_t at = side(star[0]).second;
+    for (size_t step = 1; step < star.size(); ++step) {
+      size_t next = 0, found = 0;
+      for (size_t i = 0; i < star.size(); ++i)
+        if (side(star[i]).first == at) next = i, ++found;
+      if (found != 1 || next == 0) return false;
+      at = side(star[next]).second;
+    }
+    return at == side(star[0]).first;
   }
 
   /// Whether u's triangles without v, once u stands at v, all face the plane's way (n) and
@@ -222,21 +244,30 @@ class FlatMerger {
     return true;
   }
 
-  /// The link condition: u and v share exactly the two neighbours across their edge, and
-  /// the mesh is not a tetrahedron about to fold flat.
-  bool links_once(uint32_t u, uint32_t v, const std::vector<uint32_t>& ring) const {
-    size_t common = 0, v_ring = 0;
+  /// The link condition: the edge uv lies on exactly two triangles, and u and v share
+  /// exactly the two neighbours across it (`ring`: u's, sorted; `v_ring`: scratch).
+  bool link_condition(uint32_t u, uint32_t v, const std::vector<uint32_t>& ring, std::vector<uint32_t>& v_ring) const {
+    size_t shared = 0;
+    for (uint32_t f : faces_[u]) {
+      const auto& t = tris_[f];
+      shared += t[0] == v || t[1] == v || t[2] == v;
+    }
+    if (shared != 2) return false;
+    v_ring.clear();
     for (uint32_t f : faces_[v])
       for (uint32_t w : tris_[f])
-        if (w != v) {
-          ++v_ring;
-          if (w != u && std::binary_search(ring.begin(), ring.end(), w)) ++common;
-        }
-    // Each common neighbour is met twice around v (on two of its triangles), as around u.
-    return common == 4 && !(ring.size() <= 6 && v_ring <= 6);
+        if (w != v && w != u) v_ring.push_back(w);
+    std::sort(v_ring.begin(), v_ring.end());
+    v_ring.erase(std::unique(v_ring.begin(), v_ring.end()), v_ring.end());
+    size_t common = 0;
+    for (uint32_t w : v_ring) common += std::binary_search(ring.begin(), ring.end(), w);
+    return common == 2;
   }
 
-  void collapse(uint32_t u, uint32_t v) {
+  /// u onto v; every vertex of u's star may have moved by `moved` since the input.
+  void collapse(uint32_t u, uint32_t v, double moved) {
+    for (uint32_t f : faces_[u])
+      for (uint32_t w : tris_[f]) moved_[w] = std::max(moved_[w], moved);
     for (uint32_t f : faces_[u]) {
       auto& t = tris_[f];
       if (t[0] == v || t[1] == v || t[2] == v) {
@@ -256,6 +287,7 @@ class FlatMerger {
 }  // namespace
 
 size_t merge_flat(TriMesh& mesh, double drift, std::vector<Vec3>* merged_away, const std::vector<uint8_t>* keep) {
+  if (merged_away) merged_away->clear();
   if (!(drift > 0) || mesh.triangles.empty()) return 0;
   FlatMerger m(mesh, drift, keep);
   m.run();

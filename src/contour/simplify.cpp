@@ -1,6 +1,8 @@
 // Output sized to the geometry: a dual contour has a vertex per gray cell, so a flat face or a
-// straight crease costs one vertex per finest cell along it. Edge collapses merge those
-// vertices: both ends move to the point nearest their planes (on a crease, onto its line),
+// straight crease costs one vertex per finest cell along it. Flat regions are merged first
+// without moving the surface (merge_flat.h); then edge collapses merge the vertices left,
+// checked against that merged contour with the tolerance less the merge's share (and the raw
+// vertices the merge took away against each round's result): both ends move to the point nearest their planes (on a crease, onto its line),
 // allowed where every vertex of the original contour that the two stars answer for stays within
 // the tolerance of the new star. Original points, not original triangles' planes, are the
 // measure: a triangle spanning a crease between vertices a tenth of a cell off its line has a
@@ -743,12 +745,12 @@ std::vector<std::array<Vec3, 2>> crossings_of_the_input(const TriMesh& out, cons
 }
 
 /// The collapses that check original points, in rounds; false (and `mesh` as it was) when
-/// none could be taken. `also`: more points of the original surface, each within
-/// `also_tolerance` of `mesh`'s triangles, that the result must keep within `tolerance` plus
+/// none could be taken. `merged_away`: more points of the original surface, each within
+/// `merge_drift` of `mesh`'s triangles, that the result must keep within `tolerance` plus
 /// that; where one is left farther, the round after keeps the triangle it lies on as it is.
 /// `input_crossings`: where `mesh` itself crosses, when that is why none could be taken.
-bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const std::vector<Vec3>& also,
-                        double also_tolerance, std::vector<std::array<Vec3, 2>>& input_crossings) {
+bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const std::vector<Vec3>& merged_away,
+                        double merge_drift, std::vector<std::array<Vec3, 2>>& input_crossings) {
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
@@ -781,8 +783,8 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
     TriMesh out = s.result(kept);
     if (out.triangles.size() == mesh.triangles.size()) return false;
     const auto crossings = self_intersecting_pairs(out);
-    const std::vector<uint32_t> left = left_behind(out, also, tolerance + also_tolerance, surface);
-    if (crossings.empty() && left.empty()) {
+    const std::vector<uint32_t> under_points = left_behind(out, merged_away, tolerance + merge_drift, surface);
+    if (crossings.empty() && under_points.empty()) {
       mesh = std::move(out);
       return true;
     }
@@ -808,7 +810,7 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
       if (at_crossing[v]) input_at[kept[v]] = 1;
     for (uint32_t u = 0; u < mesh.positions.size(); ++u)
       if (input_at[s.survivor(u)]) frozen[u] = 1;
-    for (uint32_t f : left)
+    for (uint32_t f : under_points)
       for (uint32_t u : mesh.triangles[f]) frozen[u] = 1;
   }
   return false;
@@ -830,22 +832,27 @@ size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_ove
   for (int attempt = 0; attempt < kMergeAttempts; ++attempt) {
     TriMesh merged = mesh;
     std::vector<Vec3> merged_away;
-    merge_flat(merged, drift, &merged_away, &keep);
+    const size_t flat = merge_flat(merged, drift, &merged_away, &keep);
     std::vector<std::array<Vec3, 2>> merged_crossings;
-    if (collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift, merged_crossings)) {
+    if (collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift, merged_crossings) ||
+        (merged_crossings.empty() && flat > 0 && self_intersecting_pairs(merged).empty())) {
       const size_t removed = mesh.triangles.size() - merged.triangles.size();
       mesh = std::move(merged);
       return removed;
     }
     if (merged_crossings.empty()) return 0;
-    // Every input vertex in reach of the crossing triangles' boxes: the input triangles they
-    // cover have their corners there.
+    // A fan triangle was made by merging a vertex whose neighbours include its corners, and
+    // no vertex next to a kept one merges: keeping every input vertex in the crossing
+    // triangles' boxes undoes them. When none is newly kept, the input itself crosses there.
+    bool more = false;
     for (uint32_t u = 0; u < mesh.positions.size(); ++u)
       for (const auto& [lo, hi] : merged_crossings) {
-        bool inside = true;
-        for (int k = 0; k < 3; ++k) inside &= mesh.positions[u][k] >= lo[k] - drift && mesh.positions[u][k] <= hi[k] + drift;
-        if (inside) keep[u] = 1;
+        bool inside = !keep[u];
+        for (int k = 0; k < 3 && inside; ++k)
+          inside = mesh.positions[u][k] >= lo[k] - drift && mesh.positions[u][k] <= hi[k] + drift;
+        if (inside) keep[u] = 1, more = true;
       }
+    if (!more) return 0;
   }
   return 0;
 }
