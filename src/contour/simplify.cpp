@@ -1,8 +1,8 @@
 // Output sized to the geometry: a dual contour has a vertex per gray cell, so a flat face or a
 // straight crease costs one vertex per finest cell along it. Flat regions are merged first
 // without moving the surface (merge_flat.h); then edge collapses merge the vertices left,
-// checked against that merged contour with the tolerance less the merge's share (and the raw
-// vertices the merge took away against each round's result): both ends move to the point nearest their planes (on a crease, onto its line),
+// checked against that merged contour with the tolerance less the merge's share, the raw
+// vertices the merge took away among the points they keep within it: both ends move to the point nearest their planes (on a crease, onto its line),
 // allowed where every vertex of the original contour that the two stars answer for stays within
 // the tolerance of the new star. Original points, not original triangles' planes, are the
 // measure: a triangle spanning a crease between vertices a tenth of a cell off its line has a
@@ -120,14 +120,17 @@ struct Scratch {
 class Simplifier {
  public:
   /// `frozen`: per vertex of `mesh`, whether it must stay where it is (empty: none).
-  /// `surface`: the distance to `mesh`.
+  /// `surface`: the distance to `mesh`. `more`: original points besides `mesh`'s vertices (the
+  /// raw vertices a flat merge took away), each answered for by the triangle of `mesh` in
+  /// `more_on` at that distance; they are numbered after the vertices.
   Simplifier(const TriMesh& mesh, const detail::MeshDistance& surface, double tolerance,
-             const std::vector<uint8_t>& frozen)
-      : pos_(mesh.positions), original_(mesh.positions), original_surface_(surface), tris_(mesh.triangles), tol_(tolerance),
-        quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
-        next_point_(pos_.size(), kNoPoint), near_(pos_.size(), 0.0), alive_(tris_.size(), 1), off_(tris_.size(), 0.0),
-        near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_), deferred_(pos_.size(), 0),
-        logged_(pos_.size(), 0) {
+             const std::vector<uint8_t>& frozen, const std::vector<Vec3>& more,
+             const std::vector<detail::Nearest>& more_on)
+      : pos_(mesh.positions), original_(with(mesh.positions, more)), original_surface_(surface), tris_(mesh.triangles),
+        tol_(tolerance), quadric_(pos_.size()), faces_(pos_.size()), first_point_(tris_.size(), kNoPoint),
+        next_point_(original_.size(), kNoPoint), near_(original_.size(), 0.0), alive_(tris_.size(), 1),
+        off_(tris_.size(), 0.0), near_raw_(tris_.size()), merged_into_(pos_.size()), frozen_(frozen), grid_(pos_),
+        deferred_(pos_.size(), 0), logged_(original_.size(), 0) {
     for (uint32_t f = 0; f < tris_.size(); ++f) near_raw_[f] = surface.hint_of(f);
     std::iota(merged_into_.begin(), merged_into_.end(), 0u);
     frozen_.resize(pos_.size(), 0);
@@ -145,6 +148,17 @@ class Simplifier {
     // triangle's corner: at distance 0).
     for (uint32_t v = 0; v < pos_.size(); ++v)
       if (!faces_[v].empty()) answer_for(v, faces_[v][0]);
+    for (size_t i = 0; i < more.size(); ++i) {
+      const uint32_t p = uint32_t(pos_.size() + i);
+      answer_for(p, more_on[i].triangle);
+      near_[p] = more_on[i].distance;
+    }
+  }
+
+  static std::vector<Vec3> with(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    std::vector<Vec3> all(a);
+    all.insert(all.end(), b.begin(), b.end());
+    return all;
   }
 
   static constexpr uint16_t kNoBlock = UINT16_MAX;
@@ -152,9 +166,10 @@ class Simplifier {
   /// What a later round takes over from this round's blocks: the merges and where each
   /// original point is answered for, and the vertices and triangles still alive.
   struct BlocksState {
-    // Per vertex and original point (the same numbers): their merge, the next point on their
-    // triangle's list, how near it, whether deferred; for all, or (a later grid's phase) only
-    // for those it touched (its blocks' vertices, the points it moved), in `touched`'s order.
+    // Per vertex and original point (the same numbers; the points besides the vertices come
+    // after them): their merge, the next point on their triangle's list, how near it, whether
+    // deferred; for all, or (a later grid's phase) only for those it touched (its blocks'
+    // vertices, the points it moved), in `touched`'s order.
     std::vector<uint32_t> touched;
     bool partial = false;
     std::vector<uint32_t> merged_into, next_point;
@@ -315,10 +330,11 @@ class Simplifier {
       st.partial = true;
       st.touched = *touched;
       for (uint32_t i : *touched) {
-        st.merged_into.push_back(merged_into_[i]);
+        const bool vertex = i < pos_.size();
+        st.merged_into.push_back(vertex ? merged_into_[i] : i);
         st.next_point.push_back(next_point_[i]);
         st.near.push_back(near_[i]);
-        st.deferred.push_back(deferred_[i]);
+        st.deferred.push_back(vertex ? deferred_[i] : 0);
       }
     } else {
       st.merged_into = merged_into_, st.next_point = next_point_, st.near = near_, st.deferred = deferred_;
@@ -347,8 +363,8 @@ class Simplifier {
   /// for. Returns the vertices and points a partial `done` changed there.
   std::vector<uint32_t> adopt(const BlocksState& done, const std::vector<uint16_t>& membership,
                               const std::vector<uint8_t>& run) {
-    const auto adopted = [&](uint32_t u) { return membership[u] != kNoBlock && !run[membership[u]]; };
-    std::vector<uint8_t> taken(tris_.size(), 0), point_taken(done.partial ? pos_.size() : 0, 0);
+    const auto adopted = [&](uint32_t u) { return u < pos_.size() && membership[u] != kNoBlock && !run[membership[u]]; };
+    std::vector<uint8_t> taken(tris_.size(), 0), point_taken(done.partial ? original_.size() : 0, 0);
     for (uint32_t f = 0; f < tris_.size(); ++f) {
       const auto& t = tris_[f];
       if (!alive_[f] || !adopted(t[0]) || membership[t[1]] != membership[t[0]] || membership[t[2]] != membership[t[0]])
@@ -692,25 +708,6 @@ class Simplifier {
   }
 };
 
-/// The triangles of `mesh` (its `surface`) nearest the points farther than `tolerance` from
-/// `out`, once each.
-std::vector<uint32_t> left_behind(const TriMesh& out, const std::vector<Vec3>& points, double tolerance,
-                                  const detail::MeshDistance& surface) {
-  if (points.empty()) return {};
-  const detail::MeshDistance result(out, detail::Pruning::Boxes);
-  std::vector<uint8_t> far(points.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    uint32_t hint = 0;
-    for (size_t i = r.begin(); i < r.end(); ++i) far[i] = !result.within(points[i], tolerance, &hint);
-  });
-  std::vector<uint32_t> nearest;
-  for (size_t i = 0; i < points.size(); ++i)
-    if (far[i]) nearest.push_back(surface.nearest(points[i]).triangle);
-  std::sort(nearest.begin(), nearest.end());
-  nearest.erase(std::unique(nearest.begin(), nearest.end()), nearest.end());
-  return nearest;
-}
-
 /// The boxes of the crossing pairs whose two triangles are `mesh`'s own, unchanged
 /// (`kept`: the vertex of `mesh` that each vertex of `out` is): no round can undo those.
 std::vector<std::array<Vec3, 2>> crossings_of_the_input(const TriMesh& out, const std::vector<uint32_t>& kept,
@@ -745,12 +742,11 @@ std::vector<std::array<Vec3, 2>> crossings_of_the_input(const TriMesh& out, cons
 }
 
 /// The collapses that check original points, in rounds; false (and `mesh` as it was) when
-/// none could be taken. `merged_away`: more points of the original surface, each within
-/// `merge_drift` of `mesh`'s triangles, that the result must keep within `tolerance` plus
-/// that; where one is left farther, the round after keeps the triangle it lies on as it is.
+/// none could be taken. `merged_away`: more points of the original surface (near `mesh`'s
+/// triangles) that the result keeps within `tolerance` as it keeps `mesh`'s vertices.
 /// `input_crossings`: where `mesh` itself crosses, when that is why none could be taken.
 bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const std::vector<Vec3>& merged_away,
-                        double merge_drift, std::vector<std::array<Vec3, 2>>& input_crossings) {
+                        std::vector<std::array<Vec3, 2>>& input_crossings) {
   // The local checks keep the mesh closed and 2-manifold; a crossing between parts that are
   // not neighbours (two sheets a fraction of a cell apart) is found on the result. Then the
   // input vertices merged into the crossing triangles stay as they are, and the rest is
@@ -758,11 +754,17 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
   constexpr int kRounds = 6;
   std::vector<uint8_t> frozen(mesh.positions.size(), 0), frozen_before;
   const detail::MeshDistance surface(mesh, detail::Pruning::Boxes);
+  // Each point merged away is answered for by the triangle it lies on (within the merge's drift).
+  std::vector<detail::Nearest> on(merged_away.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, merged_away.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    uint32_t hint = 0;
+    for (size_t i = r.begin(); i < r.end(); ++i) on[i] = surface.nearest(merged_away[i], &hint);
+  });
   // Each phase of a round as it ended: the next round redoes only the blocks where vertices
   // were frozen since, and those their changes reach in the later grids.
   std::vector<Simplifier::PhaseRecord> last;
   for (int round = 0; round < kRounds; ++round) {
-    Simplifier s(mesh, surface, tolerance, frozen);
+    Simplifier s(mesh, surface, tolerance, frozen, merged_away, on);
     std::vector<uint8_t> changed(mesh.positions.size(), 0);
     if (round > 0)
       for (uint32_t u = 0; u < frozen.size(); ++u) changed[u] = frozen[u] != frozen_before[u];
@@ -783,15 +785,12 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
     TriMesh out = s.result(kept);
     if (out.triangles.size() == mesh.triangles.size()) return false;
     const auto crossings = self_intersecting_pairs(out);
-    const std::vector<uint32_t> under_points = left_behind(out, merged_away, tolerance + merge_drift, surface);
-    if (crossings.empty() && under_points.empty()) {
+    if (crossings.empty()) {
       mesh = std::move(out);
       return true;
     }
-    if (!crossings.empty()) {
-      input_crossings = crossings_of_the_input(out, kept, mesh, crossings);
-      if (!input_crossings.empty()) return false;
-    }
+    input_crossings = crossings_of_the_input(out, kept, mesh, crossings);
+    if (!input_crossings.empty()) return false;
     // The vertices of the crossing triangles, and from the second round on their neighbours
     // too: keeping only the crossing triangles raw can make the next collapses beside them
     // cross again, and a wider raw patch settles in fewer rounds.
@@ -810,8 +809,6 @@ bool collapse_in_rounds(TriMesh& mesh, double tolerance, bool take_over, const s
       if (at_crossing[v]) input_at[kept[v]] = 1;
     for (uint32_t u = 0; u < mesh.positions.size(); ++u)
       if (input_at[s.survivor(u)]) frozen[u] = 1;
-    for (uint32_t f : under_points)
-      for (uint32_t u : mesh.triangles[f]) frozen[u] = 1;
   }
   return false;
 }
@@ -834,7 +831,7 @@ size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_ove
     std::vector<Vec3> merged_away;
     const size_t flat = merge_flat(merged, drift, &merged_away, &keep);
     std::vector<std::array<Vec3, 2>> merged_crossings;
-    if (collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, drift, merged_crossings) ||
+    if (collapse_in_rounds(merged, tolerance - drift, take_over, merged_away, merged_crossings) ||
         (merged_crossings.empty() && flat > 0 && self_intersecting_pairs(merged).empty())) {
       const size_t removed = mesh.triangles.size() - merged.triangles.size();
       mesh = std::move(merged);
