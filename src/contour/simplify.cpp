@@ -1,15 +1,15 @@
 // Output sized to the geometry: a dual contour has a vertex per gray cell, so a flat face or a
 // straight crease costs one vertex per finest cell along it. Flat regions are merged first
-// without moving the surface (merge_flat.h); then edge collapses merge the vertices left,
-// checked against that merged contour with the tolerance less the merge's share, the raw
-// vertices the merge took away among the points they keep within it: both ends move to the point nearest their planes (on a crease, onto its line),
-// allowed where every vertex of the original contour that the two stars answer for stays within
-// the tolerance of the new star. Original points, not original triangles' planes, are the
-// measure: a triangle spanning a crease between vertices a tenth of a cell off its line has a
-// plane tilted across the crease, which would stop every collapse along it. Each collapse is
-// checked locally (the link condition keeps the mesh closed and 2-manifold; the turned
-// triangles keep their orientation and do not become needles), and the whole result is checked
-// for crossings before it replaces the contour.
+// without moving the surface (merge_flat.h); then edge collapses merge the vertices left: both
+// ends move to the point nearest their planes (on a crease, onto its line), allowed where every
+// vertex of the original contour that the two stars answer for (the merged mesh's vertices and
+// those the merge took away) stays within the tolerance, less the merge's share, of the new
+// star. Original points, not original triangles' planes, are the measure: a triangle spanning a
+// crease between vertices a tenth of a cell off its line has a plane tilted across the crease,
+// which would stop every collapse along it. Each collapse is checked locally (the link
+// condition keeps the mesh closed and 2-manifold; the turned triangles keep their orientation
+// and do not become needles), and the whole result is checked for crossings before it replaces
+// the contour.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -820,7 +820,7 @@ size_t simplify(TriMesh& mesh, double tolerance) { return detail::simplify_in_ro
 size_t detail::simplify_in_rounds(TriMesh& mesh, double tolerance, bool take_over) {
   if (!(tolerance > 0) || mesh.triangles.empty()) return 0;
   // Flat regions first, moving the surface by a small share of the tolerance: the collapses
-  // that check original points then start from far fewer of them. Two sheets closer than that
+  // then start from far fewer vertices. Two sheets closer than that
   // share may cross once merged; then the merge is redone with the input kept as it is around
   // the crossing (a few times; then the input is written).
   constexpr int kMergeAttempts = 3;
