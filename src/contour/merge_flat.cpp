@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/blocks.h"
+#include "contour/edge_collapse.h"
 #include "contour/triangle_shape.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
@@ -75,24 +76,8 @@ class FlatMerger {
       if (faces_[u].empty() && had_triangles_[u]) out.push_back(pos_[u]);
   }
 
-  TriMesh result() const {
-    TriMesh out;
-    std::vector<uint32_t> remap(pos_.size(), UINT32_MAX);
-    for (uint32_t f = 0; f < tris_.size(); ++f) {
-      if (!alive_[f]) continue;
-      std::array<uint32_t, 3> t;
-      for (int k = 0; k < 3; ++k) {
-        uint32_t& r = remap[tris_[f][k]];
-        if (r == UINT32_MAX) {
-          r = uint32_t(out.positions.size());
-          out.positions.push_back(pos_[tris_[f][k]]);
-        }
-        t[k] = r;
-      }
-      out.triangles.push_back(t);
-    }
-    return out;
-  }
+  TriMesh result() const { return live_mesh(pos_, tris_, alive_); }
+
 
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
@@ -268,19 +253,7 @@ class FlatMerger {
   void collapse(uint32_t u, uint32_t v, double moved) {
     for (uint32_t f : faces_[u])
       for (uint32_t w : tris_[f]) moved_[w] = std::max(moved_[w], moved);
-    for (uint32_t f : faces_[u]) {
-      auto& t = tris_[f];
-      if (t[0] == v || t[1] == v || t[2] == v) {
-        alive_[f] = 0;
-        for (uint32_t w : t)
-          if (w != u) std::erase(faces_[w], f);
-        continue;
-      }
-      for (uint32_t& w : t)
-        if (w == u) w = v;
-      faces_[v].push_back(f);
-    }
-    faces_[u].clear();
+    hand_star_over(u, v, tris_, faces_, alive_);
   }
 };
 

@@ -23,6 +23,7 @@
 
 #include "contour/simplify.h"
 #include "contour/blocks.h"
+#include "contour/edge_collapse.h"
 #include "contour/merge_flat.h"
 #include "contour/triangle_shape.h"
 #include "geometry/lattice.h"
@@ -243,26 +244,8 @@ class Simplifier {
   }
 
   /// The simplified mesh; `kept[i]`: the vertex of the input that output vertex i is.
-  TriMesh result(std::vector<uint32_t>& kept) const {
-    TriMesh out;
-    kept.clear();
-    std::vector<uint32_t> remap(pos_.size(), UINT32_MAX);
-    for (uint32_t f = 0; f < tris_.size(); ++f) {
-      if (!alive_[f]) continue;
-      std::array<uint32_t, 3> t;
-      for (int k = 0; k < 3; ++k) {
-        uint32_t& r = remap[tris_[f][k]];
-        if (r == UINT32_MAX) {
-          r = uint32_t(out.positions.size());
-          out.positions.push_back(pos_[tris_[f][k]]);
-          kept.push_back(tris_[f][k]);
-        }
-        t[k] = r;
-      }
-      out.triangles.push_back(t);
-    }
-    return out;
-  }
+  TriMesh result(std::vector<uint32_t>& kept) const { return detail::live_mesh(pos_, tris_, alive_, &kept); }
+
 
  private:
   std::vector<Vec3> pos_;
@@ -691,19 +674,7 @@ class Simplifier {
     for (size_t k = 0; k < s.star.size(); ++k) off_[s.star[k]] = s.new_off[k], near_raw_[s.star[k]] = s.new_near_raw[k];
     pos_[v] = x;
     merged_into_[u] = v;
-    for (uint32_t f : faces_[u]) {
-      auto& t = tris_[f];
-      if (t[0] == v || t[1] == v || t[2] == v) {
-        alive_[f] = 0;
-        for (uint32_t w : t)
-          if (w != u) std::erase(faces_[w], f);
-        continue;
-      }
-      for (uint32_t& w : t)
-        if (w == u) w = v;
-      faces_[v].push_back(f);
-    }
-    faces_[u].clear();
+    detail::hand_star_over(u, v, tris_, faces_, alive_);
     quadric_[v].add(quadric_[u]);
   }
 };
