@@ -138,13 +138,11 @@ class FlatMerger {
                        double& moved) {
     ring.clear();
     Vec3 n{0, 0, 0};
-    double worst_before = 1;
     for (uint32_t f : faces_[u]) {
       const auto& t = tris_[f];
       for (uint32_t w : t)
         if (w != u) ring.push_back(w);
       n = add3(n, triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
-      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
     if (block != kAnyBlock)
       for (uint32_t w : ring)
@@ -154,15 +152,11 @@ class FlatMerger {
       for (uint32_t w : ring)
         if ((*keep_)[w]) return kNone;
     }
-    // A closed disk: the link is one cycle through every neighbour once (each on exactly two
-    // triangles of the star).
-    if (!one_cycle(u)) return kNone;
-    std::sort(ring.begin(), ring.end());
     const double len = norm3(n);
     if (!(len > 0)) return kNone;
     n = scale3(n, 1 / len);
     // Flat: every vertex of the star this near the plane through u, every triangle facing
-    // the plane's way (no pleat).
+    // the plane's way (no pleat). Most stars that are not flat stop here, first.
     double off = 0, bound = moved_[u];
     for (uint32_t w : ring) {
       off = std::max(off, std::abs(dot3(n, sub3(pos_[w], pos_[u]))));
@@ -171,11 +165,17 @@ class FlatMerger {
     // The fan and the star both lie within `off` of the plane over the same polygon.
     bound += 2 * off;
     if (!(bound <= drift_)) return kNone;
+    double worst_before = 1;
     for (uint32_t f : faces_[u]) {
       const auto& t = tris_[f];
       const Vec3 m = triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
       if (!(dot3(m, n) >= kKeptNormalCosine * norm3(m))) return kNone;
+      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
+    // A closed disk: the link is one cycle through every neighbour once (each on exactly two
+    // triangles of the star).
+    if (!one_cycle(u)) return kNone;
+    std::sort(ring.begin(), ring.end());
     const double min_quality = std::min(kMinTriangleQuality, worst_before);
     uint32_t best = kNone;
     double best_quality = -1;

@@ -114,6 +114,7 @@ struct Scratch {
   std::vector<MovedPoint> moved_points;
   std::vector<uint32_t> new_near_raw;  // per triangle of that star: where the original was found
   bool left_block = false;  // the last vertex tried had a collapse refused for leaving the block
+  double worst_u = 1;       // the worst shape in the star of the vertex tried
   bool log_moves = false;
   std::vector<uint32_t> moved_log;  // every original point the collapses moved, if log_moves
 };
@@ -479,6 +480,7 @@ class Simplifier {
     if (frozen_[u]) return false;
     ring(u, s.ring_u);
     if (!in_block(s.ring_u, block)) return s.left_block = true, false;
+    s.worst_u = worst_shape(u);
     s.candidates.clear();
     double error = 0;
     for (uint32_t v : s.ring_u)
@@ -524,7 +526,8 @@ class Simplifier {
     if (common != 2) return false;
     // A closed mesh of 4 vertices (a tetrahedron) would fold flat.
     if (s.ring_u.size() <= 3 && s.ring_v.size() <= 3) return false;
-    return keeps_shape(u, v, x) && keeps_shape(v, u, x) && keeps_points(u, v, x, s) && near_original(x, s);
+    return keeps_shape(u, v, x, s.worst_u) && keeps_shape(v, u, x, worst_shape(v)) && keeps_points(u, v, x, s) &&
+           near_original(x, s);
   }
 
   /// Whether every original point the stars of u and v answer for lies within the tolerance
@@ -638,13 +641,19 @@ class Simplifier {
     return true;
   }
 
-  /// Whether the triangles of `a` without `b` keep orientation and shape with `a` at x.
-  bool keeps_shape(uint32_t a, uint32_t b, const Vec3& x) const {
-    double worst_before = 1;
+  /// The worst shape among the triangles of a's star.
+  double worst_shape(uint32_t a) const {
+    double worst = 1;
     for (uint32_t f : faces_[a]) {
       const auto& t = tris_[f];
-      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+      worst = std::min(worst, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
     }
+    return worst;
+  }
+
+  /// Whether the triangles of `a` without `b` keep orientation and shape with `a` at x
+  /// (`worst_before`: a's worst_shape): no worse than the floor, or than they were.
+  bool keeps_shape(uint32_t a, uint32_t b, const Vec3& x, double worst_before) const {
     const double min_quality = std::min(kMinTriangleQuality, worst_before);
     for (uint32_t f : faces_[a]) {
       const auto& t = tris_[f];
