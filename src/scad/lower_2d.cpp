@@ -226,8 +226,10 @@ Region Lowering::text(const Node& n, double st) const {
   p.language = str("language", "en");
   p.script = str("script", "");
   // Straight pieces per curve of the outline: floor(fragments / 8) + 1 for the circle
-  // fragments of the text's size (counted on OpenSCAD 2021's exports for $fn 8 to 40).
-  p.segments = frags(n, p.size, st) / 8 + 1;
+  // fragments of the text's size, and never fewer than 2 (counted on OpenSCAD 2021's exports
+  // for $fn 3 to 40 and sizes 0.5 to 30). With one chord per curve a small "o"'s outer ring cuts
+  // through its hole.
+  p.segments = std::max(2, frags(n, p.size, st) / 8 + 1);
   return text_region(p);
 }
 
