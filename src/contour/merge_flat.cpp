@@ -8,6 +8,7 @@
 #include "contour/merge_flat.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -91,6 +92,16 @@ class FlatMerger {
   std::vector<double> moved_;
   double drift_;
   std::vector<uint8_t> deferred_;      // per vertex: to be tried again in the next grid
+  // A triangle of the star of the vertex being tried, read once: its corners and positions.
+  struct StarTriangle {
+    std::array<uint32_t, 3> v;
+    std::array<Vec3, 3> p;
+  };
+  // What trying one vertex needs for itself (each block has its own).
+  struct Scratch {
+    std::vector<uint32_t> ring, v_ring;
+    std::vector<StarTriangle> star;
+  };
   std::vector<uint16_t> membership_;  // per live vertex: its block of the grid in use
   static constexpr uint16_t kNoBlock = UINT16_MAX;
   static constexpr int kAnyBlock = -1;
@@ -104,7 +115,7 @@ class FlatMerger {
     const auto local = [&](uint32_t w) {
       return block == kAnyBlock ? size_t(w) : size_t(std::lower_bound(members.begin(), members.end(), w) - members.begin());
     };
-    std::vector<uint32_t> ring, v_ring;
+    Scratch s;
     bool stopped = false;
     for (int pass = 0; pass < 32; ++pass) {
       size_t done = 0;
@@ -113,10 +124,10 @@ class FlatMerger {
         if (!dirty[i] || faces_[u].empty()) continue;
         bool left_block = false;
         double moved = 0;
-        const uint32_t v = best_target(u, block, ring, v_ring, left_block, moved);
+        const uint32_t v = best_target(u, block, s, left_block, moved);
         deferred_[u] = left_block;
         if (v == kNone) continue;
-        for (uint32_t w : ring) next[local(w)] = 1;
+        for (uint32_t w : s.ring) next[local(w)] = 1;
         collapse(u, v, moved);
         ++done;
       }
@@ -134,15 +145,17 @@ class FlatMerger {
 
   /// The neighbour u may go onto without moving the surface, the one leaving the best-shaped
   /// triangles; kNone when u's star is not flat or no neighbour will do.
-  uint32_t best_target(uint32_t u, int block, std::vector<uint32_t>& ring, std::vector<uint32_t>& v_ring, bool& left_block,
-                       double& moved) {
+  uint32_t best_target(uint32_t u, int block, Scratch& s, bool& left_block, double& moved) {
+    auto& ring = s.ring;
     ring.clear();
+    s.star.clear();
     Vec3 n{0, 0, 0};
     for (uint32_t f : faces_[u]) {
       const auto& t = tris_[f];
       for (uint32_t w : t)
         if (w != u) ring.push_back(w);
-      n = add3(n, triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+      const StarTriangle& st = s.star.emplace_back(StarTriangle{t, {pos_[t[0]], pos_[t[1]], pos_[t[2]]}});
+      n = add3(n, triangle_normal(st.p[0], st.p[1], st.p[2]));
     }
     if (block != kAnyBlock)
       for (uint32_t w : ring)
@@ -166,11 +179,10 @@ class FlatMerger {
     bound += 2 * off;
     if (!(bound <= drift_)) return kNone;
     double worst_before = 1;
-    for (uint32_t f : faces_[u]) {
-      const auto& t = tris_[f];
-      const Vec3 m = triangle_normal(pos_[t[0]], pos_[t[1]], pos_[t[2]]);
+    for (const StarTriangle& t : s.star) {
+      const Vec3 m = triangle_normal(t.p[0], t.p[1], t.p[2]);
       if (!(dot3(m, n) >= kKeptNormalCosine * norm3(m))) return kNone;
-      worst_before = std::min(worst_before, triangle_quality(pos_[t[0]], pos_[t[1]], pos_[t[2]]));
+      worst_before = std::min(worst_before, triangle_quality(t.p[0], t.p[1], t.p[2]));
     }
     // A closed disk: the link is one cycle through every neighbour once (each on exactly two
     // triangles of the star).
@@ -182,8 +194,8 @@ class FlatMerger {
     for (size_t i = 0; i < ring.size(); i += 2) {
       const uint32_t v = ring[i];
       double q = 0;
-      if (fan_keeps(u, v, n, std::max(min_quality, best_quality), q) && q > best_quality &&
-          link_condition(u, v, ring, v_ring))
+      if (fan_keeps(u, v, s.star, n, std::max(min_quality, best_quality), q) && q > best_quality &&
+          link_condition(u, v, ring, s.v_ring))
         best = v, best_quality = q;
     }
     moved = bound;
@@ -211,15 +223,17 @@ class FlatMerger {
     return at == side(star[0]).first;
   }
 
-  /// Whether u's triangles without v, once u stands at v, all face the plane's way (n) and
-  /// are shaped at least `floor`; `worst` is set to the worst shape among them.
-  bool fan_keeps(uint32_t u, uint32_t v, const Vec3& n, double floor, double& worst) const {
+  /// Whether u's triangles (`star`) without v, once u stands at v, all face the plane's way
+  /// (n) and are shaped at least `floor`; `worst` is set to the worst shape among them.
+  bool fan_keeps(uint32_t u, uint32_t v, const std::vector<StarTriangle>& star, const Vec3& n, double floor,
+                 double& worst) const {
     worst = 1;
-    for (uint32_t f : faces_[u]) {
-      const auto& t = tris_[f];
-      if (t[0] == v || t[1] == v || t[2] == v) continue;
-      std::array<Vec3, 3> p;
-      for (int k = 0; k < 3; ++k) p[k] = t[k] == u ? pos_[v] : pos_[t[k]];
+    const Vec3& at = pos_[v];
+    for (const StarTriangle& t : star) {
+      if (t.v[0] == v || t.v[1] == v || t.v[2] == v) continue;
+      std::array<Vec3, 3> p = t.p;
+      for (int k = 0; k < 3; ++k)
+        if (t.v[k] == u) p[k] = at;
       const Vec3 m = triangle_normal(p[0], p[1], p[2]);
       const double along = dot3(m, n);
       if (!(along > 0 && along * along >= kKeptNormalCosine * kKeptNormalCosine * dot3(m, m))) return false;
