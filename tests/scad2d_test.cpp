@@ -161,6 +161,35 @@ TEST(ScadText, CentredTextIsPlacedAsOpenScadPlacesIt) {
   EXPECT_NEAR(hi[1], 5.02844, 2e-3);
 }
 
+// Vertical text placed as OpenSCAD 2021 places it (its DXF exports of "lH" at size 10): each
+// glyph centred on the pen line, the pen going down by the font's line height, "top" lifting
+// the column above the origin, halign by the widest glyph.
+TEST(ScadText, VerticalTextIsPlacedAsOpenScadPlacesIt) {
+  struct Case {
+    const char* args;
+    double x0, x1, y0, y1;
+  };
+  const Case cases[] = {
+      {"direction = \"ttb\"", -3.7582, 3.9995, -23.7558, -1.2151},
+      {"direction = \"btt\", spacing = 1.5, valign = \"top\"", -3.7582, 3.9995, 7.8148, 36.7147},
+      {"direction = \"ttb\", halign = \"right\", valign = \"center\"", -11.3394, -3.5817, -11.0269, 11.5138},
+      {"direction = \"btt\", halign = \"center\", valign = \"bottom\", spacing = 0.8", -7.5488, 0.2089, -21.4616,
+       -1.4721},
+  };
+  for (const Case& c : cases) {
+    const Outline o = outline_of(std::string("text(text = \"lH\", size = 10, ") + c.args + ");");
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const auto& r : o.rings)
+      for (const auto& q : r)
+        for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
+    SCOPED_TRACE(c.args);
+    EXPECT_NEAR(lo[0], c.x0, 0.01);
+    EXPECT_NEAR(hi[0], c.x1, 0.01);
+    EXPECT_NEAR(lo[1], c.y0, 0.01);
+    EXPECT_NEAR(hi[1], c.y1, 0.01);
+  }
+}
+
 // Extruded text (holes, separate parts) is a closed solid of its outline's area times height.
 TEST(ScadText, ExtrudedTextIsAValidSolid) {
   EvalOptions o;

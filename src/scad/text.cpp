@@ -6,9 +6,11 @@
 #include <ft2build.h>
 #include FT_FREETYPE_H
 #include FT_OUTLINE_H
+#include <hb-ft.h>
 #include <hb.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <mutex>
 
@@ -21,6 +23,11 @@ namespace {
 // 1000 / 1024 of the glyphs' advance widths at that scale.
 constexpr double kEmPerSize = 100.0 / 72.0;
 constexpr double kAdvanceScale = 1000.0 / 1024.0;
+// Vertical text is placed by FreeType's vertical metrics at the size OpenSCAD sets (1000 times
+// the text's size in 26.6 points at 100 dpi); HarfBuzz's positions are then 26.6 pixels, 1024
+// of them a model unit.
+constexpr double kCharSizeScale = 1000;
+constexpr double kPositionUnit = 1024;
 
 // fontconfig's configuration, loaded once and released at exit (its default global one, from
 // FcInit, is never released).
@@ -129,12 +136,30 @@ Region text_region(const TextParams& p) {
   // Outlines in font units: no hinting, the em square at its design size.
   const double unit = p.size * kEmPerSize / face->units_per_EM;
   // HarfBuzz shapes with its own OpenType tables, in font units (its default scale).
-  hb_blob_t* blob = hb_blob_create_from_file(file.c_str());
-  hb_face_t* hb_face = hb_face_create(blob, 0);
-  hb_font_t* font = hb_font_create(hb_face);
+  // HarfBuzz shapes horizontal text with its own OpenType tables, in font units (its default
+  // scale); vertical text through FreeType at OpenSCAD's size, whose synthesized vertical
+  // metrics (a glyph centred on the pen line, advancing by the typographic line height) are
+  // the ones OpenSCAD's glyphs stand on.
+  const hb_direction_t asked = direction_of(p.direction);
+  const bool vertical = asked != HB_DIRECTION_INVALID && HB_DIRECTION_IS_VERTICAL(asked);
+  hb_blob_t* blob = nullptr;
+  hb_face_t* hb_face = nullptr;
+  hb_font_t* font = nullptr;
+  double position_unit = 0;  // model units per HarfBuzz position unit
+  if (vertical) {
+    if (FT_Set_Char_Size(face, 0, FT_F26Dot6(p.size * kCharSizeScale), 100, 100))
+      throw InvalidInput("text: cannot set the font's size");
+    font = hb_ft_font_create_referenced(face);
+    position_unit = 1 / kPositionUnit;
+  } else {
+    blob = hb_blob_create_from_file(file.c_str());
+    hb_face = hb_face_create(blob, 0);
+    font = hb_font_create(hb_face);
+    position_unit = kAdvanceScale * unit;
+  }
   hb_buffer_t* buf = hb_buffer_create();
   hb_buffer_add_utf8(buf, p.text.c_str(), int(p.text.size()), 0, int(p.text.size()));
-  if (const hb_direction_t d = direction_of(p.direction); d != HB_DIRECTION_INVALID) hb_buffer_set_direction(buf, d);
+  if (asked != HB_DIRECTION_INVALID) hb_buffer_set_direction(buf, asked);
   if (!p.script.empty()) hb_buffer_set_script(buf, hb_script_from_string(p.script.c_str(), int(p.script.size())));
   if (!p.language.empty()) hb_buffer_set_language(buf, hb_language_from_string(p.language.c_str(), int(p.language.size())));
   hb_buffer_guess_segment_properties(buf);
@@ -142,7 +167,6 @@ Region text_region(const TextParams& p) {
   unsigned count = 0;
   const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buf, &count);
   const hb_glyph_position_t* pos = hb_buffer_get_glyph_positions(buf, &count);
-  const bool vertical = HB_DIRECTION_IS_VERTICAL(hb_buffer_get_direction(buf));
   OutlineSink sink;
   sink.unit = unit;
   sink.segments = std::max(1, p.segments);
@@ -152,25 +176,36 @@ Region text_region(const TextParams& p) {
   funcs.conic_to = &OutlineSink::conic_to;
   funcs.cubic_to = &OutlineSink::cubic_to;
   double pen_x = 0, pen_y = 0;
+  // Vertical text: the widest glyph's box (OpenSCAD's, of the glyph hinted at that size, lies
+  // within a few thousandths of the unhinted outline's).
+  double widest = 0;
+  const double pixel = p.size * kCharSizeScale / 72 * 100 / face->units_per_EM;  // 26.6 units per font unit
   for (unsigned i = 0; i < count; ++i) {
     if (FT_Load_Glyph(face, info[i].codepoint, FT_LOAD_NO_SCALE | FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP) == 0 &&
         face->glyph->format == FT_GLYPH_FORMAT_OUTLINE) {
-      sink.dx = (pen_x + pos[i].x_offset * kAdvanceScale) * unit;
-      sink.dy = (pen_y + pos[i].y_offset * kAdvanceScale) * unit;
+      sink.dx = pen_x + pos[i].x_offset * position_unit;
+      sink.dy = pen_y + pos[i].y_offset * position_unit;
       FT_Outline_Decompose(&face->glyph->outline, &funcs, &sink);
+      if (vertical) {
+        FT_BBox box;
+        FT_Outline_Get_CBox(&face->glyph->outline, &box);
+        widest = std::max(widest, (box.xMax - box.xMin) * pixel / kPositionUnit);
+      }
     }
-    pen_x += pos[i].x_advance * kAdvanceScale * p.spacing;
-    pen_y += pos[i].y_advance * kAdvanceScale * p.spacing;
+    pen_x += pos[i].x_advance * position_unit * p.spacing;
+    pen_y += pos[i].y_advance * position_unit * p.spacing;
   }
   hb_buffer_destroy(buf);
   hb_font_destroy(font);
-  hb_face_destroy(hb_face);
-  hb_blob_destroy(blob);
+  if (hb_face) hb_face_destroy(hb_face);
+  if (blob) hb_blob_destroy(blob);
   // FreeType's outer contours run clockwise (TrueType): reverse all, fill by non-zero winding.
   for (Ring& r : sink.rings) std::reverse(r.begin(), r.end());
   Region region = region_union({sink.rings});
   // Alignment: along the line by the advance, across it by the outlines' extent, which
-  // OpenSCAD measures at the advances' scale too.
+  // OpenSCAD measures at the advances' scale too. Vertical text as OpenSCAD 2021 places it:
+  // across the line by the widest glyph's box, along it by the advance (the pen goes down, so
+  // "top" lifts the text above the origin; "bottom" and "baseline" leave it hanging below).
   double lo[2] = {kHuge, kHuge}, hi[2] = {-kHuge, -kHuge};
   for (const Ring& r : region)
     for (const P2& q : r)
@@ -179,19 +214,17 @@ Region text_region(const TextParams& p) {
   for (int a = 0; a < 2; ++a) lo[a] *= kAdvanceScale, hi[a] *= kAdvanceScale;
   double sx = 0, sy = 0;
   if (!vertical) {
-    const double width = pen_x * unit;
+    const double width = pen_x;
     if (p.halign == "center") sx = -width / 2;
     else if (p.halign == "right") sx = -width;
     if (p.valign == "top") sy = -hi[1];
     else if (p.valign == "center") sy = -(lo[1] + hi[1]) / 2;
     else if (p.valign == "bottom") sy = -lo[1];
   } else {
-    if (p.halign == "center") sx = -(lo[0] + hi[0]) / 2;
-    else if (p.halign == "right") sx = -hi[0];
-    else if (p.halign == "left") sx = -lo[0];
-    const double height = pen_y * unit;
-    if (p.valign == "center") sy = -height / 2;
-    else if (p.valign == "bottom") sy = -height;
+    if (p.halign == "center") sx = -widest / 2;
+    else if (p.halign == "right") sx = -widest;
+    if (p.valign == "top") sy = -pen_y;
+    else if (p.valign == "center") sy = -pen_y / 2;
   }
   for (Ring& r : region)
     for (P2& q : r) q[0] += sx, q[1] += sy;
