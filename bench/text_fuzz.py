@@ -8,7 +8,7 @@ font among the installed Liberation and DejaVu faces, spacing, halign, valign, d
 (horizontal and vertical) and $fn/$fa/$fs. OpenSCAD exports the outline as DXF LINEs and the
 .csg; `pic eval x.csg -o pic.dxf --json` gives PIC's area and rings. A case is reported BAD when
 the areas differ by more than 2e-3 (relative) or the drawings' boxes by more than 2e-3 of the
-text's size; the two agree to about 3e-4 otherwise (OpenSCAD's curves and advances are rounded
+drawing's extent (or the text's size, if larger); the two agree to about 3e-4 otherwise (OpenSCAD's curves and advances are rounded
 in 26.6 fixed point). Every case is replayable: OUTDIR/N/m.scad, ref.dxf, pic.dxf.
 """
 import json
@@ -110,8 +110,9 @@ def main():
         rel = abs(pic_area - ref_area) / max(abs(ref_area), 1e-12)
         if ref_box is None or box_pic is None:  # an empty drawing: both must be
             off = 0 if ref_box == box_pic else float("inf")
-        else:
-            off = max(abs(a - b) for a, b in zip(ref_box, box_pic)) / size
+        else:  # relative to the drawing: a long column's advances add up
+            extent = max(size, ref_box[2] - ref_box[0], ref_box[3] - ref_box[1])
+            off = max(abs(a - b) for a, b in zip(ref_box, box_pic)) / extent
         verdict = "BAD" if rel > 2e-3 or off > 2e-3 else "ok"
         bad += verdict == "BAD"
         print(seed, verdict, "area %.2e box %.2e" % (rel, off), scad, flush=True)
