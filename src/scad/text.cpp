@@ -13,6 +13,8 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <string>
+#include <vector>
 
 
 namespace pic::detail::scad {
@@ -122,48 +124,57 @@ hb_direction_t direction_of(const std::string& d) {
   return HB_DIRECTION_INVALID;
 }
 
-}  // namespace
-
-Region text_region(const TextParams& p) {
-  if (p.text.empty() || !(p.size > 0)) return {};
-  const std::string file = font_file(p.font);
-  FT_Library lib = nullptr;
-  if (FT_Init_FreeType(&lib)) throw InvalidInput("text: FreeType could not start");
-  const std::unique_ptr<FT_LibraryRec_, decltype(&FT_Done_FreeType)> lib_guard(lib, FT_Done_FreeType);
-  FT_Face face = nullptr;
-  if (FT_New_Face(lib, file.c_str(), 0, &face)) throw InvalidInput("text: cannot read font file " + file);
-  const std::unique_ptr<FT_FaceRec_, decltype(&FT_Done_Face)> face_guard(face, FT_Done_Face);
-  // Outlines in font units: no hinting, the em square at its design size.
-  const double unit = p.size * kEmPerSize / face->units_per_EM;
-  // HarfBuzz shapes with its own OpenType tables, in font units (its default scale).
-  // HarfBuzz shapes horizontal text with its own OpenType tables, in font units (its default
-  // scale); vertical text through FreeType at OpenSCAD's size, whose synthesized vertical
-  // metrics (a glyph centred on the pen line, advancing by the typographic line height) are
-  // the ones OpenSCAD's glyphs stand on.
-  const hb_direction_t asked = direction_of(p.direction);
-  const bool vertical = asked != HB_DIRECTION_INVALID && HB_DIRECTION_IS_VERTICAL(asked);
+// HarfBuzz's font for shaping: horizontal text with HarfBuzz's own OpenType tables, in font
+// units (its default scale); vertical text through FreeType at OpenSCAD's size, whose
+// synthesized vertical metrics (a glyph centred on the pen line, advancing by the typographic
+// line height) are the ones OpenSCAD's glyphs stand on.
+struct ShapingFont {
   hb_blob_t* blob = nullptr;
-  hb_face_t* hb_face = nullptr;
+  hb_face_t* face = nullptr;
   hb_font_t* font = nullptr;
   double position_unit = 0;  // model units per HarfBuzz position unit
-  if (vertical) {
-    if (FT_Set_Char_Size(face, 0, FT_F26Dot6(p.size * kCharSizeScale), 100, 100))
-      throw InvalidInput("text: cannot set the font's size");
-    font = hb_ft_font_create_referenced(face);
-    position_unit = 1 / kPositionUnit;
-  } else {
-    blob = hb_blob_create_from_file(file.c_str());
-    hb_face = hb_face_create(blob, 0);
-    font = hb_font_create(hb_face);
-    position_unit = kAdvanceScale * unit;
+
+  ShapingFont(FT_Face ft, const std::string& file, bool vertical, double size, double unit) {
+    if (vertical) {
+      if (FT_Set_Char_Size(ft, 0, FT_F26Dot6(size * kCharSizeScale), 100, 100))
+        throw InvalidInput("text: cannot set the font's size");
+      font = hb_ft_font_create_referenced(ft);
+      position_unit = 1 / kPositionUnit;
+    } else {
+      blob = hb_blob_create_from_file(file.c_str());
+      face = hb_face_create(blob, 0);
+      font = hb_font_create(face);
+      position_unit = kAdvanceScale * unit;
+    }
   }
-  hb_buffer_t* buf = hb_buffer_create();
+  ~ShapingFont() {
+    hb_font_destroy(font);
+    if (face) hb_face_destroy(face);
+    if (blob) hb_blob_destroy(blob);
+  }
+  ShapingFont(const ShapingFont&) = delete;
+  ShapingFont& operator=(const ShapingFont&) = delete;
+};
+
+// The glyphs' outlines where HarfBuzz puts them, and where the pen ends.
+struct Line {
+  std::vector<Ring> rings;
+  double pen_x = 0, pen_y = 0;
+  double widest = 0;  // vertical text: the widest glyph's box
+};
+
+Line lay_out(FT_Face face, const std::string& file, const TextParams& p, hb_direction_t direction, bool vertical) {
+  // Outlines in font units: no hinting, the em square at its design size.
+  const double unit = p.size * kEmPerSize / face->units_per_EM;
+  const ShapingFont font(face, file, vertical, p.size, unit);
+  const std::unique_ptr<hb_buffer_t, decltype(&hb_buffer_destroy)> buffer(hb_buffer_create(), hb_buffer_destroy);
+  hb_buffer_t* buf = buffer.get();
   hb_buffer_add_utf8(buf, p.text.c_str(), int(p.text.size()), 0, int(p.text.size()));
-  if (asked != HB_DIRECTION_INVALID) hb_buffer_set_direction(buf, asked);
+  if (direction != HB_DIRECTION_INVALID) hb_buffer_set_direction(buf, direction);
   if (!p.script.empty()) hb_buffer_set_script(buf, hb_script_from_string(p.script.c_str(), int(p.script.size())));
   if (!p.language.empty()) hb_buffer_set_language(buf, hb_language_from_string(p.language.c_str(), int(p.language.size())));
   hb_buffer_guess_segment_properties(buf);
-  hb_shape(font, buf, nullptr, 0);
+  hb_shape(font.font, buf, nullptr, 0);
   unsigned count = 0;
   const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buf, &count);
   const hb_glyph_position_t* pos = hb_buffer_get_glyph_positions(buf, &count);
@@ -175,59 +186,76 @@ Region text_region(const TextParams& p) {
   funcs.line_to = &OutlineSink::line_to;
   funcs.conic_to = &OutlineSink::conic_to;
   funcs.cubic_to = &OutlineSink::cubic_to;
-  double pen_x = 0, pen_y = 0;
-  // Vertical text: the widest glyph's box (OpenSCAD's, of the glyph hinted at that size, lies
-  // within a few thousandths of the unhinted outline's).
-  double widest = 0;
+  Line line;
+  // OpenSCAD measures a glyph's box hinted at its size; the unhinted outline's lies within a
+  // few thousandths of it.
   const double pixel = p.size * kCharSizeScale / 72 * 100 / face->units_per_EM;  // 26.6 units per font unit
   for (unsigned i = 0; i < count; ++i) {
     if (FT_Load_Glyph(face, info[i].codepoint, FT_LOAD_NO_SCALE | FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP) == 0 &&
         face->glyph->format == FT_GLYPH_FORMAT_OUTLINE) {
-      sink.dx = pen_x + pos[i].x_offset * position_unit;
-      sink.dy = pen_y + pos[i].y_offset * position_unit;
+      sink.dx = line.pen_x + pos[i].x_offset * font.position_unit;
+      sink.dy = line.pen_y + pos[i].y_offset * font.position_unit;
       FT_Outline_Decompose(&face->glyph->outline, &funcs, &sink);
       if (vertical) {
         FT_BBox box;
         FT_Outline_Get_CBox(&face->glyph->outline, &box);
-        widest = std::max(widest, (box.xMax - box.xMin) * pixel / kPositionUnit);
+        line.widest = std::max(line.widest, (box.xMax - box.xMin) * pixel / kPositionUnit);
       }
     }
-    pen_x += pos[i].x_advance * position_unit * p.spacing;
-    pen_y += pos[i].y_advance * position_unit * p.spacing;
+    line.pen_x += pos[i].x_advance * font.position_unit * p.spacing;
+    line.pen_y += pos[i].y_advance * font.position_unit * p.spacing;
   }
-  hb_buffer_destroy(buf);
-  hb_font_destroy(font);
-  if (hb_face) hb_face_destroy(hb_face);
-  if (blob) hb_blob_destroy(blob);
-  // FreeType's outer contours run clockwise (TrueType): reverse all, fill by non-zero winding.
-  for (Ring& r : sink.rings) std::reverse(r.begin(), r.end());
-  Region region = region_union({sink.rings});
-  // Alignment: along the line by the advance, across it by the outlines' extent, which
-  // OpenSCAD measures at the advances' scale too. Vertical text as OpenSCAD 2021 places it:
-  // across the line by the widest glyph's box, along it by the advance (the pen goes down, so
-  // "top" lifts the text above the origin; "bottom" and "baseline" leave it hanging below).
-  double lo[2] = {kHuge, kHuge}, hi[2] = {-kHuge, -kHuge};
-  for (const Ring& r : region)
-    for (const P2& q : r)
-      for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
-  if (region.empty()) return region;
-  for (int a = 0; a < 2; ++a) lo[a] *= kAdvanceScale, hi[a] *= kAdvanceScale;
+  line.rings = std::move(sink.rings);
+  return line;
+}
+
+// Where halign and valign move the text. Horizontal: along the line by the advance, across it
+// by the outlines' extent, which OpenSCAD measures at the advances' scale too. Vertical, as
+// OpenSCAD 2021 places it: across the line by the widest glyph's box, along it by the advance
+// (the pen goes down, so "top" lifts the column above the origin; "bottom" and "baseline"
+// leave it hanging below).
+P2 alignment_shift(const Region& region, const TextParams& p, const Line& line, bool vertical) {
   double sx = 0, sy = 0;
-  if (!vertical) {
-    const double width = pen_x;
-    if (p.halign == "center") sx = -width / 2;
-    else if (p.halign == "right") sx = -width;
-    if (p.valign == "top") sy = -hi[1];
-    else if (p.valign == "center") sy = -(lo[1] + hi[1]) / 2;
-    else if (p.valign == "bottom") sy = -lo[1];
-  } else {
-    if (p.halign == "center") sx = -widest / 2;
-    else if (p.halign == "right") sx = -widest;
-    if (p.valign == "top") sy = -pen_y;
-    else if (p.valign == "center") sy = -pen_y / 2;
+  if (vertical) {
+    if (p.halign == "center") sx = -line.widest / 2;
+    else if (p.halign == "right") sx = -line.widest;
+    if (p.valign == "top") sy = -line.pen_y;
+    else if (p.valign == "center") sy = -line.pen_y / 2;
+    return {sx, sy};
   }
+  double lo = kHuge, hi = -kHuge;
+  for (const Ring& r : region)
+    for (const P2& q : r) lo = std::min(lo, q[1]), hi = std::max(hi, q[1]);
+  lo *= kAdvanceScale, hi *= kAdvanceScale;
+  if (p.halign == "center") sx = -line.pen_x / 2;
+  else if (p.halign == "right") sx = -line.pen_x;
+  if (p.valign == "top") sy = -hi;
+  else if (p.valign == "center") sy = -(lo + hi) / 2;
+  else if (p.valign == "bottom") sy = -lo;
+  return {sx, sy};
+}
+
+}  // namespace
+
+Region text_region(const TextParams& p) {
+  if (p.text.empty() || !(p.size > 0)) return {};
+  const std::string file = font_file(p.font);
+  FT_Library lib = nullptr;
+  if (FT_Init_FreeType(&lib)) throw InvalidInput("text: FreeType could not start");
+  const std::unique_ptr<FT_LibraryRec_, decltype(&FT_Done_FreeType)> lib_guard(lib, FT_Done_FreeType);
+  FT_Face face = nullptr;
+  if (FT_New_Face(lib, file.c_str(), 0, &face)) throw InvalidInput("text: cannot read font file " + file);
+  const std::unique_ptr<FT_FaceRec_, decltype(&FT_Done_Face)> face_guard(face, FT_Done_Face);
+  const hb_direction_t direction = direction_of(p.direction);
+  const bool vertical = direction != HB_DIRECTION_INVALID && HB_DIRECTION_IS_VERTICAL(direction);
+  Line line = lay_out(face, file, p, direction, vertical);
+  // FreeType's outer contours run clockwise (TrueType): reverse all, fill by non-zero winding.
+  for (Ring& r : line.rings) std::reverse(r.begin(), r.end());
+  Region region = region_union({line.rings});
+  if (region.empty()) return region;
+  const P2 shift = alignment_shift(region, p, line, vertical);
   for (Ring& r : region)
-    for (P2& q : r) q[0] += sx, q[1] += sy;
+    for (P2& q : r) q[0] += shift[0], q[1] += shift[1];
   return region;
 }
 
