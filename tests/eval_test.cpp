@@ -15,6 +15,7 @@
 #include "pic/primitives.h"
 #include "pic/scad.h"
 #include "scad/scad_detail.h"
+#include "signs/invariants.h"
 #include "support/mesh_checks.h"
 #include "support/temp_dir.h"
 
@@ -462,6 +463,36 @@ TEST(Float32, EvalToStlWritesWhatItChecked) {
   // The exact volume; the written mesh is simplified within half a finest cell (0.11 here) of
   // the raw contour over about 9,700 of area, which moves it by about a thousandth.
   EXPECT_NEAR(volume(m), 46357.5454, 46357.5454 * 2e-3);
+}
+
+// A Boolean combines a few coarse cells a second time around contacts, after stamping more
+// cells, which grows the operands' partial contours: a parity walk in a level-4 leaf of the
+// text then gave a point on such a cell's face the other sign, and the octree held two signs
+// for one lattice point (its loader refused it; the mesh had a boundary edge and three
+// non-manifold edges). Found by the semantics fuzz at depth 9.
+TEST(Eval, ASecondPassKeepsTheSignsTheFirstGave) {
+  const std::string csg = R"(resize(newsize = [3.08,0,3.03], auto = [1,1,1], convexity = 0) {
+  union() {
+    multmatrix([[0.5, 0.612372, 0.612372, 0], [0, 0.707107, -0.707107, 0], [-0.866025, 0.353553, 0.353553, 0], [0, 0, 0, 1]]) {
+      linear_extrude(height = 1, center = false, convexity = 1, scale = [1, 1], $fn = 0, $fa = 12, $fs = 2) {
+        text(text = "g8", size = 3.84, spacing = 1, font = "", direction = "ltr", language = "en", script = "Latn", halign = "right", valign = "baseline", $fn = 0, $fa = 12, $fs = 2);
+      }
+    }
+    multmatrix([[1, 0.3, 0, 0], [0, 1, -0.21, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {
+      rotate_extrude(angle = 360, convexity = 2, $fn = 0, $fa = 5, $fs = 2) {
+        multmatrix([[1, 0, 0, 2.74], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {
+          polygon(points = [[0, 0], [3.7, 3.7], [2.97, 0], [0, 3.64]], paths = undef, convexity = 1);
+        }
+      }
+    }
+  }
+})";
+  EvalOptions o;
+  o.depth = 9;
+  const Octree t = eval_csg(csg, o);
+  EXPECT_NO_THROW(detail::check_octree(t, "eval"));
+  const MeshTopology topo = analyze_topology(contour(t));
+  EXPECT_TRUE(topo.closed() && topo.manifold());
 }
 
 TEST(EvalCli, UnsupportedNodeExits2WithOneLine) {

@@ -3,6 +3,7 @@
 #include "csg/combine.h"
 
 #include "csg/gray_cell.h"
+#include "signs/leaf_walks.h"
 
 namespace pic::detail {
 
@@ -334,6 +335,9 @@ class Combiner {
     std::array<CombineCounts, 8> sub_stats;
     auto task = [&](int c) {
       Operand ca(a_.t, a_.stamps, a_.pc, stamp_), cb(b_.t, b_.stamps, b_.pc, stamp_);
+      // A second pass's outer views are shared: that pass runs without tasks in parallel.
+      ca.outer = a_.outer, ca.held = a_.held, ca.inner = a_.inner;
+      cb.outer = b_.outer, cb.held = b_.held, cb.inner = b_.inner;
       Combiner sub(frags[c], ca, cb, op_, options_, max_depth_, stamp_, parallel_splits_ - 1, parallel_, focus_,
                    sub_stats[c]);
       // Both sides internal here: no sign grid is read.
@@ -507,6 +511,29 @@ std::vector<LeafRef> coarse_gray_leaves_at(const Octree& a, const std::vector<La
   return out;
 }
 
+/// The lattice points on the boundaries of the `cells` (leaves of `t`) that other leaves of `t`
+/// have as corners.
+KeyBits corners_held_around(const Octree& t, const std::vector<LeafRef>& cells) {
+  KeyBits held;
+  std::vector<LeafRef> touching;
+  for (const LeafRef& c : cells) {
+    const int64_t s = c.cell.span();
+    const Lat lo = c.cell.lat, hi{lo[0] + s, lo[1] + s, lo[2] + s};
+    touching.clear();
+    leaves_touching(t, 0, Cell{}, lo, hi, kMaxLevel, touching);
+    for (const LeafRef& l : touching) {
+      bool recombined = false;
+      for (const LeafRef& x : cells) recombined = recombined || x.node == l.node;
+      if (recombined) continue;
+      for (int k = 0; k < 8; ++k) {
+        const Lat q = l.cell.corner(k);
+        if (c.cell.holds(q)) held.insert(lattice_key(q), true);
+      }
+    }
+  }
+  return held;
+}
+
 }  // namespace
 
 /// Combines the stamped cells into A. Every task reads A as it was; the new nodes land after
@@ -537,17 +564,28 @@ std::vector<SignHint> combine_stamped(Octree& a, Stamps& sa, const Octree& b, co
   const std::vector<LeafRef> coarse = coarse_gray_leaves_at(a, corners, depth);
   if (coarse.empty()) return std::move(f.hints);
   // Those leaves' cells combined again from A as it was, split down to the finest level
-  // around the contacts; the rest of the result stays as it is.
+  // around the contacts; the rest of the result stays as it is, and with it the signs its
+  // leaves hold on those cells' boundaries. The focus stamps more cells and grows the partial
+  // contours, so there the operands are asked as the first pass saw them.
+  const KeyBits held = corners_held_around(a, coarse);
   landed.undo(a, sa);
+  const Stamps sa_first = sa, sb_first = sb;
+  const PartialContour pa_first = pa, pb_first = pb;
   prepare_focus(corners);
   const FocusCells focus(corners, depth);
   Fragment again;
   std::vector<Node> roots;
   {
     Operand oa(a, sa, pa, stamp), ob(b, sb, pb, stamp);
+    Operand oa_first(a, sa_first, pa_first, stamp), ob_first(b, sb_first, pb_first, stamp);
+    oa.outer = &oa_first, ob.outer = &ob_first;
+    oa.held = ob.held = &held;
     CombineCounts counts;
     Combiner comb(again, oa, ob, op, options, depth, stamp, 0, false, &focus, counts);
-    for (const LeafRef& l : coarse) roots.push_back(comb.run_at(l.cell));
+    for (const LeafRef& l : coarse) {
+      oa.inner = ob.inner = l.cell;
+      roots.push_back(comb.run_at(l.cell));
+    }
     stats.cells_visited += counts.cells_visited;
     stats.gray_pairs += counts.gray_pairs;
     stats.forced_subdivisions += counts.forced_subdivisions;

@@ -64,6 +64,15 @@ struct Operand {
   const Stamps& stamps;  // per node of t: the operation's stamp where it stamped it
   uint32_t stamp = 0;
 
+  /// A second pass over a few cells of a result (combine.h) must give each lattice point on
+  /// such a cell's boundary that a leaf of the rest of the result has as a corner (`held`) the
+  /// sign the first pass gave it: a parity walk depends on the partial contour, and the focus
+  /// of the second pass stamps more cells and grows it. Those points are asked of `outer`, the
+  /// operand as the first pass saw it; `inner` is the cell being recombined.
+  Operand* outer = nullptr;
+  const KeyBits* held = nullptr;
+  Cell inner;
+
   Operand(const Octree& tree, const Stamps& tree_stamps, const PartialContour& contour, uint32_t op_stamp)
       : t(tree), pc(contour), tris(contour.tris), bvh(contour.bvh), stamps(tree_stamps), stamp(op_stamp) {}
 
@@ -147,6 +156,7 @@ struct Operand {
   bool sign(const Lat& p) {
     // Every lattice point is asked for by up to 8 cells: remember all answers, not only the
     // ones that needed a parity walk.
+    if (held_outside(p)) return outer->sign(p);
     const uint64_t key = lattice_key(p);
     if (const int m = memo.find(key); m >= 0) return m;
     const Hit h = find(0, Cell{}, p);
@@ -160,9 +170,8 @@ struct Operand {
   /// sign_X(p) for p known to lie in the closed cell of gray leaf `leaf`: a point strictly
   /// inside it needs no search from the root.
   bool sign_in(const Lat& p, uint32_t leaf, const Cell& cell) {
-    const int64_t s = cell.span();
-    for (int k = 0; k < 3; ++k)
-      if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return sign(p);
+    if (!strictly_inside(cell, p)) return sign(p);
+    if (held_outside(p)) return outer->sign_in(p, leaf, cell);
     if (const int m = memo.find(lattice_key(p)); m >= 0) return m;
     return classify(p, leaf, cell);
   }
@@ -198,6 +207,16 @@ struct Operand {
   }
 
  private:
+  bool held_outside(const Lat& p) const {
+    return outer && !strictly_inside(inner, p) && held->find(lattice_key(p)) >= 0;
+  }
+  static bool strictly_inside(const Cell& cell, const Lat& p) {
+    const int64_t s = cell.span();
+    for (int k = 0; k < 3; ++k)
+      if (p[k] <= cell.lat[k] || p[k] >= cell.lat[k] + s) return false;
+    return true;
+  }
+
   uint32_t last_leaf_ = ~uint32_t{0};  // the leaf classify asked last, its triangles and anchor
   const std::vector<uint32_t>* last_tris_ = nullptr;
   int last_anchor_ = 0;
