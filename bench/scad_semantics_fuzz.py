@@ -10,7 +10,9 @@ twist, scale (even, uneven, to a point) and wall diagonals; rotate_extrude by an
 booleans, offsets, hulls and Minkowski sums; polygons with holes or crossing themselves;
 projections; text; rounded boxes; `%` and `*` parts; resize with auto; mirrors and shears. A case is reported when PIC's volume differs from OpenSCAD's CGAL render by more
 than 0.5 % at DEPTH and two levels deeper still by more than 0.1 % and more than half as much
-(sampling error shrinks with the cell, a different shape does not). OpenSCAD itself fails on some models (a twisted
+(sampling error shrinks with the cell, a different shape does not), and every model PIC
+does not refuse (exit 2) but fails on: an invalid solid written (exit 4), an internal error, a
+crash or a timeout. OpenSCAD itself fails on some models (a twisted
 extrusion to a point with a hole is not closed, and CGAL then drops it from the Boolean): its
 stderr is kept in OUTDIR/SEED/openscad.err and a reported line says when it holds an ERROR:
 read it before calling a case PIC's. A negative OpenSCAD volume (a polyhedron whose faces
@@ -130,15 +132,18 @@ def volume(path):
 
 
 def pic_volume(csg, out, depth):
-    """PIC's volume, or None and the reason."""
+    """PIC's volume, or None and the reason; the reason starts with FAILED when PIC did not
+    refuse the model (exit 2) but wrote an invalid solid (exit 4), failed inside (3) or crashed."""
     try:
         run = subprocess.run([PIC, "eval", csg, "-o", out, "--depth", str(depth), "--json"],
                              capture_output=True, text=True, timeout=300)
         if run.returncode != 0:
-            return None, run.stderr.strip().splitlines()[-1] if run.stderr.strip() else "exit %d" % run.returncode
+            line = run.stderr.strip().splitlines()[-1] if run.stderr.strip() else ""
+            failed = "FAILED exit %d: " % run.returncode if run.returncode != 2 else ""
+            return None, failed + (line or "exit %d" % run.returncode)
         return json.loads(run.stdout)["volume"], ""
     except (subprocess.SubprocessError, ValueError, KeyError) as e:
-        return None, str(e)
+        return None, "FAILED " + str(e)
 
 
 def main():
@@ -164,6 +169,10 @@ def main():
                 continue
         expected = volume(ref) if os.path.exists(ref) else None
         got, why = pic_volume(csg, os.path.join(d, "pic.stl"), depth)
+        if why.startswith("FAILED"):
+            reported += 1
+            print(seed, "PIC", why)
+            continue
         if expected is None or got is None:
             print(seed, "skipped: pic %s, openscad %s %s" % (got, expected, why))
             continue
