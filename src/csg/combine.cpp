@@ -2,6 +2,8 @@
 // fragments that land in A once every task is done. See combine.h.
 #include "csg/combine.h"
 
+#include <algorithm>
+
 #include "csg/gray_cell.h"
 #include "signs/leaf_walks.h"
 
@@ -514,6 +516,9 @@ std::vector<LeafRef> coarse_gray_leaves_at(const Octree& a, const std::vector<La
 /// The lattice points on the boundaries of the `cells` (leaves of `t`) that other leaves of `t`
 /// have as corners.
 KeyBits corners_held_around(const Octree& t, const std::vector<LeafRef>& cells) {
+  std::vector<uint32_t> recombined;
+  for (const LeafRef& c : cells) recombined.push_back(c.node);
+  std::sort(recombined.begin(), recombined.end());
   KeyBits held;
   std::vector<LeafRef> touching;
   for (const LeafRef& c : cells) {
@@ -522,9 +527,7 @@ KeyBits corners_held_around(const Octree& t, const std::vector<LeafRef>& cells) 
     touching.clear();
     leaves_touching(t, 0, Cell{}, lo, hi, kMaxLevel, touching);
     for (const LeafRef& l : touching) {
-      bool recombined = false;
-      for (const LeafRef& x : cells) recombined = recombined || x.node == l.node;
-      if (recombined) continue;
+      if (std::binary_search(recombined.begin(), recombined.end(), l.node)) continue;
       for (int k = 0; k < 8; ++k) {
         const Lat q = l.cell.corner(k);
         if (c.cell.holds(q)) held.insert(lattice_key(q), true);
