@@ -79,7 +79,6 @@ class FlatMerger {
 
   TriMesh result() const { return live_mesh(pos_, tris_, alive_); }
 
-
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
   const std::vector<uint8_t>* keep_;  // per vertex: its star stays as it is (none: all may merge)

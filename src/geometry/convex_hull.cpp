@@ -11,6 +11,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "geometry/live_mesh.h"
 #include "geometry/predicates.h"
 #include "geometry/vec3.h"
 
@@ -30,8 +31,7 @@ size_t farthest(const std::vector<Vec3>& pts, const F& score) {
 }  // namespace
 
 TriMesh convex_hull(const std::vector<Vec3>& pts) {
-  TriMesh out;
-  if (pts.size() < 4) return out;
+  if (pts.size() < 4) return {};
   // A first tetrahedron of far-apart points (a leftmost one, the farthest from it, the farthest
   // from their line, the farthest from their plane); none when all points are coplanar.
   const size_t i0 = farthest(pts, [](const Vec3& p) { return -p[0]; });
@@ -45,13 +45,13 @@ TriMesh convex_hull(const std::vector<Vec3>& pts) {
   size_t i3 = farthest(pts, [&](const Vec3& p) { return std::abs(dot3(n, sub3(p, pts[i0]))); });
   int side = orient3d(pts[i0], pts[i1], pts[i2], pts[i3]);
   for (size_t i = 0; i < pts.size() && side == 0; ++i) side = orient3d(pts[i0], pts[i1], pts[i2], pts[i3 = i]);
-  if (side == 0) return out;  // flat (or fewer than 3 distinct non-collinear points)
+  if (side == 0) return {};  // flat (or fewer than 3 distinct non-collinear points)
 
   std::vector<std::array<uint32_t, 3>> faces;  // outward by the right-hand rule
-  std::vector<bool> alive;
+  std::vector<uint8_t> alive;
   const auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
     faces.push_back({a, b, c});
-    alive.push_back(true);
+    alive.push_back(1);
   };
   const uint32_t t0 = uint32_t(i0), t1 = uint32_t(i1), t2 = uint32_t(i2), t3 = uint32_t(i3);
   if (side > 0) {  // t3 on the side (t0, t1, t2) faces: that face points inward
@@ -72,7 +72,7 @@ TriMesh convex_hull(const std::vector<Vec3>& pts) {
     for (size_t f : visible)
       for (int k = 0; k < 3; ++k) edges.insert(uint64_t(faces[f][k]) << 32 | faces[f][(k + 1) % 3]);
     for (size_t f : visible) {
-      alive[f] = false;
+      alive[f] = 0;
       --live;
       for (int k = 0; k < 3; ++k) {
         const uint32_t a = faces[f][k], b = faces[f][(k + 1) % 3];
@@ -87,24 +87,10 @@ TriMesh convex_hull(const std::vector<Vec3>& pts) {
       for (size_t f = 0; f < faces.size(); ++f)
         if (alive[f]) faces[kept++] = faces[f];
       faces.resize(kept);
-      alive.assign(kept, true);
+      alive.assign(kept, 1);
     }
   }
-  std::vector<uint32_t> remap(pts.size(), UINT32_MAX);
-  for (size_t f = 0; f < faces.size(); ++f) {
-    if (!alive[f]) continue;
-    std::array<uint32_t, 3> tri;
-    for (int k = 0; k < 3; ++k) {
-      uint32_t& r = remap[faces[f][k]];
-      if (r == UINT32_MAX) {
-        r = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(pts[faces[f][k]]);
-      }
-      tri[k] = r;
-    }
-    out.triangles.push_back(tri);
-  }
-  return out;
+  return live_mesh(pts, faces, alive);
 }
 
 }  // namespace pic::detail
