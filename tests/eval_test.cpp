@@ -466,10 +466,10 @@ TEST(Float32, EvalToStlWritesWhatItChecked) {
 }
 
 // A Boolean combines a few coarse cells a second time around contacts, after stamping more
-// cells, which grows the operands' partial contours: a parity walk in a level-4 leaf of the
-// text then gave a point on such a cell's face the other sign, and the octree held two signs
-// for one lattice point (its loader refused it; the mesh had a boundary edge and three
-// non-manifold edges). Found by the semantics fuzz at depth 9.
+// cells, which grows the operands' partial contours. Here a parity walk in a level-4 leaf of
+// the text can turn at a point on such a cell's face that finer leaves beside the cell hold as
+// a corner: that point must keep one sign, or the contour has a boundary edge and
+// non-manifold edges at depth 9.
 TEST(Eval, ASecondPassKeepsTheSignsTheFirstGave) {
   const std::string csg = R"(resize(newsize = [3.08,0,3.03], auto = [1,1,1], convexity = 0) {
   union() {
