@@ -247,7 +247,6 @@ class Simplifier {
   /// The simplified mesh; `kept[i]`: the vertex of the input that output vertex i is.
   TriMesh result(std::vector<uint32_t>& kept) const { return detail::live_mesh(pos_, tris_, alive_, &kept); }
 
-
  private:
   std::vector<Vec3> pos_;
   const std::vector<Vec3> original_;
