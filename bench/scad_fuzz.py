@@ -46,6 +46,22 @@ def model(r, level=0):
     return op + "(){ " + " ".join(model(r, level + 1) for _ in range(r.randint(2, 4))) + " }"
 
 
+def stl_volume(path):
+    """The volume an ASCII STL encloses (OpenSCAD's export): zero for a sheet without inside."""
+    corners, volume = [], 0.0
+    with open(path) as f:
+        for line in f:
+            w = line.split()
+            if w and w[0] == "vertex":
+                corners.append([float(c) for c in w[1:4]])
+                if len(corners) == 3:
+                    a, b, c = corners
+                    volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                               a[2] * (b[0] * c[1] - b[1] * c[0])) / 6
+                    corners = []
+    return volume
+
+
 def run_case(seed, depth, out):
     d = os.path.join(out, str(seed))
     os.makedirs(d, exist_ok=True)
@@ -62,6 +78,9 @@ def run_case(seed, depth, out):
     j = json.loads(p.stdout)
     if ref_empty:
         return None if j.get("pics", 0) == 0 else "OpenSCAD's render is empty, PIC's is not"
+    if j.get("triangles", 0) == 0:
+        v = stl_volume(ref)
+        return None if abs(v) < 1e-9 else f"PIC's result is empty, OpenSCAD's has volume {v:.6g}"
     cell = j["cube"]["size"] / 2 ** depth
     c = subprocess.run([PIC, "compare", os.path.join(d, "pic.stl"), ref, "--unit", str(cell), "--json"],
                        capture_output=True, text=True)

@@ -221,6 +221,50 @@ TEST(Csg, BoxMinusBoxLeavesThinWall) {
   expect_exact_box_result(a, b, CsgOp::Subtract, 8, 0.125 - 0.48 * 0.48 * 0.49);
 }
 
+/// Area of the convex polygon `p` (counter-clockwise) on the side y < y0 (below) or y > y0.
+double area_beyond(std::vector<std::array<double, 2>> p, double y0, bool below) {
+  std::vector<std::array<double, 2>> kept;
+  const auto in = [&](const std::array<double, 2>& q) { return below ? q[0] < y0 : q[0] > y0; };
+  for (size_t i = 0; i < p.size(); ++i) {
+    const auto& a = p[i];
+    const auto& b = p[(i + 1) % p.size()];
+    if (in(a)) kept.push_back(a);
+    if (in(a) != in(b)) {
+      const double t = (y0 - a[0]) / (b[0] - a[0]);
+      kept.push_back({y0, a[1] + t * (b[1] - a[1])});
+    }
+  }
+  double twice = 0;
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const auto& a = kept[i];
+    const auto& b = kept[(i + 1) % kept.size()];
+    twice += a[0] * b[1] - b[0] * a[1];
+  }
+  return std::abs(twice) / 2;
+}
+
+// A cube turned 17 degrees about its edge on the x axis, minus a box with a corner at the
+// same point, whose faces x = 0 and z = 0 hold that edge: each operand is one PIC per octant,
+// and in the octant holding the common corner both have the same corner signs and a vertex on
+// that corner. The two leaves still stand for different surfaces (their polygons run to
+// different neighbours), so the Boolean must compute the cell, not take it for A - A.
+TEST(Csg, LeavesWithTheSameDataButDifferentSurfacesAreCombined) {
+  const double s = 1.95, turn = 17 * std::numbers::pi / 180;
+  const Vec3 box{3.88, 1.42, 3.28};
+  const TriMesh a = transformed(make_box({0, 0, 0}, {s, s, s}), rotation({1, 0, 0}, turn), {0, 0, 0});
+  const TriMesh b = make_box({0, 0, 0}, box);
+  const Cube cube{{-0.2425, -1.535, -0.5425}, 4.365};
+  const Octree r = csg(sample_in_unit(a, 10, cube), sample_in_unit(b, 10, cube), CsgOp::Subtract);
+  const TriMesh m = unsplit_contour(r);
+  ASSERT_TRUE(IsClosedManifold(m));
+  // The box spans the cube along x and above it, so the result is the turned square (in y, z)
+  // outside the strip 0 < y < box y, times the side.
+  const double c = std::cos(turn), sn = std::sin(turn);
+  const std::vector<std::array<double, 2>> square{{0, 0}, {s * c, s * sn}, {s * (c - sn), s * (sn + c)}, {-s * sn, s * c}};
+  const double exact = s * (area_beyond(square, 0, true) + area_beyond(square, box[1], false));
+  EXPECT_NEAR(volume(m), exact, 2e-3 * exact);
+}
+
 TEST(Csg, IntersectionOfRotatedBoxes) {
   // An axis box and a diamond prism (45 degrees about z): an octagonal prism.
   const Box a = axis_box({0.3, 0.3, 0.3}, {0.7, 0.7, 0.6});

@@ -359,9 +359,11 @@ class Combiner {
   Node gray_cell(const Cell& cell, const Side& a, const Side& b) {
     ++stats_.gray_pairs;
     const uint8_t sr = apply_mask(op_, a.signs, b.signs);
-    // The same PIC in both operands (A op A, or untouched common history): nothing to compute.
+    // The same PIC and the same surface in both operands (A op A, or untouched common
+    // history): nothing to compute.
     if (a.real && b.real && a.signs == b.signs &&
-        a_.t.vertices[a_.t.nodes[a.node].index] == b_.t.vertices[b_.t.nodes[b.node].index]) {
+        a_.t.vertices[a_.t.nodes[a.node].index] == b_.t.vertices[b_.t.nodes[b.node].index] &&
+        same_surface(a_, a, b_, b)) {
       if (op_ == CsgOp::Subtract) return uniform(false);
       return copy_side(a_, a, cell, false, true);
     }

@@ -1,6 +1,9 @@
 // GraycellCSG's predicates (paper Figure 3): whether the summed QEF's vertex may stand for the
 // result in a cell, or the cell must be subdivided. See gray_cell.h.
 #include "csg/gray_cell.h"
+
+#include <algorithm>
+
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 
@@ -156,6 +159,18 @@ EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Opera
     }
   }
   return v;
+}
+
+bool same_surface(const Operand& xa, const Side& a, const Operand& xb, const Side& b) {
+  if (a.idx.size() != b.idx.size()) return false;
+  const auto corners = [](const Operand& x, const Side& s) {
+    std::vector<std::array<I3, 3>> v;
+    v.reserve(s.idx.size());
+    for (uint32_t k : s.idx) v.push_back(x.tris[k].v);
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  return corners(xa, a) == corners(xb, b);
 }
 
 /// Whether the two operands' partial contours meet inside the cell.

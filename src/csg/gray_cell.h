@@ -31,6 +31,11 @@ EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Opera
 /// faces, edges or corners, such as a box minus a box that shares its faces): the result there
 /// is one operand's surface or none, with no new feature to refine toward.
 bool surfaces_coincide(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
+/// Whether the operands' partial contours over the cell are the same triangles. A leaf's signs
+/// and vertex alone do not fix the surface in its cell: its polygons also run to the
+/// neighbours' vertices, so two solids can share a leaf's data there and still differ (two
+/// boxes with a common corner, each with a vertex on it).
+bool same_surface(const Operand& xa, const Side& a, const Operand& xb, const Side& b);
 /// Whether the two operands' partial contours meet inside the cell.
 bool surfaces_meet(const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell);
 
