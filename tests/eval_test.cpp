@@ -551,5 +551,51 @@ TEST(EvalCli, ScadEvaluatesTheRenderTreeNotThePreview) {
   for (const Vec3& p : m.positions) EXPECT_LT(p[0], 2.5);  // nothing where the preview cube is
 }
 
+/// `body` moved by (x, y, z), as OpenSCAD's .csg export writes it.
+std::string moved(double x, double y, double z, const std::string& body) {
+  std::ostringstream s;
+  s << "multmatrix([[1, 0, 0, " << x << "], [0, 1, 0, " << y << "], [0, 0, 1, " << z << "], [0, 0, 0, 1]]) { " << body
+    << " }";
+  return s.str();
+}
+
+// A part cut in half by a box twenty times its size: the root cube is around the half that
+// remains, not around the box, so the cut keeps the part's resolution (around the box the
+// finest cell was ten times larger and the half sphere 0.12 % short of its volume).
+TEST(Eval, APartCutByAHugeBoxKeepsItsResolution) {
+  EvalOptions o;
+  o.depth = 8;
+  const std::string sphere = "sphere($fn = 48, $fa = 12, $fs = 2, r = 10);";
+  EvalStats whole_stats, half_stats;
+  const double whole = volume(unsplit_contour(eval_csg(sphere, o, &whole_stats)));
+  const std::string box = moved(-100, -100, -200, "cube(size = [200, 200, 200], center = false);");
+  const TriMesh half = unsplit_contour(eval_csg("difference() { " + sphere + " " + box + " }", o, &half_stats));
+  EXPECT_TRUE(test::IsClosedManifold(half));
+  EXPECT_LT(half_stats.cube.size, 1.2 * whole_stats.cube.size);
+  // The faceted sphere's rings are symmetric about z = 0.
+  EXPECT_NEAR(volume(half), whole / 2, 2e-4 * whole / 2);
+  for (const Vec3& p : half.positions) EXPECT_GE(p[2], -1e-6 * half_stats.cube.size);
+}
+
+// The cube may follow the result only where the leaves reaching out of it can be cut to it:
+// a cutter that is not convex (an extruded L) keeps the cube around every leaf, and so does a
+// hull, whose parts outside shape what is inside.
+TEST(Eval, LeavesThatCannotBeCutKeepTheCubeAroundThemAll) {
+  EvalOptions o;
+  o.depth = 6;
+  const std::string part = "cube(size = [10, 10, 10], center = false);";
+  const std::string l_cutter = moved(
+      -100, -100, 5,
+      "linear_extrude(height = 200, center = false, convexity = 1, scale = [1, 1], $fn = 0, $fa = 12, $fs = 2) { "
+      "polygon(points = [[0, 0], [200, 0], [200, 50], [50, 50], [50, 200], [0, 200]], paths = undef, convexity = 1); }");
+  const std::string hull_cutter = "hull() { " + moved(-100, -100, 5, "cube(size = [1, 1, 1], center = false);") + " " +
+                                  moved(100, 100, 150, "cube(size = [1, 1, 1], center = false);") + " }";
+  for (const std::string& cutter : {l_cutter, hull_cutter}) {
+    EvalStats st;
+    eval_csg("difference() { " + part + " " + cutter + " }", o, &st);
+    EXPECT_GT(st.cube.size, 150) << cutter;
+  }
+}
+
 }  // namespace
 }  // namespace pic

@@ -328,21 +328,21 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
   EvalOptions first = options;
   if (options.smooth) first.smooth = false;
   Solid model = lower(0, &st.nodes);
-  Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
-  solid_bounds(model, lo, hi, st.leaves, st.triangles);
+  const auto count_leaves = [&] {
+    Vec3 lo{detail::kHuge, detail::kHuge, detail::kHuge}, hi{-detail::kHuge, -detail::kHuge, -detail::kHuge};
+    st.leaves = st.triangles = 0;
+    solid_bounds(model, lo, hi, st.leaves, st.triangles);
+  };
+  count_leaves();
   if (model.kind == Solid::Kind::Empty || st.leaves == 0) throw InvalidInput(source + ": the model is empty");
-  TriMesh corners;
-  corners.positions = {lo, hi};
-  st.cube = bounding_cube(corners);
+  st.cube = root_cube(model);
   if (options.smooth) {
     // Second pass: tessellate against the finest cell of the cube found above.
     model = lower(st.cube.size / double(int64_t{1} << options.depth), nullptr);
-    Vec3 lo2 = lo, hi2 = hi;
-    st.leaves = st.triangles = 0;
-    solid_bounds(model, lo2, hi2, st.leaves, st.triangles);
-    corners.positions = {lo2, hi2};
-    st.cube = bounding_cube(corners);
+    st.cube = root_cube(model);
   }
+  count_leaves();
+  if (st.leaves == 0) throw InvalidInput(source + ": the model is empty");
   st.mesh_seconds = since(t0);
   if (options.progress)
     options.progress("sampling " + std::to_string(st.leaves) + " leaves (" + std::to_string(st.triangles) +

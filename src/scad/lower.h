@@ -49,6 +49,10 @@ inline bool boxes_apart(const std::array<Vec3, 2>& a, const std::array<Vec3, 2>&
 
 /// Grows [lo, hi] by the leaves' vertices; counts the leaves and their triangles.
 void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& triangles);
+/// The root cube to evaluate `model` in: around where its result can lie when that cube is at
+/// most half the one around all its leaves, the leaves reaching out of it cut to it; else
+/// around all the leaves (a hull, a sum or a leaf that is not convex reaching out) (root_cube.cpp).
+Cube root_cube(Solid& model);
 /// The surface of a lowered 3D subtree: a leaf's own mesh, else its Booleans evaluated on
 /// octrees (options.depth, in the subtree's own cube) and contoured (evaluate.cpp).
 TriMesh solid_surface(const Solid& s, const EvalOptions& options);
