@@ -561,7 +561,7 @@ std::string moved(double x, double y, double z, const std::string& body) {
 
 // A part cut in half by a box twenty times its size: the root cube is around the half that
 // remains, not around the box, so the cut keeps the part's resolution (around the box the
-// finest cell was ten times larger and the half sphere 0.12 % short of its volume).
+// finest cell would be ten times larger and the half sphere 0.12 % short of its volume).
 TEST(Eval, APartCutByAHugeBoxKeepsItsResolution) {
   EvalOptions o;
   o.depth = 8;
