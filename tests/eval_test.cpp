@@ -577,6 +577,27 @@ TEST(Eval, APartCutByAHugeBoxKeepsItsResolution) {
   for (const Vec3& p : half.positions) EXPECT_GE(p[2], -1e-6 * half_stats.cube.size);
 }
 
+// A subtree whose shape `resize` needs is evaluated in the cube around its own result too: the
+// half of a unit sphere cut by a 200-unit box, scaled up tenfold, is the half of the sphere
+// scaled tenfold, not a blob sampled at the box's resolution.
+TEST(Eval, AResizedPartCutByAHugeBoxKeepsItsResolution) {
+  EvalOptions o;
+  o.depth = 8;
+  const std::string box = moved(-100, -100, -200, "cube(size = [200, 200, 200], center = false);");
+  const std::string small = "sphere($fn = 48, $fa = 12, $fs = 2, r = 1);";
+  const std::string big = "multmatrix([[10, 0, 0, 0], [0, 10, 0, 0], [0, 0, 10, 0], [0, 0, 0, 1]]) { " + small + " }";
+  // OpenSCAD's sphere of 48 fragments has its rings at polar angles (i + 1/2)·180°/24: it
+  // reaches cos(3.75°) of its radius along every axis, and resize fits that reach.
+  const double reach = std::cos(3.75 * std::numbers::pi / 180);
+  const double expected =
+      volume(unsplit_contour(eval_csg("difference() { " + big + " " + box + " }", o))) / std::pow(reach, 3);
+  const TriMesh resized = unsplit_contour(eval_csg(
+      "resize(newsize = [20, 20, 10], auto = [0, 0, 0]) { difference() { " + small + " " + box + " } }", o));
+  EXPECT_TRUE(test::IsClosedManifold(resized));
+  EXPECT_NEAR(volume(resized), expected, 2e-3 * expected);
+  for (const Vec3& p : resized.positions) EXPECT_GE(p[2], -1e-3);
+}
+
 // The cube may follow the result only where the leaves reaching out of it can be cut to it:
 // a cutter that is not convex (an extruded L) keeps the cube around every leaf, and so does a
 // hull, whose parts outside shape what is inside.

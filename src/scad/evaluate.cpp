@@ -288,15 +288,17 @@ void solid_bounds(const Solid& s, Vec3& lo, Vec3& hi, size_t& leaves, size_t& tr
 
 TriMesh solid_surface(const Solid& s, const EvalOptions& options) {
   if (s.kind == Solid::Kind::Mesh) return s.mesh;
+  // In the cube around where the subtree's result can lie, as a whole model's: a small
+  // remnant of big operands keeps its own resolution (a resize then scales it up).
+  Solid model = s;
+  const Cube cube = root_cube(model);
   Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
   size_t leaves = 0, tris = 0;
-  solid_bounds(s, lo, hi, leaves, tris);
+  solid_bounds(model, lo, hi, leaves, tris);
   if (leaves == 0) return {};
-  TriMesh corners;
-  corners.positions = {lo, hi};
   EvalOptions o = options;
   o.progress = nullptr;
-  const std::optional<Octree> t = evaluate_model(s, o, bounding_cube(corners), leaves, nullptr);
+  const std::optional<Octree> t = evaluate_model(model, o, cube, leaves, nullptr);
   if (!t) return {};
   return contour(*t);
 }
