@@ -456,10 +456,14 @@ TEST(Offset, NoCoarseLeafHidesOrInventsSurface) {
   // cad_part (a 0.05 wall between a hole and a face) at depth 9 in a cube of 0.66: shrunk by
   // 20 cells the wall goes, leaving a slot, and a level-2 cell's crossings fit the hole's
   // curved offset and the face's plane as one crease (a diamond 0.13 wide through the face);
-  // grown by 20 cells, a level-3 cell's polygons would cut across the rounded rim of the hole.
+  // grown by 20 cells, a level-3 cell's polygons would cut across the rounded rim of the hole;
+  // grown by 100, the floor under the hole dips 2.5 cells (the rim's round) between four
+  // level-3 leaves whose corners and octant centres all lie on the flat part, and only their
+  // polygons' middles see it.
   const TriMesh part = read_mesh(dir + "/cad_part.obj");
   for (const auto& [cells, origin, size] :
-       {std::tuple{-20.0, Vec3{-0.33, -0.33, -0.23}, 0.66}, std::tuple{20.0, Vec3{-0.361, -0.361, -0.261}, 0.722}}) {
+       {std::tuple{-20.0, Vec3{-0.33, -0.33, -0.23}, 0.66}, std::tuple{20.0, Vec3{-0.361, -0.361, -0.261}, 0.722},
+        std::tuple{100.0, Vec3{-0.55, -0.55, -0.45}, 1.1}}) {
     SampleOptions o = at_depth(9);
     o.cube = Cube{origin, size};
     const double cell = size / 512, d = cells * cell;
@@ -469,6 +473,26 @@ TEST(Offset, NoCoarseLeafHidesOrInventsSurface) {
     if (cells > 0) EXPECT_LE(e.back_worst, cell) << cells << " cells";
     std::printf("  [measure] cad_part offset by %g cells: %.3f / %.3f cells both ways\n", cells, e.worst / cell,
                 e.back_worst / cell);
+  }
+}
+
+// A coarse leaf's planes are its own edges' crossings, its polygons run to its neighbours'
+// vertices: a faceted sphere of 6 segments shrunk by a third of a unit has a leaf holding a
+// corner of the top cap whose polygons, straight across the equator's crease to vertices
+// below it, cut the solid half a unit deep at every depth. Each polygon must keep to the
+// surface between its vertices.
+TEST(Offset, PolygonsOfACoarseLeafKeepToTheSurface) {
+  const TriMesh ball = make_sphere({0, 0, 0}, 4, 6);
+  for (const int depth : {8, 9}) {
+    const Octree t = offset(ball, -0.3125, at_depth(depth));
+    const TriMesh m = contour(t);
+    expect_valid(m);
+    const double cell = finest_cell(t);
+    const OffsetDistance e = offset_distance(m, ball, -0.3125, 20000);
+    EXPECT_LE(e.worst, cell) << "depth " << depth;
+    EXPECT_LE(e.back_worst, cell) << "depth " << depth;
+    std::printf("  [measure] 6-segment sphere shrunk at depth %d: %.3f / %.3f cells both ways\n", depth,
+                e.worst / cell, e.back_worst / cell);
   }
 }
 

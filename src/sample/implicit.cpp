@@ -22,6 +22,7 @@
 #include "geometry/vec3.h"
 #include "octree/cell.h"
 #include "octree/cell_vertex.h"
+#include "octree/dual_walk.h"
 #include "pic/sample.h"
 #include "signs/invariants.h"
 #include "signs/settle.h"
@@ -111,6 +112,12 @@ struct Memos {
   PointMemo points;
   EdgeMemo edges;
 };
+
+/// Leaves within this many levels of the cap are not asked whether they hide surface: a sheet
+/// hidden in one moves the surface by less than its size, 4 finest cells, and asking them
+/// doubled the values an offset takes (spot grown at depth 10: 2.15 M instead of 1.13 M) for
+/// no change measured.
+constexpr int kUncheckedLevels = 2;
 
 /// A cell waiting at its level, with f at its corners.
 struct Job {
@@ -378,7 +385,7 @@ class LevelSampler {
       const double off = reach(fv[i]);
       fits[fitting[i]] = off * off < error_;
     }
-    keep_only_whole_surfaces(jobs, cand, cell_edges, edges, sol, fits);
+    keep_only_whole_surfaces(jobs, cand, cell_edges, edges, fits);
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
       const uint8_t signs = signs_of(j.v);
@@ -402,20 +409,15 @@ class LevelSampler {
   /// which bounds the distance from c to the surface from below, must not say the surface is
   /// nearer than every plane. Every point of the cell lies within an octant's half-diagonal of
   /// its centre, so a sheet anywhere in the cell shows in some octant's bound; a sheet the
-  /// bound cannot tell from a plane lies about as near c as the plane does.
-  ///
-  /// Leaves within kUncheckedLevels of the cap are not asked: a sheet hidden in one moves the
-  /// surface by less than its size, 4 finest cells, and asking them doubled the values an
-  /// offset takes (spot grown at depth 10: 2.15 M instead of 1.13 M) for no change measured.
-  static constexpr int kUncheckedLevels = 2;
+  /// bound cannot tell from a plane lies about as near c as the plane does. Leaves within
+  /// kUncheckedLevels of the cap are not asked. Where the leaf's polygons run, between its
+  /// vertex and its neighbours', is asked once the tree is whole (refine_polygons_off_surface).
   void keep_only_whole_surfaces(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
                                 const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
-                                const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
+                                std::vector<char>& fits) {
     std::vector<size_t> asked;
     for (size_t k = 0; k < cand.size(); ++k)
       if (fits[k] && jobs[cand[k]].cell.level + kUncheckedLevels < max_depth_) asked.push_back(k);
-    chords_on_surface(asked, cell_edges, edges, sol, fits);
-    std::erase_if(asked, [&](size_t k) { return !fits[k]; });
     octants_agree(jobs, cand, asked, cell_edges, edges, fits);
   }
 
@@ -424,27 +426,6 @@ class LevelSampler {
 
   /// The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
   double sheet_tolerance() const { return 2 * std::sqrt(error_); }
-
-  /// A leaf's polygons run from its vertex to its edges' crossings: on a sheet that curves away
-  /// from them between (a hole's rounded rim taken for the corner of its tangent planes, its
-  /// vertex on the flat part) the chords' middles leave the surface. Clears `fits` of the
-  /// leaves `asked` where one does.
-  void chords_on_surface(const std::vector<size_t>& asked, const std::vector<std::array<uint32_t, 12>>& cell_edges,
-                         const std::vector<Edge>& edges, const std::vector<Qef::Solution>& sol,
-                         std::vector<char>& fits) {
-    std::vector<size_t> first;
-    std::vector<Vec3> middles;
-    for (size_t k : asked) {
-      first.push_back(middles.size());
-      for (uint32_t id : cell_edges[k])
-        if (id != kNone) middles.push_back(scale3(add3(sol[k].position, edges[id].x), 0.5));
-    }
-    first.push_back(middles.size());
-    const std::vector<double> f = values(middles);
-    for (size_t i = 0; i < asked.size(); ++i)
-      for (size_t c = first[i]; c < first[i + 1]; ++c)
-        if (reach(f[c]) > sheet_tolerance()) fits[asked[i]] = 0;
-  }
 
   /// Each octant of the leaves `asked`, at its centre c, but those their own corner clears (|f|
   /// there beyond the octant's diagonal: no surface in it): c on the side of the nearest plane
@@ -684,6 +665,96 @@ void refine_coarse_sides(Octree& tree, FunctionResample& resample, const Resampl
   resample.to_corner = false;
 }
 
+/// The gray leaves at least 2^kUncheckedLevels finest cells wide, by node (sorted).
+std::vector<LeafRef> coarse_gray_leaves(const Octree& tree) {
+  std::vector<LeafRef> out;
+  const auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+    const Node& n = tree.nodes[node];
+    if (n.kind == CellKind::Internal) {
+      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
+    } else if (n.kind == CellKind::Gray && cell.level + kUncheckedLevels < tree.max_depth) {
+      out.push_back({node, cell});
+    }
+  };
+  walk(walk, 0, Cell{});
+  std::sort(out.begin(), out.end(), [](const LeafRef& a, const LeafRef& b) { return a.node < b.node; });
+  return out;
+}
+
+/// A coarse leaf's polygons join its vertex to its neighbours' by straight sides, but its
+/// planes come from its own edges' crossings only: a crease inside the cell that no edge
+/// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
+/// across it (a faceted sphere shrunk by a third of a unit: the polygons from a leaf holding
+/// the top cap's corner cut its equator half a unit deep, at every depth). f at the middle of
+/// every polygon side that leaves such a leaf, and at the centre of every polygon that has
+/// one, must put the surface within half a finest cell (by f's Lipschitz bound); where it
+/// does not, those coarse leaves are sampled again, split at least once, until every polygon
+/// keeps to the surface or the rounds run out. The mesh sampler needs no such pass: its
+/// planes are the input's own, every one that meets the cell.
+void refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionResample& resample,
+                                 const ResampleLeaf& from_function, const ImplicitSolid& f) {
+  const bool parallel = resample.options.parallel && !f.values;
+  const double cell = 1.0 / double(int64_t{1} << tree.max_depth);
+  // The planes' own fit (2δ, as the octant questions), at most half a finest cell; in f's units.
+  const double tolerance = std::min(cell / 2, 2 * std::sqrt(resample.options.error)) * f.lipschitz * tree.cube.size;
+  size_t checked = 0;  // nodes below this were in the tree at the last round's check
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<LeafRef> coarse = coarse_gray_leaves(tree);
+    if (coarse.empty()) return;
+    const size_t before = checked;
+    checked = tree.nodes.size();
+    const auto coarse_index = [&](uint32_t node) -> int64_t {
+      const auto it = std::lower_bound(coarse.begin(), coarse.end(), node,
+                                       [](const LeafRef& l, uint32_t n) { return l.node < n; });
+      return it != coarse.end() && it->node == node ? it - coarse.begin() : -1;
+    };
+    // Each point asked, and the coarse leaves it answers for.
+    std::vector<Vec3> points;
+    std::vector<std::array<int64_t, 4>> blamed;
+    dual_walk(tree, nullptr, [&](const DualPolygon& poly) {
+      std::array<int64_t, 4> idx{-1, -1, -1, -1};
+      bool any = false;
+      bool changed = false;  // a polygon whose leaves all passed the last round is the same
+      for (int i = 0; i < poly.count; ++i) {
+        any = (idx[i] = coarse_index(poly.leaf[i])) >= 0 || any;
+        changed = changed || poly.leaf[i] >= before;
+      }
+      if (!any || !changed) return;
+      Vec3 centre{0, 0, 0};
+      for (int i = 0; i < poly.count; ++i) {
+        centre = add3(centre, scale3(poly.pos[i], 1.0 / poly.count));
+        const int j = (i + 1) % poly.count;
+        // Each side once, from the polygon that runs it from the lower leaf number.
+        if ((idx[i] < 0 && idx[j] < 0) || poly.leaf[i] > poly.leaf[j]) continue;
+        points.push_back(scale3(add3(poly.pos[i], poly.pos[j]), 0.5));
+        blamed.push_back({idx[i], idx[j], -1, -1});
+      }
+      points.push_back(centre);
+      blamed.push_back(idx);
+    });
+    const std::vector<double> fv = sampler.values(points);
+    std::vector<char> off(coarse.size(), 0);
+    for (size_t i = 0; i < points.size(); ++i)
+      if (std::abs(fv[i]) > tolerance)
+        for (int64_t k : blamed[i])
+          if (k >= 0) off[size_t(k)] = 1;
+    std::vector<Lat> centres;
+    for (size_t k = 0; k < coarse.size(); ++k)
+      if (off[k]) {
+        const Lat lo = coarse[k].cell.lat;
+        const int64_t h = coarse[k].cell.span() / 2;
+        centres.push_back({lo[0] + h, lo[1] + h, lo[2] + h});
+      }
+    if (centres.empty()) return;
+    std::sort(centres.begin(), centres.end());
+    resample.also = centres;
+    resample.to_corner = true;
+    refine_all_around(tree, centres, from_function, parallel);
+    resample.also.clear();
+    resample.to_corner = false;
+  }
+}
+
 }  // namespace
 
 Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleStats* stats) {
@@ -712,6 +783,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.vertices = std::move(b.vertices);
   FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo, {}};
   const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) { return resample(l, p); };
+  refine_polygons_off_surface(tree, sampler, resample, from_function, solid);
   refine_coarse_sides(tree, resample, from_function);
   // Leaves the cap stopped with two surface components get one, as after any sampling; a
   // point the settling flips at a coarser leaf is refined around first.
