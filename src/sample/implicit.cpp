@@ -665,20 +665,26 @@ void refine_coarse_sides(Octree& tree, FunctionResample& resample, const Resampl
   resample.to_corner = false;
 }
 
-/// The gray leaves at least 2^kUncheckedLevels finest cells wide, by node (sorted).
-std::vector<LeafRef> coarse_gray_leaves(const Octree& tree) {
-  std::vector<LeafRef> out;
-  const auto walk = [&](auto&& self, uint32_t node, const Cell& cell) -> void {
+/// Each gray leaf by its vertex number: the leaf, and its vertex in unit coordinates.
+struct GrayLeaves {
+  std::vector<LeafRef> leaf;
+  std::vector<Vec3> pos;
+};
+GrayLeaves gray_leaves(const Octree& tree) {
+  GrayLeaves g;
+  g.leaf.resize(tree.vertices.size());
+  g.pos.resize(tree.vertices.size());
+  const auto place = [&](uint32_t node, const Cell& cell) {
     const Node& n = tree.nodes[node];
-    if (n.kind == CellKind::Internal) {
-      for (int c = 0; c < 8; ++c) self(self, n.index + c, cell.child(c));
-    } else if (n.kind == CellKind::Gray && cell.level + kUncheckedLevels < tree.max_depth) {
-      out.push_back({node, cell});
-    }
+    if (n.kind != CellKind::Gray) return;
+    g.leaf[n.index] = {node, cell};
+    g.pos[n.index] = vertex_unit(cell, tree.vertices[n.index]);
   };
-  walk(walk, 0, Cell{});
-  std::sort(out.begin(), out.end(), [](const LeafRef& a, const LeafRef& b) { return a.node < b.node; });
-  return out;
+  if (tree.nodes[0].kind == CellKind::Internal)
+    tbb::parallel_for(0, 8, [&](int c) { visit_leaves(tree, tree.nodes[0].index + c, Cell{}.child(c), place); });
+  else
+    visit_leaves(tree, 0, Cell{}, place);
+  return g;
 }
 
 /// A coarse leaf's polygons join its vertex to its neighbours' by straight sides, but its
@@ -686,64 +692,61 @@ std::vector<LeafRef> coarse_gray_leaves(const Octree& tree) {
 /// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
 /// across it (a faceted sphere shrunk by a third of a unit: the polygons from a leaf holding
 /// the top cap's corner cut its equator half a unit deep, at every depth). f at the middle of
-/// every polygon side that leaves such a leaf, and at the centre of every polygon that has
-/// one, must put the surface within half a finest cell (by f's Lipschitz bound); where it
-/// does not, those coarse leaves are sampled again, split at least once, until every polygon
-/// keeps to the surface or the rounds run out. The mesh sampler needs no such pass: its
-/// planes are the input's own, every one that meets the cell.
+/// every polygon side that leaves a leaf at least 2^kUncheckedLevels finest cells wide, and at
+/// the centre of every polygon that has one, must put the surface within the planes' own fit
+/// (2δ, as the octant questions), at most half a finest cell (by f's Lipschitz bound); where it
+/// does not, those leaves are sampled again, split at least once, until every polygon keeps to
+/// the surface or the rounds run out. The mesh sampler needs no such pass: its planes are
+/// every input triangle that meets the cell.
 void refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionResample& resample,
                                  const ResampleLeaf& from_function, const ImplicitSolid& f) {
   const bool parallel = resample.options.parallel && !f.values;
   const double cell = 1.0 / double(int64_t{1} << tree.max_depth);
-  // The planes' own fit (2δ, as the octant questions), at most half a finest cell; in f's units.
+  // In f's units.
   const double tolerance = std::min(cell / 2, 2 * std::sqrt(resample.options.error)) * f.lipschitz * tree.cube.size;
-  size_t checked = 0;  // nodes below this were in the tree at the last round's check
+  const auto coarse = [&](const LeafRef& l) { return l.cell.level + kUncheckedLevels < tree.max_depth; };
+  size_t checked = 0;  // nodes below this were in the tree when the last round asked
   for (int round = 0; round < 8; ++round) {
-    const std::vector<LeafRef> coarse = coarse_gray_leaves(tree);
-    if (coarse.empty()) return;
+    const GrayLeaves g = gray_leaves(tree);
+    const std::vector<MeshPolygon> polys = dual_polygons(tree);
     const size_t before = checked;
     checked = tree.nodes.size();
-    const auto coarse_index = [&](uint32_t node) -> int64_t {
-      const auto it = std::lower_bound(coarse.begin(), coarse.end(), node,
-                                       [](const LeafRef& l, uint32_t n) { return l.node < n; });
-      return it != coarse.end() && it->node == node ? it - coarse.begin() : -1;
-    };
-    // Each point asked, and the coarse leaves it answers for.
+    // Each point asked, and the vertices of the coarse leaves it answers for (kNone: none).
     std::vector<Vec3> points;
-    std::vector<std::array<int64_t, 4>> blamed;
-    dual_walk(tree, nullptr, [&](const DualPolygon& poly) {
-      std::array<int64_t, 4> idx{-1, -1, -1, -1};
-      bool any = false;
-      bool changed = false;  // a polygon whose leaves all passed the last round is the same
+    std::vector<std::array<uint32_t, 4>> blamed;
+    for (const MeshPolygon& poly : polys) {
+      std::array<uint32_t, 4> mine{kNone, kNone, kNone, kNone};
+      bool any = false, changed = false;  // a polygon whose leaves all passed the last round is the same
       for (int i = 0; i < poly.count; ++i) {
-        any = (idx[i] = coarse_index(poly.leaf[i])) >= 0 || any;
-        changed = changed || poly.leaf[i] >= before;
+        const LeafRef& l = g.leaf[poly.v[i]];
+        if (coarse(l)) mine[i] = poly.v[i], any = true;
+        changed = changed || l.node >= before;
       }
-      if (!any || !changed) return;
+      if (!any || !changed) continue;
       Vec3 centre{0, 0, 0};
       for (int i = 0; i < poly.count; ++i) {
-        centre = add3(centre, scale3(poly.pos[i], 1.0 / poly.count));
         const int j = (i + 1) % poly.count;
-        // Each side once, from the polygon that runs it from the lower leaf number.
-        if ((idx[i] < 0 && idx[j] < 0) || poly.leaf[i] > poly.leaf[j]) continue;
-        points.push_back(scale3(add3(poly.pos[i], poly.pos[j]), 0.5));
-        blamed.push_back({idx[i], idx[j], -1, -1});
+        centre = add3(centre, scale3(g.pos[poly.v[i]], 1.0 / poly.count));
+        // Each side once: from the polygon that runs it from the lower vertex number.
+        if ((mine[i] == kNone && mine[j] == kNone) || poly.v[i] > poly.v[j]) continue;
+        points.push_back(scale3(add3(g.pos[poly.v[i]], g.pos[poly.v[j]]), 0.5));
+        blamed.push_back({mine[i], mine[j], kNone, kNone});
       }
       points.push_back(centre);
-      blamed.push_back(idx);
-    });
+      blamed.push_back(mine);
+    }
     const std::vector<double> fv = sampler.values(points);
-    std::vector<char> off(coarse.size(), 0);
+    std::vector<char> off(tree.vertices.size(), 0);
     for (size_t i = 0; i < points.size(); ++i)
       if (std::abs(fv[i]) > tolerance)
-        for (int64_t k : blamed[i])
-          if (k >= 0) off[size_t(k)] = 1;
+        for (uint32_t v : blamed[i])
+          if (v != kNone) off[v] = 1;
     std::vector<Lat> centres;
-    for (size_t k = 0; k < coarse.size(); ++k)
-      if (off[k]) {
-        const Lat lo = coarse[k].cell.lat;
-        const int64_t h = coarse[k].cell.span() / 2;
-        centres.push_back({lo[0] + h, lo[1] + h, lo[2] + h});
+    for (size_t v = 0; v < off.size(); ++v)
+      if (off[v]) {
+        const Cell& c = g.leaf[v].cell;
+        const int64_t h = c.span() / 2;
+        centres.push_back({c.lat[0] + h, c.lat[1] + h, c.lat[2] + h});
       }
     if (centres.empty()) return;
     std::sort(centres.begin(), centres.end());
