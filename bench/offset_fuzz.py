@@ -11,7 +11,9 @@ exact number of cells would meet exactly, where the exact offset keeps a sheet o
 thickness between them that no solid has. A case is reported when `pic offset` crashes
 or fails other than by refusing (exit 2, "shrinking by D leaves nothing"), when its mesh is not
 closed, 2-manifold and free of self-intersections (meshcheck), or when it lies farther than
-1.5 finest cells from the exact offset surface either way (`pic compare --offset`). Shrinks
+1.5 finest cells from the exact offset surface either way (`pic compare --offset`; a render
+that is not a clean 2-manifold, parts touching along an edge or float vertices crossing by a
+hair, is only checked for validity: the exact offset needs one). Shrinks
 that leave a slot or blade thinner than a cell are a known limit (docs/benchmarks.md): read a
 reported case before calling it PIC's. Every case is replayable from its seed (OUTDIR/SEED).
 """
@@ -76,9 +78,10 @@ def run_case(seed, depth, out):
             or check.get("nonmanifold_vertices", 0) != 0:
         return False, "INVALID %+d cells: %s" % (cells, json.dumps({k: check.get(k) for k in (
             "closed", "manifold", "nonmanifold_vertices", "self_intersections")} if check else None))
-    if not info.get("manifold") or info.get("nonmanifold_vertices", 0) != 0:
-        # OpenSCAD's parts touching along an edge: PIC offsets the solid, the exact offset needs a 2-manifold.
-        return None, "valid %+d cells; the render is not 2-manifold: no exact offset to compare" % cells
+    if not info.get("manifold") or info.get("nonmanifold_vertices", 0) != 0 or info.get("self_intersections", 0) != 0:
+        # OpenSCAD's parts touching along an edge, or its float vertices crossing by a hair: PIC
+        # offsets the solid (signs by the winding number), the exact offset needs a clean 2-manifold.
+        return None, "valid %+d cells; the render is not a clean 2-manifold: no exact offset to compare" % cells
     c = subprocess.run([PIC, "compare", stl, ref, "--offset", "%.17g" % distance, "--samples", "20000",
                         "--unit", "%.17g" % (size / 2 ** depth), "--json"], capture_output=True, text=True, timeout=600)
     if c.returncode != 0:

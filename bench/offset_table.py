@@ -8,7 +8,8 @@ For each input and each distance N cells the root cube is fixed so that N cells 
 distance (the cube around the input grown by the distance, 1/16 margin on each side, its size
 512 cells at depth 9), then `pic offset IN -o out.stl --distance D --depth DEPTH --cube X,Y,Z,S`,
 meshcheck's validity (closed, 2-manifold, no non-manifold vertex, exact self-intersection
-test) and `pic compare out.stl IN --offset D` in finest cells, out -> exact / exact -> out.
+test) and `pic compare out.stl IN --offset D` in finest cells, out -> exact / exact -> out
+(the worst output vertex).
 A shrink past the deepest point is refused (exit 2): "—". Prints one markdown row per input.
 """
 import json
@@ -64,7 +65,7 @@ def one(path, cells, depth, out):
         m.get("self_intersections", 0) == 0
     c = json.loads(subprocess.run([PIC, "compare", out, path, "--offset", "%.17g" % d, "--samples", "100000",
                                    "--unit", "%.17g" % cell, "--json"], capture_output=True, text=True).stdout)
-    text = "%.2f / %.2f" % (c["offset_worst"], c["offset_back_worst"])
+    text = "%.2f / %.2f (%.2f)" % (c["offset_worst"], c["offset_back_worst"], c["offset_worst_vertex"])
     return text if valid else text + " (NOT VALID)"
 
 

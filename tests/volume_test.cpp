@@ -496,6 +496,23 @@ TEST(Offset, PolygonsOfACoarseLeafKeepToTheSurface) {
   }
 }
 
+// A closed, consistently oriented mesh that crosses itself (two overlapping boxes written as
+// one mesh, as a soup union or an export whose float vertices cross) has faces inside the
+// solid, and a point beside one takes the sign of that face's pseudonormal: outside. Its
+// offset is taken to its sampled surface instead, whose signs are the winding number's.
+TEST(Offset, AMeshThatCrossesItselfIsOffsetAsTheSolidItBounds) {
+  TriMesh two = make_box({0, 0, 0}, {1.2, 1, 1});
+  const TriMesh b = make_box({0.8, 0, 0}, {2, 1, 1});
+  const auto base = uint32_t(two.positions.size());
+  two.positions.insert(two.positions.end(), b.positions.begin(), b.positions.end());
+  for (auto t : b.triangles) two.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  ASSERT_GT(count_self_intersections(two), 0u);
+  const TriMesh m = contour(offset(two, -0.1, at_depth(7)));
+  expect_valid(m);
+  // The union [0, 2] x [0, 1] x [0, 1] shrunk by 0.1.
+  EXPECT_NEAR(volume(m), 1.8 * 0.8 * 0.8, 1e-6);
+}
+
 TEST(MeshDistance, FartherThanNeverMissesATriangle) {
   // Boxes of 1 to 32 finest cells (depth 10) about spot's surface and radii up to 40 cells:
   // whenever the test says every triangle is farther than r, no point of the box may be

@@ -112,6 +112,10 @@ int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (det > kBound * perm) return 1;
   if (-det > kBound * perm) return -1;
   if (perm == 0) return 0;
+  // Four points on one lattice-aligned plane (a CAD face: one coordinate shared exactly) are
+  // coplanar without the exact sum.
+  for (int k = 0; k < 3; ++k)
+    if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) return 0;
   const Expansion ebx = diff(b[0], a[0]), eby = diff(b[1], a[1]), ebz = diff(b[2], a[2]);
   const Expansion ecx = diff(c[0], a[0]), ecy = diff(c[1], a[1]), ecz = diff(c[2], a[2]);
   const Expansion edx = diff(d[0], a[0]), edy = diff(d[1], a[1]), edz = diff(d[2], a[2]);

@@ -46,10 +46,15 @@ void check_finite(double x, const char* what) {
 }
 
 /// The surface a signed distance can be taken to: the mesh itself when it is closed,
-/// 2-manifold and consistently oriented with positive volume; otherwise its PIC contour.
+/// 2-manifold, consistently oriented, with positive volume and not crossing itself; otherwise
+/// its PIC contour (signs by the winding number, the contour intersection-free). Where a closed
+/// mesh crosses itself, the nearest feature's pseudonormal gives the wrong sign on one side of
+/// the crossing (an OpenSCAD render whose float vertices cross by a hair: an offset 100 cells off).
 TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
   const MeshTopology t = analyze_topology(mesh);
-  if (t.closed() && t.manifold() && t.inconsistent_edges == 0 && volume(mesh) > 0) return mesh;
+  if (t.closed() && t.manifold() && t.inconsistent_edges == 0 && volume(mesh) > 0 &&
+      self_intersecting_pairs(mesh).empty())
+    return mesh;
   return contour(sample(mesh, options));
 }
 
@@ -183,10 +188,12 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   return sample_with_mesh(f, o, stats, mesh);
 }
 
-Octree offset(const TriMesh& solid, double distance, const SampleOptions& options, SampleStats* stats,
-              VolumeMesh* mesh) {
+namespace {
+
+/// The offset of a closed surface a signed distance may be taken to (closed_surface).
+Octree offset_of_surface(const TriMesh& surface, double distance, const SampleOptions& options, SampleStats* stats,
+                         VolumeMesh* mesh) {
   check_finite(distance, "the offset distance");
-  const TriMesh surface = closed_surface(solid, options);
   const Cube cube = cube_around(surface, distance, options);
   try {
     return sample_distance(surface, cube, options, stats, mesh, {{distance, distance}},
@@ -200,11 +207,19 @@ Octree offset(const TriMesh& solid, double distance, const SampleOptions& option
   }
 }
 
+}  // namespace
+
+Octree offset(const TriMesh& solid, double distance, const SampleOptions& options, SampleStats* stats,
+              VolumeMesh* mesh) {
+  return offset_of_surface(closed_surface(solid, options), distance, options, stats, mesh);
+}
+
 Octree offset(const Octree& solid, double distance, const SampleOptions& options, SampleStats* stats,
               VolumeMesh* mesh) {
   SampleOptions o = options;
   if (!o.cube && distance <= 0) o.cube = solid.cube;
-  return offset(contour(solid), distance, o, stats, mesh);
+  // A PIC's contour is closed, 2-manifold and free of crossings by construction.
+  return offset_of_surface(contour(solid), distance, o, stats, mesh);
 }
 
 Octree shell(const TriMesh& solid, double thickness, bool outward, const SampleOptions& options, SampleStats* stats,
@@ -232,14 +247,15 @@ Octree round_edges(const TriMesh& solid, double radius, bool convex, const Sampl
   // The first offset's surface with its edge points on the exact offset, for the second.
   VolumeMesh first;
   try {
-    offset(surface, convex ? -radius : radius, o, nullptr, &first);
+    offset_of_surface(surface, convex ? -radius : radius, o, nullptr, &first);
   } catch (const EmptySolid&) {
     char what[160];
     std::snprintf(what, sizeof what, "rounding with radius %g leaves nothing: no point of the solid lies deeper than that",
                   radius);
     throw EmptySolid(what);
   }
-  return offset(first.mesh, convex ? radius : -radius, o, stats, mesh);
+  // The contour of a sampled volume: closed, 2-manifold and free of crossings by construction.
+  return offset_of_surface(first.mesh, convex ? radius : -radius, o, stats, mesh);
 }
 
 Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& options, SampleStats* stats,
