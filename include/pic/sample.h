@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -107,6 +108,14 @@ struct ImplicitSolid {
   /// the half-diagonal times `lipschitz` does. Near the surface a distance proves more (it
   /// knows where its surface lies), so the cells beside a coarse leaf stay coarse.
   std::function<bool(const Vec3& lo, const Vec3& hi)> clear;
+  /// Where the surface may bend inside the box [lo, hi] (world units) by more than the sampling
+  /// tolerance across it (optional): for each such bend, its point nearest a cell's vertex and
+  /// the normal there. An offset rounds a sharp edge, and the crossings of a coarse cell's
+  /// edges can all miss the round (they land on the flat parts beside it, whose planes then
+  /// meet in a sharp corner). A cell above the cap whose vertex lies farther than the tolerance
+  /// from the tangent plane at such a point that f puts on the surface is split.
+  std::function<void(const Vec3& lo, const Vec3& hi, const Vec3& vertex, std::vector<std::array<Vec3, 2>>& bends)>
+      bends;
 };
 /// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs
 /// from f (0 counts as outside), edge crossings by root finding, Hermite normals from the

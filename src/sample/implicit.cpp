@@ -385,6 +385,7 @@ class LevelSampler {
       const double off = reach(fv[i]);
       fits[fitting[i]] = off * off < error_;
     }
+    keep_only_bends(jobs, cand, sol, fits);
     keep_only_whole_surfaces(jobs, cand, cell_edges, edges, fits);
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
@@ -397,6 +398,34 @@ class LevelSampler {
         split.push_back(j);
       }
     }
+  }
+
+  /// A leaf above the cap whose vertex lies off a bend of the surface that f reports in its
+  /// cell (ImplicitSolid::bends: an offset's round of a sharp edge, between crossings that all
+  /// land on the flat parts beside it) is split: its planes' corner would cut the round off.
+  void keep_only_bends(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
+                       const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
+    if (!f_.bends) return;
+    const double tolerance = std::min(sheet_tolerance(), 0.5 / double(int64_t{1} << max_depth_));
+    std::vector<size_t> leaf;  // per point asked
+    std::vector<Vec3> points;  // unit coordinates
+    std::vector<std::array<Vec3, 2>> found;
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const Cell& c = jobs[cand[k]].cell;
+      if (!fits[k] || c.level >= max_depth_) continue;
+      found.clear();
+      f_.bends(world(c.min_unit()), world(c.max_unit()), world(sol[k].position), found);
+      for (const auto& [at, normal] : found) {
+        const Vec3 p = scale3(sub3(at, cube_.origin), 1 / cube_.size);
+        if (std::abs(dot3(sub3(sol[k].position, p), normal)) <= tolerance) continue;
+        leaf.push_back(k);
+        points.push_back(p);
+      }
+    }
+    // Only where the bend is the surface: a nearer part of the solid may hide it.
+    const std::vector<double> f = values(points);
+    for (size_t i = 0; i < points.size(); ++i)
+      if (reach(f[i]) <= tolerance) fits[leaf[i]] = 0;
   }
 
   /// A leaf above the cap may stand only for surface its planes (the crossings of its edges)
