@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -15,6 +16,7 @@
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
 #include "sample/round_body.h"
+#include "sample/rounded_edges.h"
 #include "pic/contour.h"
 #include "pic/csg.h"
 #include "pic/io.h"
@@ -632,8 +634,16 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
 
 /// f = g(signed distance to `mesh`) with g's value and slope, as the sampler asks it, without
 /// a proof of clear cells.
-ImplicitSolid plain_distance(const detail::SignedDistance& sd, std::function<std::pair<double, double>(double)> g) {
+/// `rounds`: the offset distances whose rounds of sharp edges the function reports as bends,
+/// as an offset's does (sampled at depth 9 in `cube`).
+ImplicitSolid plain_distance(const detail::SignedDistance& sd, std::function<std::pair<double, double>(double)> g,
+                             const TriMesh& surface, const Cube& cube, std::vector<double> rounds) {
   ImplicitSolid f;
+  auto edges = std::make_shared<std::vector<detail::RoundedEdges>>();
+  for (double r : rounds) edges->emplace_back(surface, r, detail::bend_tolerance(cube, 9, 1e-8));
+  f.bends = [edges](const Vec3& lo, const Vec3& hi, const Vec3& v, std::vector<std::array<Vec3, 2>>& out) {
+    for (const detail::RoundedEdges& e : *edges) e.points(lo, hi, v, out);
+  };
   f.value = [&sd, g](const Vec3& p) { return g(sd(p)).first; };
   f.value_gradient = [&sd, g](const Vec3& p, Vec3& grad) {
     const auto [v, slope] = g(sd.with_gradient(p, grad));
@@ -666,15 +676,18 @@ TEST(Offset, CellsBesideTheSurfaceStayCoarse) {
   const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
   const detail::SignedDistance sd(spot);
   const double d = 0.05, t = 0.03;
-  expect_same_contour_from_more_cells(offset(spot, d, at_depth(9)), plain_distance(sd, [&](double x) {
+  const Octree grown = offset(spot, d, at_depth(9));
+  expect_same_contour_from_more_cells(grown, plain_distance(sd, [&](double x) {
     return std::pair{x - d, 1.0};
-  }), "grown");
-  expect_same_contour_from_more_cells(offset(spot, -t, at_depth(9)), plain_distance(sd, [&](double x) {
+  }, spot, grown.cube, {d}), "grown");
+  const Octree shrunk = offset(spot, -t, at_depth(9));
+  expect_same_contour_from_more_cells(shrunk, plain_distance(sd, [&](double x) {
     return std::pair{x + t, 1.0};
-  }), "shrunk");
-  expect_same_contour_from_more_cells(shell(spot, t, false, at_depth(9)), plain_distance(sd, [&](double x) {
+  }, spot, shrunk.cube, {-t}), "shrunk");
+  const Octree shelled = shell(spot, t, false, at_depth(9));
+  expect_same_contour_from_more_cells(shelled, plain_distance(sd, [&](double x) {
     return x >= -x - t ? std::pair{x, 1.0} : std::pair{-x - t, -1.0};
-  }), "shell");
+  }, spot, shelled.cube, {-t}), "shell");
 }
 
 TEST(Offset, EveryLatticePointHasOneSignWhereTheDistanceBreaksItsBound) {

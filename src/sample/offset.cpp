@@ -6,10 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <optional>
 
-#include "geometry/box_tree.h"
 #include "geometry/mesh_distance.h"
 #include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
@@ -18,6 +16,7 @@
 #include "pic/measure.h"
 #include "pic/volume.h"
 #include "sample/round_body.h"
+#include "sample/rounded_edges.h"
 
 namespace pic {
 
@@ -114,92 +113,6 @@ bool clear_of_bands(const SignedDistance& sd, const std::vector<Band>& bands, co
   return clear_of_bands(sd.mesh_distance(), bands, lo, hi, d, nearest);
 }
 
-/// The sharp edges an offset by `distance` rounds: convex ones when it grows, concave ones when
-/// it shrinks; the offset there is a cylinder of radius |distance| over the angle θ between the
-/// faces' normals, which bulges |distance| (1 - cos θ/2) off the chord across it. Only edges
-/// whose bulge exceeds `tolerance` are kept; a cell's crossings can miss such a round
-/// altogether where the cell is wider than the chord that stays within the tolerance,
-/// sqrt(8 |distance| tolerance).
-class RoundedEdges {
- public:
-  RoundedEdges(const TriMesh& surface, double distance, double tolerance)
-      : radius_(std::abs(distance)), widest_(std::sqrt(8 * std::abs(distance) * tolerance)) {
-    if (distance == 0) return;
-    const double min_cos = std::cos(2 * std::acos(std::clamp(1 - tolerance / radius_, -1.0, 1.0)));
-    // Each edge's two faces, by its vertex pair (the surface is closed and 2-manifold).
-    std::vector<std::pair<uint64_t, uint32_t>> edges;
-    edges.reserve(3 * surface.triangles.size());
-    for (uint32_t f = 0; f < surface.triangles.size(); ++f)
-      for (int k = 0; k < 3; ++k) {
-        const uint64_t a = surface.triangles[f][k], b = surface.triangles[f][(k + 1) % 3];
-        edges.push_back({std::min(a, b) << 32 | std::max(a, b), f});
-      }
-    std::sort(edges.begin(), edges.end());
-    std::vector<detail::Box> boxes;
-    for (size_t i = 0; i + 1 < edges.size(); ++i) {
-      if (edges[i].first != edges[i + 1].first || (i + 2 < edges.size() && edges[i + 2].first == edges[i].first))
-        continue;
-      const auto& t1 = surface.triangles[edges[i].second];
-      const auto& t2 = surface.triangles[edges[i + 1].second];
-      const Vec3 n1 = unit_normal(surface, t1), n2 = unit_normal(surface, t2);
-      if (detail::dot3(n1, n2) > min_cos) continue;  // too flat to bulge
-      const uint32_t a = uint32_t(edges[i].first >> 32), b = uint32_t(edges[i].first & 0xffffffffu);
-      // The second face's far corner below the first face's plane: a convex edge.
-      uint32_t far = t2[0];
-      for (uint32_t v : t2)
-        if (v != a && v != b) far = v;
-      const bool convex = detail::dot3(n1, detail::sub3(surface.positions[far], surface.positions[a])) < 0;
-      if (convex != (distance > 0)) continue;  // a crease of the offset, not a round
-      const Vec3 &p = surface.positions[a], &q = surface.positions[b];
-      segments_.push_back({p, q});
-      detail::Box box{p, p};
-      for (int k = 0; k < 3; ++k) box.lo[k] = std::min(p[k], q[k]), box.hi[k] = std::max(p[k], q[k]);
-      boxes.push_back(box);
-    }
-    tree_ = std::make_unique<detail::BoxTree>(boxes);
-  }
-
-  /// The points of the rounds nearest `vertex` inside the box [lo, hi], with their normals,
-  /// where the box is wider than the chord that stays within the tolerance: on each edge within
-  /// reach, the point at the offset distance from the edge's point nearest the vertex.
-  void points(const Vec3& lo, const Vec3& hi, const Vec3& vertex, std::vector<std::array<Vec3, 2>>& out) const {
-    if (segments_.empty() || hi[0] - lo[0] <= widest_) return;
-    const Vec3 c = detail::scale3(detail::add3(lo, hi), 0.5);
-    const double reach = radius_ + detail::norm3(detail::sub3(hi, lo)) / 2;
-    detail::Box q{c, c};
-    for (int k = 0; k < 3; ++k) q.lo[k] -= reach, q.hi[k] += reach;
-    tree_->query(q, [&](uint32_t j) {
-      const Vec3 p = nearest_on_segment(vertex, segments_[j][0], segments_[j][1]);
-      const Vec3 d = detail::sub3(vertex, p);
-      const double len = detail::norm3(d);
-      if (!(len > 0)) return;
-      const Vec3 n = detail::scale3(d, 1 / len);
-      const Vec3 r = detail::add3(p, detail::scale3(n, radius_));
-      for (int k = 0; k < 3; ++k)
-        if (r[k] < lo[k] || r[k] > hi[k]) return;
-      out.push_back({r, n});
-    });
-  }
-
- private:
-  static Vec3 unit_normal(const TriMesh& m, const std::array<uint32_t, 3>& t) {
-    const Vec3 n = detail::cross3(detail::sub3(m.positions[t[1]], m.positions[t[0]]),
-                                  detail::sub3(m.positions[t[2]], m.positions[t[0]]));
-    const double len = detail::norm3(n);
-    return len > 0 ? detail::scale3(n, 1 / len) : n;
-  }
-  static Vec3 nearest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-    const Vec3 ab = detail::sub3(b, a);
-    const double len2 = detail::dot3(ab, ab);
-    const double t = len2 > 0 ? std::clamp(detail::dot3(detail::sub3(p, a), ab) / len2, 0.0, 1.0) : 0.0;
-    return detail::add3(a, detail::scale3(ab, t));
-  }
-
-  double radius_, widest_;
-  std::vector<std::array<Vec3, 2>> segments_;
-  std::unique_ptr<detail::BoxTree> tree_;
-};
-
 /// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1 and zero at the
 /// distances `levels`.
 template <class G>
@@ -222,14 +135,12 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     return v;
   };
   solid.clear = [&](const Vec3& lo, const Vec3& hi) { return clear_of_bands(sd, levels, lo, hi, &hints.local()); };
-  // The tolerance the sampler holds a polygon to: 2δ, at most half a finest cell.
-  const double cell = cube.size / double(int64_t{1} << options.depth);
-  const double tolerance = std::min(cell / 2, 2 * std::sqrt(options.error) * cube.size);
-  std::vector<RoundedEdges> rounded;
+  const double tolerance = detail::bend_tolerance(cube, options.depth, options.error);
+  std::vector<detail::RoundedEdges> rounded;
   for (const Band& b : levels)
     if (b.lo == b.hi && b.lo != 0) rounded.emplace_back(surface, b.lo, tolerance);
   solid.bends = [&](const Vec3& lo, const Vec3& hi, const Vec3& vertex, std::vector<std::array<Vec3, 2>>& bends) {
-    for (const RoundedEdges& r : rounded) r.points(lo, hi, vertex, bends);
+    for (const detail::RoundedEdges& r : rounded) r.points(lo, hi, vertex, bends);
   };
   solid.distance = true;
   SampleOptions o = options;
