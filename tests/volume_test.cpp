@@ -498,6 +498,32 @@ TEST(Offset, PolygonsOfACoarseLeafKeepToTheSurface) {
   }
 }
 
+// An offset rounds a shrunk solid's concave edges. A triangular prism with a square hole near
+// its tip, shrunk by 20.37 cells: the hole's corner becomes a round of radius 0.64 that bulges
+// 5 cells off the sharp corner its two walls' planes make, and a leaf 70 cells wide had every
+// edge crossing on the walls beside it — its polygons ran straight across (4.1 / 6.3 cells).
+TEST(Offset, RoundsOfSharpEdgesAreNotCutOffByCoarseLeaves) {
+  TriMesh prism;
+  prism.positions = {{-6.5, -9.33013, 4}, {-6.5, -0.669872, 7}, {-6.5, -0.669872, 4}, {-6.5, -9.33013, 7},
+                     {1, -5, 4},          {1, -5, 7},           {-1.5, -4.5, 7},      {-1.5, -5.5, 7},
+                     {-0.5, -4.5, 7},     {-0.5, -5.5, 7},      {-1.5, -5.5, 4},      {-1.5, -4.5, 4},
+                     {-0.5, -5.5, 4},     {-0.5, -4.5, 4}};
+  prism.triangles = {{0, 1, 2},   {1, 0, 3},  {4, 1, 5},   {1, 4, 2},   {6, 1, 7},   {8, 1, 6},   {1, 8, 5},
+                     {9, 5, 8},   {9, 3, 5},  {7, 3, 9},   {3, 7, 1},   {0, 5, 3},   {5, 0, 4},   {10, 0, 11},
+                     {12, 0, 10}, {0, 12, 4}, {13, 4, 12}, {13, 2, 4},  {11, 2, 13}, {2, 11, 0},  {12, 8, 13},
+                     {8, 12, 9},  {7, 11, 6}, {11, 7, 10}, {11, 8, 6},  {8, 11, 13}, {12, 7, 9},  {7, 12, 10}};
+  SampleOptions o = at_depth(9);
+  o.cube = Cube{{-10.75, -13.000001, -2.5}, 16};
+  const double cell = 16.0 / 512, d = -20.37 * cell;
+  const TriMesh m = contour(offset(prism, d, o));
+  expect_valid(m);
+  const OffsetDistance e = offset_distance(m, prism, d, 20000);
+  EXPECT_LE(e.worst, cell);
+  EXPECT_LE(e.back_worst, cell);
+  std::printf("  [measure] prism with a hole shrunk by 20.37 cells: %.3f / %.3f cells both ways\n", e.worst / cell,
+              e.back_worst / cell);
+}
+
 // A closed, consistently oriented mesh that crosses itself (two overlapping boxes written as
 // one mesh, as a soup union or an export whose float vertices cross) has faces inside the
 // solid, and a point beside one takes the sign of that face's pseudonormal: outside. Its
