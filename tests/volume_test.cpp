@@ -479,9 +479,9 @@ TEST(Offset, NoCoarseLeafHidesOrInventsSurface) {
 }
 
 // A coarse leaf's planes are its own edges' crossings, its polygons run to its neighbours'
-// vertices: a faceted sphere of 6 segments shrunk by a third of a unit has a leaf holding a
-// corner of the top cap whose polygons, straight across the equator's crease to vertices
-// below it, cut the solid half a unit deep at every depth. Each polygon must keep to the
+// vertices: a faceted sphere of 6 segments shrunk by a third of a unit can have a leaf holding
+// a corner of the top cap whose polygons run straight across the equator's crease to vertices
+// below it, half a unit deep into the solid whatever the depth. Each polygon must keep to the
 // surface between its vertices.
 TEST(Offset, PolygonsOfACoarseLeafKeepToTheSurface) {
   const TriMesh ball = make_sphere({0, 0, 0}, 4, 6);
@@ -500,8 +500,8 @@ TEST(Offset, PolygonsOfACoarseLeafKeepToTheSurface) {
 
 // An offset rounds a shrunk solid's concave edges. A triangular prism with a square hole near
 // its tip, shrunk by 20.37 cells: the hole's corner becomes a round of radius 0.64 that bulges
-// 5 cells off the sharp corner its two walls' planes make, and a leaf 70 cells wide had every
-// edge crossing on the walls beside it — its polygons ran straight across (4.1 / 6.3 cells).
+// 5 cells off the sharp corner its two walls' planes make, and a leaf 70 cells wide there can
+// have every edge crossing on the walls beside the round, its polygons straight across it.
 TEST(Offset, RoundsOfSharpEdgesAreNotCutOffByCoarseLeaves) {
   TriMesh prism;
   prism.positions = {{-6.5, -9.33013, 4}, {-6.5, -0.669872, 7}, {-6.5, -0.669872, 4}, {-6.5, -9.33013, 7},
@@ -661,12 +661,13 @@ TEST(MeshDistance, NearestIsTheLeastOverEveryTriangle) {
 /// f = g(signed distance to `mesh`) with g's value and slope, as the sampler asks it, without
 /// a proof of clear cells.
 /// `rounds`: the offset distances whose rounds of sharp edges the function reports as bends,
-/// as an offset's does (sampled at depth 9 in `cube`).
+/// as the offset `t` sampled with the default error does.
 ImplicitSolid plain_distance(const detail::SignedDistance& sd, std::function<std::pair<double, double>(double)> g,
-                             const TriMesh& surface, const Cube& cube, std::vector<double> rounds) {
+                             const TriMesh& surface, const Octree& t, std::vector<double> rounds) {
   ImplicitSolid f;
   auto edges = std::make_shared<std::vector<detail::RoundedEdges>>();
-  for (double r : rounds) edges->emplace_back(surface, r, detail::bend_tolerance(cube, 9, 1e-8));
+  for (double r : rounds)
+    edges->emplace_back(surface, r, detail::bend_tolerance(t.cube, t.max_depth, SampleOptions{}.error));
   f.bends = [edges](const Vec3& lo, const Vec3& hi, const Vec3& v, std::vector<std::array<Vec3, 2>>& out) {
     for (const detail::RoundedEdges& e : *edges) e.points(lo, hi, v, out);
   };
@@ -705,15 +706,15 @@ TEST(Offset, CellsBesideTheSurfaceStayCoarse) {
   const Octree grown = offset(spot, d, at_depth(9));
   expect_same_contour_from_more_cells(grown, plain_distance(sd, [&](double x) {
     return std::pair{x - d, 1.0};
-  }, spot, grown.cube, {d}), "grown");
+  }, spot, grown, {d}), "grown");
   const Octree shrunk = offset(spot, -t, at_depth(9));
   expect_same_contour_from_more_cells(shrunk, plain_distance(sd, [&](double x) {
     return std::pair{x + t, 1.0};
-  }, spot, shrunk.cube, {-t}), "shrunk");
+  }, spot, shrunk, {-t}), "shrunk");
   const Octree shelled = shell(spot, t, false, at_depth(9));
   expect_same_contour_from_more_cells(shelled, plain_distance(sd, [&](double x) {
     return x >= -x - t ? std::pair{x, 1.0} : std::pair{-x - t, -1.0};
-  }, spot, shelled.cube, {-t}), "shell");
+  }, spot, shelled, {-t}), "shell");
 }
 
 TEST(Offset, EveryLatticePointHasOneSignWhereTheDistanceBreaksItsBound) {

@@ -113,7 +113,8 @@ struct ImplicitSolid {
   /// the normal there. An offset rounds a sharp edge, and the crossings of a coarse cell's
   /// edges can all miss the round (they land on the flat parts beside it, whose planes then
   /// meet in a sharp corner). A cell above the cap whose vertex lies farther than the tolerance
-  /// from the tangent plane at such a point that f puts on the surface is split.
+  /// from the tangent plane at such a point that f puts on the surface is split. Called from
+  /// several threads at once.
   std::function<void(const Vec3& lo, const Vec3& hi, const Vec3& vertex, std::vector<std::array<Vec3, 2>>& bends)>
       bends;
 };

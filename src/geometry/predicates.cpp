@@ -112,7 +112,7 @@ int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (det > kBound * perm) return 1;
   if (-det > kBound * perm) return -1;
   if (perm == 0) return 0;
-  // Four points on one lattice-aligned plane (a CAD face: one coordinate shared exactly) are
+  // Four points on one axis-aligned plane (a CAD face: one coordinate shared exactly) are
   // coplanar without the exact sum.
   for (int k = 0; k < 3; ++k)
     if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) return 0;

@@ -385,7 +385,7 @@ class LevelSampler {
       const double off = reach(fv[i]);
       fits[fitting[i]] = off * off < error_;
     }
-    keep_only_bends(jobs, cand, sol, fits);
+    split_leaves_cutting_bends(jobs, cand, sol, fits);
     keep_only_whole_surfaces(jobs, cand, cell_edges, edges, fits);
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
@@ -403,7 +403,7 @@ class LevelSampler {
   /// A leaf above the cap whose vertex lies off a bend of the surface that f reports in its
   /// cell (ImplicitSolid::bends: an offset's round of a sharp edge, between crossings that all
   /// land on the flat parts beside it) is split: its planes' corner would cut the round off.
-  void keep_only_bends(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
+  void split_leaves_cutting_bends(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
                        const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
     if (!f_.bends) return;
     const double tolerance = std::min(sheet_tolerance(), 0.5 / double(int64_t{1} << max_depth_));
@@ -721,21 +721,22 @@ GrayLeaves gray_leaves(const Octree& tree) {
 /// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
 /// across it (a faceted sphere shrunk by a third of a unit: the polygons from a leaf holding
 /// the top cap's corner cut its equator half a unit deep, at every depth). f at the middle of
-/// every polygon side that leaves a leaf at least 2^kUncheckedLevels finest cells wide, and at
+/// every polygon side that leaves a leaf wider than 2^kUncheckedLevels finest cells, and at
 /// the centre of every polygon that has one, must put the surface within the planes' own fit
 /// (2δ, as the octant questions), at most half a finest cell (by f's Lipschitz bound); where it
 /// does not, those leaves are sampled again, split at least once, until every polygon keeps to
 /// the surface or the rounds run out. The mesh sampler needs no such pass: its planes are
 /// every input triangle that meets the cell.
-void refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionResample& resample,
-                                 const ResampleLeaf& from_function, const ImplicitSolid& f) {
+/// `checked`: nodes below this number were asked already, as they are (a polygon all of whose
+/// leaves are among them is not asked again). Returns the tree's node count when done.
+size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionResample& resample,
+                                   const ResampleLeaf& from_function, const ImplicitSolid& f, size_t checked) {
   const bool parallel = resample.options.parallel && !f.values;
   const double cell = 1.0 / double(int64_t{1} << tree.max_depth);
   // In f's units.
   const double tolerance = std::min(cell / 2, 2 * std::sqrt(resample.options.error)) * f.lipschitz * tree.cube.size;
   const auto coarse = [&](const LeafRef& l) { return l.cell.level + kUncheckedLevels < tree.max_depth; };
-  size_t checked = 0;  // nodes below this were in the tree when the last round asked
-  for (int round = 0; round < 8; ++round) {
+  for (int round = 0; round < 8 && checked < tree.nodes.size(); ++round) {
     const GrayLeaves g = gray_leaves(tree);
     const std::vector<MeshPolygon> polys = dual_polygons(tree);
     const size_t before = checked;
@@ -777,7 +778,7 @@ void refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionRe
         const int64_t h = c.span() / 2;
         centres.push_back({c.lat[0] + h, c.lat[1] + h, c.lat[2] + h});
       }
-    if (centres.empty()) return;
+    if (centres.empty()) return checked;
     std::sort(centres.begin(), centres.end());
     resample.also = centres;
     resample.to_corner = true;
@@ -785,6 +786,7 @@ void refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionRe
     resample.also.clear();
     resample.to_corner = false;
   }
+  return checked;
 }
 
 }  // namespace
@@ -815,8 +817,10 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.vertices = std::move(b.vertices);
   FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo, {}};
   const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) { return resample(l, p); };
-  refine_polygons_off_surface(tree, sampler, resample, from_function, solid);
+  // The coarse sides' resampling makes new coarse leaves: their polygons are asked in turn.
+  const size_t checked = refine_polygons_off_surface(tree, sampler, resample, from_function, solid, 0);
   refine_coarse_sides(tree, resample, from_function);
+  refine_polygons_off_surface(tree, sampler, resample, from_function, solid, checked);
   // Leaves the cap stopped with two surface components get one, as after any sampling; a
   // point the settling flips at a coarser leaf is refined around first.
   settle_sampled(tree, SettleRegion{}, &from_function);

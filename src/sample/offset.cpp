@@ -49,8 +49,8 @@ void check_finite(double x, const char* what) {
 /// The surface a signed distance can be taken to: the mesh itself when it is closed,
 /// 2-manifold, consistently oriented, with positive volume and not crossing itself; otherwise
 /// its PIC contour (signs by the winding number, the contour intersection-free). Where a closed
-/// mesh crosses itself, the nearest feature's pseudonormal gives the wrong sign on one side of
-/// the crossing (an OpenSCAD render whose float vertices cross by a hair: an offset 100 cells off).
+/// mesh crosses itself, a face lies inside the solid and the nearest feature's pseudonormal
+/// gives the points beside it the outside sign (and equidistant points either sign).
 TriMesh closed_surface(const TriMesh& mesh, const SampleOptions& options) {
   const MeshTopology t = analyze_topology(mesh);
   if (t.closed() && t.manifold() && t.inconsistent_edges == 0 && volume(mesh) > 0 &&

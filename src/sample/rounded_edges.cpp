@@ -28,7 +28,8 @@ Vec3 nearest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
 
 RoundedEdges::RoundedEdges(const TriMesh& surface, double distance, double tolerance)
     : radius_(std::abs(distance)), widest_(std::sqrt(8 * std::abs(distance) * tolerance)) {
-  if (distance == 0) return;
+  // A round bulges at most its radius off its chord.
+  if (!(radius_ > tolerance)) return;
   // Faces meeting at more than this angle bulge beyond the tolerance.
   const double min_cos = std::cos(2 * std::acos(std::clamp(1 - tolerance / radius_, -1.0, 1.0)));
   // Each edge's faces, by its vertex pair.
@@ -49,7 +50,8 @@ RoundedEdges::RoundedEdges(const TriMesh& surface, double distance, double toler
     const auto& t1 = surface.triangles[edges[i].second];
     const auto& t2 = surface.triangles[edges[i + 1].second];
     const Vec3 n1 = unit_normal(surface, t1), n2 = unit_normal(surface, t2);
-    if (dot3(n1, n2) > min_cos) continue;  // too flat to bulge
+    if (dot3(n1, n1) == 0 || dot3(n2, n2) == 0) continue;  // a face without area has no side
+    if (dot3(n1, n2) > min_cos) continue;                   // too flat to bulge
     const auto a = uint32_t(edges[i].first >> 32), b = uint32_t(edges[i].first & 0xffffffffu);
     // The second face's far corner below the first face's plane: a convex edge.
     uint32_t far = t2[0];
