@@ -404,7 +404,7 @@ class LevelSampler {
   /// cell (ImplicitSolid::bends: an offset's round of a sharp edge, between crossings that all
   /// land on the flat parts beside it) is split: its planes' corner would cut the round off.
   void split_leaves_cutting_bends(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
-                       const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
+                                  const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
     if (!f_.bends) return;
     const double tolerance = std::min(sheet_tolerance(), 0.5 / double(int64_t{1} << max_depth_));
     std::vector<size_t> leaf;  // per point asked
