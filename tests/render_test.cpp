@@ -163,11 +163,7 @@ TEST(Render, FlatShadingDistinguishesFaces) {
 
 TEST(Render, CrossingTrianglesAreHighlighted) {
   // Two boxes in one mesh cross along a loop; a single box crosses nothing.
-  TriMesh two = make_box({0, 0, 0}, {1, 1, 1});
-  const TriMesh b = make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});
-  const auto off = uint32_t(two.positions.size());
-  two.positions.insert(two.positions.end(), b.positions.begin(), b.positions.end());
-  for (auto t : b.triangles) two.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  const TriMesh two = joined(make_box({0, 0, 0}, {1, 1, 1}), make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5}));
   RenderOptions o = ortho("iso");
   EXPECT_EQ(red(render(two, nullptr, o)), 0u);  // off by default
   o.highlight_crossings = true;

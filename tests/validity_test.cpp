@@ -15,6 +15,7 @@
 #include "signs/invariants.h"
 #include "support/csg_cases.h"
 #include "support/mesh_checks.h"
+#include "support/shapes.h"
 #include "support/thingi_pair.h"
 
 namespace pic {
@@ -122,11 +123,7 @@ TEST(SelfIntersect, ClosedPrimitivesAreClean) {
   EXPECT_EQ(count_self_intersections(make_sphere({0, 0, 0}, 1, 64)), 0u);
   EXPECT_EQ(count_self_intersections(make_torus({0, 0, 0}, 1, 0.3)), 0u);
   // Two overlapping boxes in one mesh: their faces cross along a closed loop.
-  TriMesh two = make_box({0, 0, 0}, {1, 1, 1});
-  const TriMesh b = make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});
-  const auto off = uint32_t(two.positions.size());
-  two.positions.insert(two.positions.end(), b.positions.begin(), b.positions.end());
-  for (auto t : b.triangles) two.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  const TriMesh two = joined(make_box({0, 0, 0}, {1, 1, 1}), make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5}));
   EXPECT_GT(count_self_intersections(two), 0u);
   EXPECT_EQ(check_validity(two).components, 2u);
 }

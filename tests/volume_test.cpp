@@ -25,6 +25,7 @@
 #include "pic/sample.h"
 #include "pic/volume.h"
 #include "support/mesh_checks.h"
+#include "support/shapes.h"
 
 namespace pic {
 namespace {
@@ -529,11 +530,7 @@ TEST(Offset, RoundsOfSharpEdgesAreNotCutOffByCoarseLeaves) {
 // solid, and a point beside one takes the sign of that face's pseudonormal: outside. Its
 // offset is taken to its sampled surface instead, whose signs are the winding number's.
 TEST(Offset, AMeshThatCrossesItselfIsOffsetAsTheSolidItBounds) {
-  TriMesh two = make_box({0, 0, 0}, {1.2, 1, 1});
-  const TriMesh b = make_box({0.8, 0, 0}, {2, 1, 1});
-  const auto base = uint32_t(two.positions.size());
-  two.positions.insert(two.positions.end(), b.positions.begin(), b.positions.end());
-  for (auto t : b.triangles) two.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  const TriMesh two = joined(make_box({0, 0, 0}, {1.2, 1, 1}), make_box({0.8, 0, 0}, {2, 1, 1}));
   ASSERT_GT(count_self_intersections(two), 0u);
   const TriMesh m = contour(offset(two, -0.1, at_depth(7)));
   expect_valid(m);
