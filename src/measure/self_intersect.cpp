@@ -22,6 +22,7 @@
 #include "pic/measure.h"
 #include "pic/types.h"
 #include "geometry/box_tree.h"
+#include "geometry/edge_faces.h"
 #include "geometry/predicates.h"
 #include "geometry/union_find.h"
 #include "measure/self_intersect.h"
@@ -103,17 +104,7 @@ MeshValidity check_validity(const TriMesh& mesh, bool self_intersections) {
   r.boundary_edges = topo.boundary_edges;
   r.degenerate_triangles = topo.degenerate_triangles;
   // Components: triangles joined across shared edges (as meshcheck counts them).
-  std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(m.triangles.size() * 3);
-  for (uint32_t f = 0; f < m.triangles.size(); ++f) {
-    const auto& t = m.triangles[f];
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = t[k], b = t[(k + 1) % 3];
-      edges.push_back({std::min(a, b) << 32 | std::max(a, b), f});
-    }
-  }
-  tbb::parallel_sort(edges.begin(), edges.end());
+  const std::vector<std::pair<uint64_t, uint32_t>> edges = detail::edge_faces(m);
   detail::UnionFind uf(m.triangles.size());
   for (size_t i = 1; i < edges.size(); ++i)
     if (edges[i].first == edges[i - 1].first) uf.join(edges[i].second, edges[i - 1].second);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "geometry/edge_faces.h"
 #include "geometry/vec3.h"
 
 namespace pic::detail {
@@ -32,15 +33,7 @@ RoundedEdges::RoundedEdges(const TriMesh& surface, double distance, double toler
   if (!(radius_ > tolerance)) return;
   // Faces meeting at more than this angle bulge beyond the tolerance.
   const double min_cos = std::cos(2 * std::acos(std::clamp(1 - tolerance / radius_, -1.0, 1.0)));
-  // Each edge's faces, by its vertex pair.
-  std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(3 * surface.triangles.size());
-  for (uint32_t f = 0; f < surface.triangles.size(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = surface.triangles[f][k], b = surface.triangles[f][(k + 1) % 3];
-      edges.push_back({std::min(a, b) << 32 | std::max(a, b), f});
-    }
-  std::sort(edges.begin(), edges.end());
+  const std::vector<std::pair<uint64_t, uint32_t>> edges = edge_faces(surface);
   std::vector<Box> boxes;
   for (size_t i = 0; i + 1 < edges.size(); ++i) {
     const bool two_faces = edges[i].first == edges[i + 1].first &&
