@@ -24,6 +24,7 @@
 #include "octree/cell_vertex.h"
 #include "octree/dual_walk.h"
 #include "pic/sample.h"
+#include "sample/rounded_edges.h"
 #include "signs/invariants.h"
 #include "signs/settle.h"
 
@@ -406,7 +407,7 @@ class LevelSampler {
   void split_leaves_cutting_bends(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
                                   const std::vector<Qef::Solution>& sol, std::vector<char>& fits) {
     if (!f_.bends) return;
-    const double tolerance = std::min(sheet_tolerance(), 0.5 / double(int64_t{1} << max_depth_));
+    const double tolerance = bend_tolerance(cube_, max_depth_, error_) / cube_.size;
     std::vector<size_t> leaf;  // per point asked
     std::vector<Vec3> points;  // unit coordinates
     std::vector<std::array<Vec3, 2>> found;
@@ -732,9 +733,8 @@ GrayLeaves gray_leaves(const Octree& tree) {
 size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, FunctionResample& resample,
                                    const ResampleLeaf& from_function, const ImplicitSolid& f, size_t checked) {
   const bool parallel = resample.options.parallel && !f.values;
-  const double cell = 1.0 / double(int64_t{1} << tree.max_depth);
   // In f's units.
-  const double tolerance = std::min(cell / 2, 2 * std::sqrt(resample.options.error)) * f.lipschitz * tree.cube.size;
+  const double tolerance = bend_tolerance(tree.cube, tree.max_depth, resample.options.error) * f.lipschitz;
   const auto coarse = [&](const LeafRef& l) { return l.cell.level + kUncheckedLevels < tree.max_depth; };
   for (int round = 0; round < 8 && checked < tree.nodes.size(); ++round) {
     const GrayLeaves g = gray_leaves(tree);

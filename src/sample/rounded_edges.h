@@ -34,8 +34,9 @@ class RoundedEdges {
   std::unique_ptr<BoxTree> tree_;
 };
 
-/// The distance the implicit sampler holds a leaf's surface to, in world units: the planes'
-/// own fit 2δ (δ² = `error`, in root-cube units), at most half a finest cell.
+/// The distance the implicit sampler holds a leaf's surface to (its polygons, its bends), in
+/// world units: the planes' own fit 2δ (δ² = `error`, in root-cube units), at most half a
+/// finest cell.
 double bend_tolerance(const Cube& cube, int depth, double error);
 
 }  // namespace pic::detail
