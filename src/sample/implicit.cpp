@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -478,6 +479,12 @@ class LevelSampler {
         // Within the tolerance of a plane both tests below pass, whatever f says there.
         const auto plane = nearest_plane(c, cell_edges[k], edges);
         if (plane.first <= tolerance) continue;
+        const Outcome known = octant_by_corners(j, o, plane, tolerance);
+        if (known == Outcome::Agrees) continue;
+        if (known == Outcome::Disagrees) {
+          fits[k] = 0;
+          continue;
+        }
         leaf.push_back(k);
         centres.push_back(c);
         planes.push_back(plane);
@@ -494,6 +501,32 @@ class LevelSampler {
       const double along = std::abs(f[i]) / cube_.size;
       if (f_.distance && along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
     }
+  }
+
+  enum class Outcome { Agrees, Disagrees, Unknown };
+  /// What octants_agree would find at octant o's centre c, where the leaf's corner values
+  /// already decide it: f's bound from each corner x_k keeps |f(c)| at least |f(x_k)| - L|c - x_k|,
+  /// and where that is positive f(c) has x_k's sign.
+  Outcome octant_by_corners(const Job& j, int o, const std::pair<double, double>& plane, double tolerance) const {
+    const double q = j.cell.size() / 4;
+    double low = 0;  // a lower bound on reach(f(c))
+    bool negative = false;
+    for (int k = 0; k < 8; ++k) {
+      const int far = std::popcount(unsigned(k ^ o));
+      const double bound = reach(j.v[k]) - q * std::sqrt(double(3 - far) + 9.0 * far);
+      if (bound > low) low = bound, negative = j.v[k] < 0;
+    }
+    // A hair of margin: f's values are rounded.
+    low -= 1e-9 * j.cell.size();
+    if (!(low > 0)) return Outcome::Unknown;
+    const auto [nearest, side] = plane;
+    const bool sign_differs = negative != (side < 0);
+    if (sign_differs && low > tolerance) return Outcome::Disagrees;
+    if (sign_differs) return Outcome::Unknown;
+    if (!f_.distance) return Outcome::Agrees;
+    const double along = low * f_.lipschitz, half_diagonal = j.cell.size() * std::sqrt(3.0) / 4;
+    if (along >= half_diagonal || nearest <= along + tolerance) return Outcome::Agrees;
+    return Outcome::Unknown;
   }
 
   /// The distance from c to the nearest of a leaf's planes, and c's signed distance to it.
