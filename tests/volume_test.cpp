@@ -391,6 +391,24 @@ TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
   EXPECT_LE(exact.worst_vertex, 0.25 * cell);
 }
 
+TEST(Offset, VerticesOfCappedLeavesLieOnTheSurface) {
+  // spot shrunk by two finest cells at depth 9: where its ears and nose meet the head the
+  // leaves at the cap hold more than their planes fit, and their clamped QEF vertices sat up to
+  // 0.36 cells inside the exact offset. Moved along f's gradient within their cells, they lie
+  // on it.
+  const TriMesh spot = read_mesh(std::string(PIC_DATA_DIR) + "/spot.obj");
+  SampleOptions o = at_depth(9);
+  o.cube = Cube{{-0.96632381249999999, -0.85789281250000005, -0.77627831250000001}, 1.932647625};
+  const double cell = o.cube->size / 512, d = -2 * cell;
+  VolumeMesh vm;
+  const Octree t = offset(spot, d, o, nullptr, &vm);
+  expect_valid(vm.mesh);
+  const OffsetDistance exact = offset_distance(vm.mesh, spot, d, 0);
+  std::printf("worst vertex: %.3f cells off the exact offset\n", exact.worst_vertex / cell);
+  EXPECT_LE(exact.worst_vertex, 0.1 * cell);
+  EXPECT_GT(analyze(t).capped, 0u);
+}
+
 TEST(OffsetSurfacePoints, LieOnTheExactOffsetOfABoxInTheirShare) {
   // The unit cube grown by 0.1: six flat faces (area 6), twelve quarter cylinders (12 x 0.05 pi)
   // and eight eighth spheres (0.04 pi). Every point is at distance 0.1 from the box, and the
