@@ -94,6 +94,46 @@ Expansion diff(double a, double b) {
 }
 int sign_of(const Expansion& e) { return e.n == 0 ? 0 : (e.v[size_t(e.n - 1)] > 0 ? 1 : -1); }
 
+/// x += b for a short expansion on the stack (grow, as above).
+template <size_t N>
+void grow_small(std::array<double, N>& x, int& n, double b) {
+  double q = b;
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    double h;
+    two_sum(q, x[size_t(i)], q, h);
+    if (h != 0) x[size_t(k++)] = h;
+  }
+  if (q != 0) x[size_t(k++)] = q;
+  n = k;
+}
+
+/// The sign of b·(c × d) when every coordinate difference is exact (as where the points are
+/// close, or share an exponent): each product two-term, each minor four, the sum at most 24
+/// terms, all on the stack.
+int orient3d_exact_differences(const Vec3& b, const Vec3& c, const Vec3& d) {
+  std::array<double, 24> sum;
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    std::array<double, 4> minor;
+    int m = 0;
+    double hi, lo;
+    two_prod(c[i], d[j], hi, lo);
+    grow_small(minor, m, lo);
+    grow_small(minor, m, hi);
+    two_prod(-c[j], d[i], hi, lo);
+    grow_small(minor, m, lo);
+    grow_small(minor, m, hi);
+    for (int t = 0; t < m; ++t) {
+      two_prod(minor[size_t(t)], b[k], hi, lo);
+      grow_small(sum, n, lo);
+      grow_small(sum, n, hi);
+    }
+  }
+  return n == 0 ? 0 : (sum[size_t(n - 1)] > 0 ? 1 : -1);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- predicates
@@ -116,6 +156,18 @@ int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   // coplanar without the exact sum.
   for (int k = 0; k < 3; ++k)
     if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) return 0;
+  bool exact = true;
+  Vec3 eb, ec, ed;
+  for (int k = 0; k < 3; ++k) {
+    double tail;
+    two_sum(b[k], -a[k], eb[k], tail);
+    exact = exact && tail == 0;
+    two_sum(c[k], -a[k], ec[k], tail);
+    exact = exact && tail == 0;
+    two_sum(d[k], -a[k], ed[k], tail);
+    exact = exact && tail == 0;
+  }
+  if (exact) return orient3d_exact_differences(eb, ec, ed);
   const Expansion ebx = diff(b[0], a[0]), eby = diff(b[1], a[1]), ebz = diff(b[2], a[2]);
   const Expansion ecx = diff(c[0], a[0]), ecy = diff(c[1], a[1]), ecz = diff(c[2], a[2]);
   const Expansion edx = diff(d[0], a[0]), edy = diff(d[1], a[1]), edz = diff(d[2], a[2]);
