@@ -12,6 +12,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <vector>
 
 #include "geometry/lattice.h"
@@ -822,18 +823,44 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
   return checked;
 }
 
+/// x moved towards f's zero by Newton steps along f's gradient, each clamped into `cell` and
+/// kept only where |f| falls (halved up to three times), until |f| is within `tolerance`.
+/// `asked` counts f's values.
+Vec3 towards_zero_in_cell(const ImplicitSolid& f, const Cube& cube, const Cell& cell, Vec3 x, double tolerance,
+                          size_t& asked) {
+  Vec3 g;
+  double fx = f.value_gradient(unit_to_world(cube, x), g);
+  ++asked;
+  const Vec3 lo = cell.min_unit();
+  for (int step = 0; step < 8 && std::abs(fx) > tolerance; ++step) {
+    const double g2 = dot3(g, g);
+    if (!(g2 > 0)) break;
+    const Vec3 full = scale3(g, fx / (g2 * cube.size));
+    bool moved = false;
+    for (double t = 1; t > 0.1 && !moved; t /= 2) {
+      Vec3 y = sub3(x, scale3(full, t));
+      for (int k = 0; k < 3; ++k) y[k] = std::clamp(y[k], lo[k], lo[k] + cell.size());
+      Vec3 gy;
+      const double fy = f.value_gradient(unit_to_world(cube, y), gy);
+      ++asked;
+      if (std::abs(fy) < std::abs(fx)) x = y, fx = fy, g = gy, moved = true;
+    }
+    if (!moved) break;
+  }
+  return x;
+}
+
 /// A gray leaf at the cap keeps whatever vertex its planes gave, fitting or not (capped), and
 /// the settling changes the signs of leaves there without moving their vertices: such a vertex
 /// can lie up to half a finest cell off the surface. Each of those (a capped leaf, or one whose
 /// node differs from `sampled`, the tree before the settling) farther than the fit test allows
-/// (sqrt(error)) takes Newton steps along f's gradient towards f's zero, each step clamped into
-/// its cell and kept only while |f| falls (halved up to three times), so the vertex stays in its
-/// cell (the contour's guarantee) and only nears the surface. A leaf whose signs make two
-/// surface components is left alone: its one vertex stands for both, and moving it onto one
-/// pulls the polygons off the other. Needs f's gradient with its value, one point at a time.
-/// Returns the values asked.
+/// (sqrt(error)) is moved towards f's zero within its cell, so it stays in its cell (the
+/// contour's guarantee) and only nears the surface. A leaf whose signs make two surface
+/// components is left alone: its one vertex stands for both, and moving it onto one pulls the
+/// polygons off the other. Needs f's gradient with its value, one point at a time. Returns
+/// the values asked.
 size_t move_cap_vertices_onto_surface(Octree& tree, const std::vector<Node>& sampled, const ImplicitSolid& f,
-                                      double error) {
+                                      double error, bool parallel) {
   if (!f.value_gradient) return 0;
   std::vector<std::pair<uint32_t, Cell>> leaves;
   visit_leaves(tree, 0, Cell{}, [&](uint32_t node, const Cell& cell) {
@@ -843,35 +870,16 @@ size_t move_cap_vertices_onto_surface(Octree& tree, const std::vector<Node>& sam
     if (settled || (n.flags & kFlagCapped)) leaves.push_back({node, cell});
   });
   const double tolerance = std::sqrt(error) * f.lipschitz * tree.cube.size;
-  std::atomic<size_t> asked{0};
-  tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t i) {
+  std::vector<size_t> asked(leaves.size(), 0);
+  auto move = [&](size_t i) {
     const auto& [node, cell] = leaves[i];
     std::array<float, 3>& local = tree.vertices[tree.nodes[node].index];
-    Vec3 x = vertex_unit(cell, local), g;
-    double fx = f.value_gradient(unit_to_world(tree.cube, x), g);
-    size_t n = 1;
-    if (std::abs(fx) > tolerance) {
-      const Vec3 lo = cell.min_unit();
-      for (int step = 0; step < 8 && std::abs(fx) > tolerance; ++step) {
-        const double g2 = dot3(g, g);
-        if (!(g2 > 0)) break;
-        const Vec3 full = scale3(g, fx / (g2 * tree.cube.size));
-        bool moved = false;
-        for (double t = 1; t > 0.1 && !moved; t /= 2) {
-          Vec3 y = sub3(x, scale3(full, t));
-          for (int k = 0; k < 3; ++k) y[k] = std::clamp(y[k], lo[k], lo[k] + cell.size());
-          Vec3 gy;
-          const double fy = f.value_gradient(unit_to_world(tree.cube, y), gy);
-          ++n;
-          if (std::abs(fy) < std::abs(fx)) x = y, fx = fy, g = gy, moved = true;
-        }
-        if (!moved) break;
-      }
-      local = to_local(cell, x);
-    }
-    asked += n;
-  });
-  return asked;
+    const Vec3 x = vertex_unit(cell, local), moved = towards_zero_in_cell(f, tree.cube, cell, x, tolerance, asked[i]);
+    if (moved != x) local = to_local(cell, moved);
+  };
+  if (parallel) tbb::parallel_for(size_t{0}, leaves.size(), move);
+  else for (size_t i = 0; i < leaves.size(); ++i) move(i);
+  return std::accumulate(asked.begin(), asked.end(), size_t{0});
 }
 
 }  // namespace
@@ -912,7 +920,7 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   settle_sampled(tree, SettleRegion{}, &from_function);
   sampler.evaluations += resample.evaluations;
   capped += resample.capped;
-  sampler.evaluations += move_cap_vertices_onto_surface(tree, sampled, solid, options.error);
+  sampler.evaluations += move_cap_vertices_onto_surface(tree, sampled, solid, options.error, options.parallel);
   PIC_CHECK_OCTREE(tree, "sampling a function");
   if (tree.vertices.empty()) throw EmptySolid("the function's solid does not meet the cube's inside and outside");
   if (stats) {
