@@ -24,6 +24,9 @@
 //                                the model's size out from each triangle's centre along its
 //                                normal, in the mesh's order; 0 = spot, 1 = the Stanford bunny
 //                                (69k small triangles: many near-ties at that distance)
+//   BM_SelfIntersections/K       the exact self-intersection test of a mesh (as an offset runs it
+//                                on its input): 0 = spot, 1 = fandisk (flat faces of many
+//                                coplanar triangles), 2 = the Stanford bunny
 //   BM_SampleAnyInput/K          depth 12: 0 = spot (clean, parity), 1 = spot with 6 holes
 //                                punched (winding), 2 = the Stanford bunny (open base, winding),
 //                                3 = the bunny with its holes closed by fans (parity): the per-PIC
@@ -418,6 +421,14 @@ void BM_NearestAtOffset(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(at.size()));
 }
 BENCHMARK(BM_NearestAtOffset)->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
+
+void BM_SelfIntersections(benchmark::State& state) {
+  const char* names[] = {"spot.obj", "fandisk.obj", "stanford-bunny.obj"};
+  const pic::TriMesh& m = mesh_of(names[state.range(0)]);
+  for (auto _ : state) benchmark::DoNotOptimize(pic::self_intersecting_pairs(m).size());
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles.size()));
+}
+BENCHMARK(BM_SelfIntersections)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The allocator settings of the command-line tool, so both measure the same thing.
 int main(int argc, char** argv) {
