@@ -359,6 +359,23 @@ TEST(Eval, MissingImportIsLeftOutWithAWarning) {
   EXPECT_NE(warnings[1].find("no_such_drawing.dxf"), std::string::npos) << warnings[1];
 }
 
+// A profile on both sides of the axis: OpenSCAD reports an error for the rotate_extrude,
+// leaves it out and renders the rest (the cube's volume, 24); so does pic eval, with a warning.
+TEST(Eval, RotateExtrudeAcrossTheAxisIsLeftOutWithAWarning) {
+  EvalOptions o;
+  o.depth = 7;
+  std::vector<std::string> warnings;
+  o.warning = [&](const std::string& w) { warnings.push_back(w); };
+  const Octree t = eval_csg(
+      "union() {\n cube(size = [2, 3, 4]);\n rotate_extrude() { multmatrix([[1, 0, 0, -0.5], [0, 1, 0, 0], "
+      "[0, 0, 1, 0], [0, 0, 0, 1]]) { square(size = [1, 1]); } }\n}",
+      o);
+  EXPECT_NEAR(volume(contour(t)), 24, 24 * 1e-6);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("line 3"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("same x coordinate sign"), std::string::npos) << warnings[0];
+}
+
 TEST(Eval, SyntaxErrorNamesLine) {
   EXPECT_THROW(eval_csg("cube(size = [1, 1, 1]);\ncube(size = [1, 1 1]);\n"), InvalidInput);
   try {

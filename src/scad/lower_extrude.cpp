@@ -162,7 +162,12 @@ Solid Lowering::rotate_extrude(const Node& n, const Affine& m) {
   check_finite(n, {angle});
   if (angle == 0 || s.empty()) return {};
   const auto [lo, hi] = x_range(s);
-  if (lo < 0 && hi > 0) fail(n, "all points must have the same x coordinate sign");
+  if (lo < 0 && hi > 0) {
+    // OpenSCAD reports this as an error, leaves the node out and renders the rest.
+    if (opt_.warning)
+      opt_.warning("line " + std::to_string(n.line) + ": rotate_extrude: all points must have the same x coordinate sign (left out)");
+    return {};
+  }
   // OpenSCAD 2021: fragments(max |x|) |angle| / 360, at least 1.
   int f = static_cast<int>(std::fmax(
       fragments_from_r(hi - lo, number(n, "$fn", 0), number(n, "$fs", 2), number(n, "$fa", 12)) *
