@@ -42,18 +42,20 @@ inline void two_prod(double a, double b, double& x, double& y) {
   x = a * b;
   y = std::fma(a, b, -x);
 }
-/// e += b, in place (Shewchuk's Grow-Expansion: component i of the result needs only e[0..i]).
-void grow(Expansion& e, double b) {
+/// v[0..n) += b, in place (Shewchuk's Grow-Expansion: component i of the result needs only
+/// v[0..i]); the caller's storage holds one more component.
+void grow(double* v, int& n, double b) {
   double q = b;
   int k = 0;
-  for (int i = 0; i < e.n; ++i) {
+  for (int i = 0; i < n; ++i) {
     double h;
-    two_sum(q, e.v[size_t(i)], q, h);
-    if (h != 0) e.v[size_t(k++)] = h;
+    two_sum(q, v[i], q, h);
+    if (h != 0) v[k++] = h;
   }
-  if (q != 0) e.v[size_t(k++)] = q;
-  e.n = k;
+  if (q != 0) v[k++] = q;
+  n = k;
 }
+void grow(Expansion& e, double b) { grow(e.v.data(), e.n, b); }
 Expansion add(Expansion e, const Expansion& f) {
   for (int i = 0; i < f.n; ++i) grow(e, f.v[size_t(i)]);
   return e;
@@ -94,20 +96,6 @@ Expansion diff(double a, double b) {
 }
 int sign_of(const Expansion& e) { return e.n == 0 ? 0 : (e.v[size_t(e.n - 1)] > 0 ? 1 : -1); }
 
-/// x += b for a short expansion on the stack (grow, as above).
-template <size_t N>
-void grow_small(std::array<double, N>& x, int& n, double b) {
-  double q = b;
-  int k = 0;
-  for (int i = 0; i < n; ++i) {
-    double h;
-    two_sum(q, x[size_t(i)], q, h);
-    if (h != 0) x[size_t(k++)] = h;
-  }
-  if (q != 0) x[size_t(k++)] = q;
-  n = k;
-}
-
 /// The sign of b·(c × d) when every coordinate difference is exact (as where the points are
 /// close, or share an exponent): each product two-term, each minor four, the sum at most 24
 /// terms, all on the stack.
@@ -120,15 +108,15 @@ int orient3d_exact_differences(const Vec3& b, const Vec3& c, const Vec3& d) {
     int m = 0;
     double hi, lo;
     two_prod(c[i], d[j], hi, lo);
-    grow_small(minor, m, lo);
-    grow_small(minor, m, hi);
+    grow(minor.data(), m, lo);
+    grow(minor.data(), m, hi);
     two_prod(-c[j], d[i], hi, lo);
-    grow_small(minor, m, lo);
-    grow_small(minor, m, hi);
+    grow(minor.data(), m, lo);
+    grow(minor.data(), m, hi);
     for (int t = 0; t < m; ++t) {
       two_prod(minor[size_t(t)], b[k], hi, lo);
-      grow_small(sum, n, lo);
-      grow_small(sum, n, hi);
+      grow(sum.data(), n, lo);
+      grow(sum.data(), n, hi);
     }
   }
   return n == 0 ? 0 : (sum[size_t(n - 1)] > 0 ? 1 : -1);

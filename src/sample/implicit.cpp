@@ -517,8 +517,7 @@ class LevelSampler {
       const double bound = reach(j.v[k]) - q * std::sqrt(double(3 - far) + 9.0 * far);
       if (bound > low) low = bound, negative = j.v[k] < 0;
     }
-    // A hair of margin: f's values are rounded.
-    low -= 1e-9 * j.cell.size();
+    low -= kCornerBoundSlack * j.cell.size();
     if (!(low > 0)) return Outcome::Unknown;
     const auto [nearest, side] = plane;
     const bool sign_differs = negative != (side < 0);

@@ -151,8 +151,12 @@ std::filesystem::path Lowering::file_arg(const Node& n) const {
 bool Lowering::missing(const Node& n, const std::filesystem::path& p) const {
   std::error_code ec;
   if (std::filesystem::exists(p, ec)) return false;
-  if (opt_.warning) opt_.warning("line " + std::to_string(n.line) + ": import: cannot open " + p.string() + " (left out)");
+  left_out(n, "cannot open " + p.string());
   return true;
+}
+
+void Lowering::left_out(const Node& n, const std::string& why) const {
+  if (opt_.warning) opt_.warning("line " + std::to_string(n.line) + ": " + n.name + ": " + why + " (left out)");
 }
 
 }  // namespace pic::detail::scad

@@ -164,8 +164,7 @@ Solid Lowering::rotate_extrude(const Node& n, const Affine& m) {
   const auto [lo, hi] = x_range(s);
   if (lo < 0 && hi > 0) {
     // OpenSCAD reports this as an error, leaves the node out and renders the rest.
-    if (opt_.warning)
-      opt_.warning("line " + std::to_string(n.line) + ": rotate_extrude: all points must have the same x coordinate sign (left out)");
+    left_out(n, "all points must have the same x coordinate sign");
     return {};
   }
   // OpenSCAD 2021: fragments(max |x|) |angle| / 360, at least 1.

@@ -72,6 +72,8 @@ class Lowering {
   double radius(const Node& n, const char* r, const char* d, double fallback) const;
   std::filesystem::path file_arg(const Node& n) const;
   bool missing(const Node& n, const std::filesystem::path& p) const;
+  /// Warns that node n is left out of the model (as OpenSCAD leaves it out) and why.
+  void left_out(const Node& n, const std::string& why) const;
 
   // 3D primitives (lower_primitives.cpp).
   TriMesh cube(const Node& n) const;
