@@ -753,5 +753,48 @@ TEST(Offset, ShrinkingToNothingSaysSo) {
   EXPECT_THROW(round_edges(make_box({0, 0, 0}, {1, 1, 1}), 0.6, true, at_depth(6)), EmptySolid);
 }
 
+TEST(Offset, DistanceBoundsDecideChecksAsTheValuesWould) {
+  // The unit box's surface thickened to 0.3 on either side (a hollow box with rounded outer
+  // edges and a sharp cubic cavity), f = d - 0.3 for the unsigned distance d to its triangles.
+  // Told that f is a distance minus an offset, with the nearest triangle as the site, the
+  // sampler decides most octant and polygon checks of its coarse leaves from bounds (the
+  // parallelogram law below, the site's distance above) instead of asking f; each bound is a
+  // proof, so the tree must be the same, bit for bit, from fewer values.
+  const TriMesh box = make_box({0, 0, 0}, {1, 1, 1});
+  const detail::MeshDistance md(box);
+  const double d = 0.3;
+  ImplicitSolid plain;
+  plain.value = [&](const Vec3& p) { return md.nearest(p).distance - d; };
+  plain.value_gradient = [&](const Vec3& p, Vec3& g) {
+    const detail::Nearest n = md.nearest(p);
+    const Vec3 away = detail::sub3(p, n.point);
+    g = n.distance > 0 ? detail::scale3(away, 1 / n.distance) : Vec3{0, 0, 1};
+    return n.distance - d;
+  };
+  plain.distance = true;
+  ImplicitSolid bounded = plain;
+  bounded.offset = d;
+  bounded.value_site = [&](const Vec3& p, uint32_t& site) {
+    site = 0;
+    return md.nearest(p, &site).distance - d;
+  };
+  bounded.site_distance = [&](const Vec3& p, uint32_t site) { return md.distance_to_hint(p, site); };
+  SampleOptions o = at_depth(9);
+  o.cube = Cube{{-0.5, -0.5, -0.5}, 2};
+  o.error = 1e-6;
+  SampleStats with, without;
+  const Octree a = sample(bounded, o, &with), b = sample(plain, o, &without);
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (size_t i = 0; i < a.nodes.size(); ++i) {
+    ASSERT_EQ(a.nodes[i].kind, b.nodes[i].kind) << "node " << i;
+    ASSERT_EQ(a.nodes[i].signs, b.nodes[i].signs) << "node " << i;
+    ASSERT_EQ(a.nodes[i].index, b.nodes[i].index) << "node " << i;
+  }
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_LT(double(with.evaluations), 0.85 * double(without.evaluations));
+  std::printf("values: %zu with the bounds, %zu without\n", with.evaluations, without.evaluations);
+  expect_valid(contour(a));
+}
+
 }  // namespace
 }  // namespace pic

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <array>
 #include <functional>
 #include <optional>
@@ -102,6 +103,19 @@ struct ImplicitSolid {
   /// taken at slope 1 -- which a function whose |f| falls short of the distance (most
   /// functions) would claim everywhere.
   bool distance = false;
+  /// When f = s - offset for a signed distance s to a surface (|s| the distance to it: an
+  /// offset of a mesh), that offset (optional). The distance to any set at a mean of points is
+  /// bounded from below by theirs (the parallelogram law: for weights w_k summing to 1 and
+  /// c = sum w_k x_k, d(c)^2 >= sum w_k d(x_k)^2 - sum w_k |x_k - c|^2), a bound far tighter
+  /// than the Lipschitz one where the surface is far from the cell, which decides many of the
+  /// sampler's checks without asking f.
+  std::optional<double> offset;
+  /// With `offset` (both optional): f at p and an opaque site there (the surface's feature
+  /// nearest p), and from a site an upper bound on |s| anywhere (the distance to that feature),
+  /// far cheaper than f. With the lower bound above they decide most of the checks of the
+  /// polygons between points asked.
+  std::function<double(const Vec3&, uint32_t& site)> value_site;
+  std::function<double(const Vec3&, uint32_t site)> site_distance;
   /// Whether f keeps one sign over the whole box [lo, hi] (world units), proven (optional;
   /// false when unsure). Asked, in place of f at the centre, of each cell whose corners agree
   /// and that no corner's value proves clear: it must prove at least what |f(centre)| beyond

@@ -665,6 +665,11 @@ bool MeshDistance::farther_than(const Vec3& lo, const Vec3& hi, double r) const 
   return true;
 }
 
+double MeshDistance::distance_to_hint(const Vec3& p, uint32_t hint) const {
+  const LeafTriangle& t = tris_[hint];
+  return std::sqrt(point_triangle_distance2(p, t.a, t.b, t.c));
+}
+
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;

@@ -61,6 +61,8 @@ class MeshDistance {
   /// where the answer for a point close by was found (opaque; start with 0): that triangle's
   /// distance bounds the search from the start. It is set to this answer's.
   Nearest nearest(const Vec3& p, uint32_t* hint = nullptr) const;
+  /// The distance from p to the triangle a hint names (set by `nearest`): at least distance(p).
+  double distance_to_hint(const Vec3& p, uint32_t hint) const;
 
  private:
   // Boxes in float, rounded outward: a box only prunes, and four of them side by side (a

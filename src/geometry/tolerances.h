@@ -130,6 +130,9 @@ inline constexpr double kHintSlack = 1e-12;
 /// A bound on |f| carried from a leaf's corners to a point inside it is lowered by this fraction
 /// of the cell: f's values are rounded.
 inline constexpr double kCornerBoundSlack = 1e-9;
+/// A value bounded inside (or outside) a tolerance decides a test without asking f only with
+/// this fraction of the tolerance to spare: the value f would give is rounded.
+inline constexpr double kBoundMargin = 1e-9;
 /// A point nearer a mesh than this fraction of the mesh's size is on it: the direction to its
 /// nearest point is rounding noise there, so the nearest face's normal stands for the gradient.
 inline constexpr double kOnSurface = 1e-10;

@@ -382,14 +382,23 @@ class LevelSampler {
         at.push_back(sol[k].position);
       }
     }
-    const std::vector<double> fv = values(at);
+    // With sites (ImplicitSolid::value_site), each vertex's site bounds f in its octants.
+    std::vector<uint32_t> site(cand.size(), kNone);
+    std::vector<double> fv;
+    if (f_.value_site && !f_.values) {
+      fv.resize(at.size());
+      evaluations += at.size();
+      for_each(at.size(), [&](size_t i) { fv[i] = f_.value_site(world(at[i]), site[fitting[i]]); });
+    } else {
+      fv = values(at);
+    }
     std::vector<char> fits(cand.size(), 0);
     for (size_t i = 0; i < fitting.size(); ++i) {
       const double off = reach(fv[i]);
       fits[fitting[i]] = off * off < error_;
     }
     split_leaves_cutting_bends(jobs, cand, sol, fits);
-    keep_only_whole_surfaces(jobs, cand, cell_edges, edges, fits);
+    keep_only_whole_surfaces(jobs, cand, cell_edges, edges, site, fits);
     for (size_t k = 0; k < cand.size(); ++k) {
       const Job& j = jobs[cand[k]];
       const uint8_t signs = signs_of(j.v);
@@ -446,11 +455,11 @@ class LevelSampler {
   /// vertex and its neighbours', is asked once the tree is whole (refine_polygons_off_surface).
   void keep_only_whole_surfaces(const std::vector<Job>& jobs, const std::vector<size_t>& cand,
                                 const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
-                                std::vector<char>& fits) {
+                                const std::vector<uint32_t>& site, std::vector<char>& fits) {
     std::vector<size_t> asked;
     for (size_t k = 0; k < cand.size(); ++k)
       if (fits[k] && jobs[cand[k]].cell.level + kUncheckedLevels < max_depth_) asked.push_back(k);
-    octants_agree(jobs, cand, asked, cell_edges, edges, fits);
+    octants_agree(jobs, cand, asked, cell_edges, edges, site, fits);
   }
 
   /// |f| as a lower bound on the distance to the surface, in unit-cube lengths.
@@ -465,7 +474,7 @@ class LevelSampler {
   /// every plane. Clears `fits` where an octant disagrees.
   void octants_agree(const std::vector<Job>& jobs, const std::vector<size_t>& cand, const std::vector<size_t>& asked,
                      const std::vector<std::array<uint32_t, 12>>& cell_edges, const std::vector<Edge>& edges,
-                     std::vector<char>& fits) {
+                     const std::vector<uint32_t>& site, std::vector<char>& fits) {
     const double tolerance = sheet_tolerance();
     std::vector<size_t> leaf;  // per centre
     std::vector<Vec3> centres;
@@ -480,7 +489,7 @@ class LevelSampler {
         // Within the tolerance of a plane both tests below pass, whatever f says there.
         const auto plane = nearest_plane(c, cell_edges[k], edges);
         if (plane.first <= tolerance) continue;
-        const Outcome known = octant_by_corners(j, o, plane, tolerance);
+        const Outcome known = octant_by_corners(j, o, c, site[k], plane, tolerance);
         if (known == Outcome::Agrees) continue;
         if (known == Outcome::Disagrees) {
           fits[k] = 0;
@@ -507,8 +516,11 @@ class LevelSampler {
   enum class Outcome { Agrees, Disagrees, Unknown };
   /// What octants_agree would find at octant o's centre c, where the leaf's corner values
   /// already decide it: f's bound from each corner x_k keeps |f(c)| at least |f(x_k)| - L|c - x_k|,
-  /// and where that is positive f(c) has x_k's sign.
-  Outcome octant_by_corners(const Job& j, int o, const std::pair<double, double>& plane, double tolerance) const {
+  /// and where that is positive f(c) has x_k's sign. For an offset, also the corners' distance
+  /// bound (offset_bound) and, from the site of the leaf's vertex, an upper bound on c's distance
+  /// to s's surface.
+  Outcome octant_by_corners(const Job& j, int o, const Vec3& c, uint32_t site, const std::pair<double, double>& plane,
+                            double tolerance) const {
     const double q = j.cell.size() / 4;
     double low = 0;  // a lower bound on reach(f(c))
     bool negative = false;
@@ -518,6 +530,18 @@ class LevelSampler {
       if (bound > low) low = bound, negative = j.v[k] < 0;
     }
     low -= kCornerBoundSlack * j.cell.size();
+    if (f_.offset) {
+      bool offset_negative = false;
+      const double b = reach(offset_bound(j, o, offset_negative)) - kCornerBoundSlack * j.cell.size();
+      if (b > low) low = b, negative = offset_negative;
+      // Nearer s's surface than |offset| (the distance to the vertex's site bounds |s(c)|), c is
+      // on its side of f's zero: f = s - offset has the sign of -offset there.
+      if (site != kNone && f_.site_distance) {
+        const double inside = std::abs(*f_.offset) - f_.site_distance(world(c), site);
+        const double near = inside > 0 ? reach(inside) - kCornerBoundSlack * j.cell.size() : 0;
+        if (near > low) low = near, negative = *f_.offset > 0;
+      }
+    }
     if (!(low > 0)) return Outcome::Unknown;
     const auto [nearest, side] = plane;
     const bool sign_differs = negative != (side < 0);
@@ -527,6 +551,34 @@ class LevelSampler {
     const double along = low * f_.lipschitz, half_diagonal = j.cell.size() * std::sqrt(3.0) / 4;
     if (along >= half_diagonal || nearest <= along + tolerance) return Outcome::Agrees;
     return Outcome::Unknown;
+  }
+
+  /// For f = s - offset (ImplicitSolid::offset): a lower bound on |f| at octant o's centre c
+  /// and f's sign there (`negative`), from s at the leaf's corners x_k, or 0. Where every corner
+  /// lies on one side of s's surface, farther than the spread below, the segment from the
+  /// nearest corner to c does not meet that surface (c is on that side too), and |s(c)|^2 is at
+  /// least sum w_k s(x_k)^2 - 9/16 h^2 (w_k: c's trilinear weights, 27/64 at the nearest corner
+  /// down to 1/64 at the farthest; 9/16 h^2 = sum w_k |x_k - c|^2 for a cell of side h).
+  double offset_bound(const Job& j, int o, bool& negative) const {
+    const double offset = *f_.offset, h = j.cell.size() * cube_.size, spread = 9.0 / 16 * h * h;
+    double sum = 0, least = detail::kHuge;
+    int side = 0;
+    for (int k = 0; k < 8; ++k) {
+      const double s = j.v[k] + offset;
+      const int sk = s > 0 ? 1 : s < 0 ? -1 : 0;
+      if (sk == 0 || (side != 0 && sk != side)) return 0;
+      side = sk;
+      static constexpr double kWeight[4] = {27.0 / 64, 9.0 / 64, 3.0 / 64, 1.0 / 64};
+      sum += kWeight[std::popcount(unsigned(k ^ o))] * s * s;
+      least = std::min(least, s * s);
+    }
+    if (!(least > spread)) return 0;
+    const double d = std::sqrt(sum - spread);
+    // f(c) = s(c) - offset, with s(c) beyond side * d.
+    const double beyond = side > 0 ? d - offset : -d - offset;
+    if ((side > 0) != (beyond > 0)) return 0;
+    negative = beyond < 0;
+    return std::abs(beyond);
   }
 
   /// The distance from c to the nearest of a leaf's planes, and c's signed distance to it.
@@ -750,6 +802,87 @@ GrayLeaves gray_leaves(const Octree& tree) {
   return g;
 }
 
+/// Which of `points` (unit space) the bounds of f = s - offset (ImplicitSolid::offset, with
+/// sites) leave to be asked, each point the mean of the polygon vertices `from` (kNone past the
+/// last); `off` gets, per point, whether |f| there is proven beyond `tolerance` (f's units).
+/// f is asked at those vertices (once each, with their sites; counted in `asked`). Where they all lie on one side of
+/// s's surface, farther than half their spread's diameter, no point of their hull meets that
+/// surface, and |s| at their mean m is at least sqrt(mean s_k^2 - mean |x_k - m|^2) (the
+/// parallelogram law) and at most m's distance to each vertex's site: f(m) lies between. A
+/// point whose interval lies inside or outside the tolerance, with a hair to spare for
+/// rounding, is decided as asking f would decide it.
+std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube, const GrayLeaves& g,
+                                        const std::vector<Vec3>& points, const std::vector<std::array<uint32_t, 4>>& from,
+                                        double tolerance, bool parallel, std::vector<char>& off, size_t& asked) {
+  off.assign(points.size(), 0);
+  std::vector<size_t> undecided(points.size());
+  std::iota(undecided.begin(), undecided.end(), size_t{0});
+  if (!f.offset || !f.value_site || !f.site_distance || points.empty()) return undecided;
+  const double offset = *f.offset;
+  // The vertices worth asking: those of points whose spread could let the lower bound come
+  // within the tolerance of |offset| (s at the vertices is about the offset).
+  const auto spread_allows = [&](size_t i) {
+    const Vec3 m = unit_to_world(cube, points[i]);
+    double spread = 0, diameter2 = 0;
+    int n = 0;
+    for (uint32_t v : from[i]) {
+      if (v == kNone) break;
+      const Vec3 x = unit_to_world(cube, g.pos[v]);
+      spread += dot3(sub3(x, m), sub3(x, m));
+      for (int a = 0; a < n; ++a) {
+        const Vec3 y = unit_to_world(cube, g.pos[from[i][a]]);
+        diameter2 = std::max(diameter2, dot3(sub3(x, y), sub3(x, y)));
+      }
+      ++n;
+    }
+    const double reach = std::abs(offset) - tolerance;
+    return n > 0 && spread / n <= 2 * std::abs(offset) * tolerance && reach > 0 && diameter2 / 2 < reach * reach;
+  };
+  std::vector<uint32_t> index(g.pos.size(), kNone), used;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (spread_allows(i))
+      for (uint32_t v : from[i])
+        if (v != kNone && index[v] == kNone) index[v] = uint32_t(used.size()), used.push_back(v);
+  std::vector<double> s(used.size());
+  std::vector<uint32_t> site(used.size());
+  const auto each = [&](size_t n, auto&& fn) {
+    if (parallel) tbb::parallel_for(size_t{0}, n, fn);
+    else for (size_t i = 0; i < n; ++i) fn(i);
+  };
+  each(used.size(), [&](size_t k) { s[k] = f.value_site(unit_to_world(cube, g.pos[used[k]]), site[k]) + offset; });
+  asked += used.size();
+  std::vector<char> decided(points.size(), 0);
+  const double inner = tolerance * (1 - kBoundMargin), outer = tolerance * (1 + kBoundMargin);
+  each(points.size(), [&](size_t i) {
+    const Vec3 m = unit_to_world(cube, points[i]);
+    int n = 0, side = 0;
+    double mean_s2 = 0, spread = 0, least = detail::kHuge, diameter2 = 0, high = detail::kHuge;
+    std::array<Vec3, 4> x;
+    for (uint32_t v : from[i]) {
+      if (v == kNone) break;
+      const uint32_t k = index[v];
+      if (k == kNone) return;
+      const int sk = s[k] > 0 ? 1 : s[k] < 0 ? -1 : 0;
+      if (sk == 0 || (side != 0 && sk != side)) return;
+      side = sk;
+      x[n] = unit_to_world(cube, g.pos[v]);
+      for (int a = 0; a < n; ++a) diameter2 = std::max(diameter2, dot3(sub3(x[a], x[n]), sub3(x[a], x[n])));
+      mean_s2 += s[k] * s[k], spread += dot3(sub3(x[n], m), sub3(x[n], m)), least = std::min(least, s[k] * s[k]);
+      high = std::min(high, f.site_distance(m, site[k]));
+      ++n;
+    }
+    if (n == 0 || !(least > diameter2 / 2)) return;
+    const double low2 = (mean_s2 - spread) / n;
+    if (!(low2 > 0)) return;
+    const double low = std::sqrt(low2);
+    const double f_lo = side > 0 ? low - offset : -high - offset, f_hi = side > 0 ? high - offset : -low - offset;
+    if (f_lo >= -inner && f_hi <= inner) decided[i] = 1;
+    else if (f_lo > outer || f_hi < -outer) decided[i] = 1, off[i] = 1;
+  });
+  std::erase_if(undecided, [&](size_t i) { return decided[i] != 0; });
+  return undecided;
+}
+
 /// A coarse leaf's polygons join its vertex to its neighbours' by straight sides, but its
 /// planes come from its own edges' crossings only: a crease inside the cell that no edge
 /// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
@@ -774,9 +907,10 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
     const std::vector<MeshPolygon> polys = dual_polygons(tree);
     const size_t before = checked;
     checked = tree.nodes.size();
-    // Each point asked, and the vertices of the coarse leaves it answers for (kNone: none).
+    // Each point asked, the vertices of the coarse leaves it answers for (kNone: none), and
+    // the polygon's vertices it is the mean of.
     std::vector<Vec3> points;
-    std::vector<std::array<uint32_t, 4>> blamed;
+    std::vector<std::array<uint32_t, 4>> blamed, from;
     for (const MeshPolygon& poly : polys) {
       std::array<uint32_t, 4> mine{kNone, kNone, kNone, kNone};
       bool any = false, changed = false;  // a polygon whose leaves all passed the last round is the same
@@ -794,14 +928,23 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
         if ((mine[i] == kNone && mine[j] == kNone) || poly.v[i] > poly.v[j]) continue;
         points.push_back(scale3(add3(g.pos[poly.v[i]], g.pos[poly.v[j]]), 0.5));
         blamed.push_back({mine[i], mine[j], kNone, kNone});
+        from.push_back({poly.v[i], poly.v[j], kNone, kNone});
       }
       points.push_back(centre);
       blamed.push_back(mine);
+      from.push_back({kNone, kNone, kNone, kNone});
+      std::copy_n(poly.v.begin(), poly.count, from.back().begin());
     }
-    const std::vector<double> fv = sampler.values(points);
+    std::vector<char> proven_off;
+    const std::vector<size_t> asked =
+        undecided_by_bounds(f, tree.cube, g, points, from, tolerance, parallel, proven_off, sampler.evaluations);
+    std::vector<Vec3> at(asked.size());
+    for (size_t k = 0; k < asked.size(); ++k) at[k] = points[asked[k]];
+    const std::vector<double> fv = sampler.values(at);
+    for (size_t k = 0; k < asked.size(); ++k) proven_off[asked[k]] = std::abs(fv[k]) > tolerance;
     std::vector<char> off(tree.vertices.size(), 0);
     for (size_t i = 0; i < points.size(); ++i)
-      if (std::abs(fv[i]) > tolerance)
+      if (proven_off[i])
         for (uint32_t v : blamed[i])
           if (v != kNone) off[v] = 1;
     std::vector<Lat> centres;

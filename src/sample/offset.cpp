@@ -114,10 +114,11 @@ bool clear_of_bands(const SignedDistance& sd, const std::vector<Band>& bands, co
 }
 
 /// The solid {f < 0} for f = g(signed distance to `surface`), g of slope +-1 and zero at the
-/// distances `levels`.
+/// distances `levels`; `offset` when g(d) = d - offset (ImplicitSolid::offset).
 template <class G>
 Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOptions& options, SampleStats* stats,
-                       VolumeMesh* mesh, const std::vector<Band>& levels, G&& g) {
+                       VolumeMesh* mesh, const std::vector<Band>& levels, G&& g,
+                       std::optional<double> offset = std::nullopt) {
   const SignedDistance sd(surface);
   // Per thread, the triangle nearest the last point asked: the sampler asks in cell order,
   // so the next point's nearest triangle is usually that one or a neighbour.
@@ -143,6 +144,14 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     for (const detail::RoundedEdges& r : rounded) r.points(lo, hi, vertex, bends);
   };
   solid.distance = true;
+  solid.offset = offset;
+  solid.value_site = [&](const Vec3& p, uint32_t& site) {
+    uint32_t& hint = hints.local();
+    const double v = g(sd(p, &hint)).first;
+    site = hint;
+    return v;
+  };
+  solid.site_distance = [&](const Vec3& p, uint32_t site) { return sd.mesh_distance().distance_to_hint(p, site); };
   SampleOptions o = options;
   o.cube = cube;
   return sample_with_mesh(solid, o, stats, mesh);
@@ -205,7 +214,7 @@ Octree offset_of_surface(const TriMesh& surface, double distance, const SampleOp
   const Cube cube = cube_around(surface, distance, options);
   try {
     return sample_distance(surface, cube, options, stats, mesh, {{distance, distance}},
-                           [&](double d) { return std::pair{d - distance, 1.0}; });
+                           [&](double d) { return std::pair{d - distance, 1.0}; }, distance);
   } catch (const EmptySolid&) {
     if (distance >= 0) throw;
     char what[160];
