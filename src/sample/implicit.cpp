@@ -110,10 +110,20 @@ struct EdgeHermite {
   Vec3 x, g;
 };
 using EdgeMemo = ThreadMemo<EdgeHermite, 14>;
-/// What a function asked one point at a time is memoized in.
+/// f at a gray leaf's vertex as stored (`at`: its unit position after rounding to the leaf's
+/// float coordinates), asked at the unrounded position `slack` (world units) away, with the
+/// site there (ImplicitSolid::value_site).
+struct VertexValue {
+  Vec3 at;
+  double f, slack;
+  uint32_t site;
+};
+/// What a function asked one point at a time is memoized in, and the values its vertex checks
+/// found (for the polygons' check).
 struct Memos {
   PointMemo points;
   EdgeMemo edges;
+  tbb::enumerable_thread_specific<std::vector<VertexValue>> vertices;
 };
 
 /// Leaves within this many levels of the cap are not asked whether they hide surface: a sheet
@@ -389,6 +399,14 @@ class LevelSampler {
       fv.resize(at.size());
       evaluations += at.size();
       for_each(at.size(), [&](size_t i) { fv[i] = f_.value_site(world(at[i]), site[fitting[i]]); });
+      if (memo_) {
+        std::vector<VertexValue>& kept = memo_->vertices.local();
+        for (size_t i = 0; i < at.size(); ++i) {
+          const Cell& cell = jobs[cand[fitting[i]]].cell;
+          const Vec3 stored = vertex_unit(cell, to_local(cell, at[i]));
+          kept.push_back({stored, fv[i], norm3(sub3(stored, at[i])) * cube_.size, site[fitting[i]]});
+        }
+      }
     } else {
       fv = values(at);
     }
@@ -805,7 +823,8 @@ GrayLeaves gray_leaves(const Octree& tree) {
 /// Which of `points` (unit space) the bounds of f = s - offset (ImplicitSolid::offset, with
 /// sites) leave to be asked, each point the mean of the polygon vertices `from` (kNone past the
 /// last); `off` gets, per point, whether |f| there is proven beyond `tolerance` (f's units).
-/// f is asked at those vertices (once each, with their sites; counted in `asked`). Where they all lie on one side of
+/// f is asked at those vertices (once each, with their sites; counted in `asked`) but where
+/// the vertex checks found it (`known`, sorted by position). Where they all lie on one side of
 /// s's surface, farther than half their spread's diameter, no point of their hull meets that
 /// surface, and |s| at their mean m is at least sqrt(mean s_k^2 - mean |x_k - m|^2) (the
 /// parallelogram law) and at most m's distance to each vertex's site: f(m) lies between. A
@@ -813,7 +832,8 @@ GrayLeaves gray_leaves(const Octree& tree) {
 /// rounding, is decided as asking f would decide it.
 std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube, const GrayLeaves& g,
                                         const std::vector<Vec3>& points, const std::vector<std::array<uint32_t, 4>>& from,
-                                        double tolerance, bool parallel, std::vector<char>& off, size_t& asked) {
+                                        double tolerance, bool parallel, const std::vector<VertexValue>& known,
+                                        std::vector<char>& off, size_t& asked) {
   off.assign(points.size(), 0);
   std::vector<size_t> undecided(points.size());
   std::iota(undecided.begin(), undecided.end(), size_t{0});
@@ -843,14 +863,23 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
     if (spread_allows(i))
       for (uint32_t v : from[i])
         if (v != kNone && index[v] == kNone) index[v] = uint32_t(used.size()), used.push_back(v);
-  std::vector<double> s(used.size());
+  std::vector<double> s(used.size()), slack(used.size(), 0);
   std::vector<uint32_t> site(used.size());
   const auto each = [&](size_t n, auto&& fn) {
     if (parallel) tbb::parallel_for(size_t{0}, n, fn);
     else for (size_t i = 0; i < n; ++i) fn(i);
   };
-  each(used.size(), [&](size_t k) { s[k] = f.value_site(unit_to_world(cube, g.pos[used[k]]), site[k]) + offset; });
-  asked += used.size();
+  std::vector<char> ask(used.size(), 1);
+  each(used.size(), [&](size_t k) {
+    const Vec3& at = g.pos[used[k]];
+    const auto it = std::lower_bound(known.begin(), known.end(), at, [](const VertexValue& v, const Vec3& p) { return v.at < p; });
+    if (it == known.end() || it->at != at) return;
+    s[k] = it->f + offset, slack[k] = it->slack, site[k] = it->site, ask[k] = 0;
+  });
+  each(used.size(), [&](size_t k) {
+    if (ask[k]) s[k] = f.value_site(unit_to_world(cube, g.pos[used[k]]), site[k]) + offset;
+  });
+  asked += size_t(std::count(ask.begin(), ask.end(), 1));
   std::vector<char> decided(points.size(), 0);
   const double inner = tolerance * (1 - kBoundMargin), outer = tolerance * (1 + kBoundMargin);
   each(points.size(), [&](size_t i) {
@@ -862,12 +891,14 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
       if (v == kNone) break;
       const uint32_t k = index[v];
       if (k == kNone) return;
-      const int sk = s[k] > 0 ? 1 : s[k] < 0 ? -1 : 0;
+      // |s| at the vertex, to within the slack of where it was asked.
+      const double near = std::abs(s[k]) - slack[k];
+      const int sk = !(near > 0) ? 0 : s[k] > 0 ? 1 : -1;
       if (sk == 0 || (side != 0 && sk != side)) return;
       side = sk;
       x[n] = unit_to_world(cube, g.pos[v]);
       for (int a = 0; a < n; ++a) diameter2 = std::max(diameter2, dot3(sub3(x[a], x[n]), sub3(x[a], x[n])));
-      mean_s2 += s[k] * s[k], spread += dot3(sub3(x[n], m), sub3(x[n], m)), least = std::min(least, s[k] * s[k]);
+      mean_s2 += near * near, spread += dot3(sub3(x[n], m), sub3(x[n], m)), least = std::min(least, near * near);
       high = std::min(high, f.site_distance(m, site[k]));
       ++n;
     }
@@ -936,8 +967,12 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
       std::copy_n(poly.v.begin(), poly.count, from.back().begin());
     }
     std::vector<char> proven_off;
-    const std::vector<size_t> asked =
-        undecided_by_bounds(f, tree.cube, g, points, from, tolerance, parallel, proven_off, sampler.evaluations);
+    std::vector<VertexValue> known;
+    if (resample.memo)
+      for (const std::vector<VertexValue>& part : resample.memo->vertices) known.insert(known.end(), part.begin(), part.end());
+    std::sort(known.begin(), known.end(), [](const VertexValue& a, const VertexValue& b) { return a.at < b.at; });
+    const std::vector<size_t> asked = undecided_by_bounds(f, tree.cube, g, points, from, tolerance, parallel, known,
+                                                          proven_off, sampler.evaluations);
     std::vector<Vec3> at(asked.size());
     for (size_t k = 0; k < asked.size(); ++k) at[k] = points[asked[k]];
     const std::vector<double> fv = sampler.values(at);
