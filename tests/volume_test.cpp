@@ -796,5 +796,25 @@ TEST(Offset, DistanceBoundsDecideChecksAsTheValuesWould) {
   expect_valid(contour(a));
 }
 
+TEST(Offset, APartHiddenInACoarseLeafIsKept) {
+  // A square prism 3 wide standing apart from a hexagonal prism, shrunk by 0.15 in a root cube
+  // whose level-1 cell holds the whole square prism and a corner of the hexagonal one: the
+  // leaf's corners, edges and octant centres all miss the square prism (every one outside
+  // it, an octant centre 0.6 from it while its planes' extensions pass nearer), so it was
+  // dropped, a whole part of the result gone. The surface point f's gradient leads to from
+  // that octant centre lies on no polygon of the leaf: the leaf is sampled again.
+  const double d = 0.148125;
+  const TriMesh both = joined(make_cylinder({-4, -4, -6}, 3 / std::sqrt(2.0), 3 * std::sqrt(2.0), 2, 4),
+                               make_cylinder({0, 4, 0}, 6, 4, 2, 6));
+  SampleOptions o = at_depth(7);
+  o.cube = Cube{{-14.56066, -14.462585, -17.5}, 32};
+  const TriMesh m = contour(offset(both, -d, o));
+  expect_valid(m);
+  const double side = 3 - 2 * d, apothem = 6 * std::sqrt(3.0) / 2 - d;
+  const double exact = side * side * (3 * std::sqrt(2.0) - 2 * d) + 2 * std::sqrt(3.0) * apothem * apothem * (4 - 2 * d);
+  EXPECT_NEAR(volume(m), exact, 1e-3 * exact);
+  EXPECT_EQ(check_validity(m, false).components, 2u);
+}
+
 }  // namespace
 }  // namespace pic

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include "geometry/lattice.h"
@@ -118,12 +119,14 @@ struct VertexValue {
   double f, slack;
   uint32_t site;
 };
-/// What a function asked one point at a time is memoized in, and the values its vertex checks
-/// found (for the polygons' check).
+/// What a function asked one point at a time is memoized in, and what its vertex and octant
+/// checks found for the polygons' check.
 struct Memos {
   PointMemo points;
   EdgeMemo edges;
   tbb::enumerable_thread_specific<std::vector<VertexValue>> vertices;
+  /// Surface points (unit space) the octant checks found in a leaf's cell away from its planes.
+  tbb::enumerable_thread_specific<std::vector<Vec3>> unrepresented;
 };
 
 /// Leaves within this many levels of the cap are not asked whether they hide surface: a sheet
@@ -497,17 +500,20 @@ class LevelSampler {
     std::vector<size_t> leaf;  // per centre
     std::vector<Vec3> centres;
     std::vector<std::pair<double, double>> planes;  // per centre: nearest_plane
+    std::vector<double> represented;                 // per centre: represented_distance
     for (size_t k : asked) {
       const Job& j = jobs[cand[k]];
       const Vec3 m = j.cell.min_unit();
       const double q = j.cell.size() / 4, diagonal = j.cell.size() * std::sqrt(3.0) / 2;
+      const Crease crease = crease_of(j, cell_edges[k], edges);
       for (int o = 0; o < 8; ++o) {
         if (reach(j.v[o]) > diagonal) continue;
         const Vec3 c{m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q};
         // Within the tolerance of a plane both tests below pass, whatever f says there.
         const auto plane = nearest_plane(c, cell_edges[k], edges);
         if (plane.first <= tolerance) continue;
-        const Outcome known = octant_by_corners(j, o, c, site[k], plane, tolerance);
+        const double rep = represented_distance(c, crease, cell_edges[k], edges);
+        const Outcome known = octant_by_corners(j, o, c, site[k], plane, rep, tolerance);
         if (known == Outcome::Agrees) continue;
         if (known == Outcome::Disagrees) {
           fits[k] = 0;
@@ -516,19 +522,111 @@ class LevelSampler {
         leaf.push_back(k);
         centres.push_back(c);
         planes.push_back(plane);
+        represented.push_back(rep);
       }
     }
     const std::vector<double> f = values(centres);
+    std::vector<size_t> unrepresented;
     for (size_t i = 0; i < centres.size(); ++i) {
       const size_t k = leaf[i];
-      const double r = reach(f[i]), half_diagonal = jobs[cand[k]].cell.size() * std::sqrt(3.0) / 4;
+      const double size = jobs[cand[k]].cell.size(), r = reach(f[i]), half_diagonal = size * std::sqrt(3.0) / 4;
       const auto [nearest, side] = planes[i];
       if (r > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
+      if (!f_.distance) continue;
       // Here |f| is taken at slope 1, as the distance along f's gradient to where f is 0: at
       // most the distance to the surface, for a bound steeper than 1 only near it.
       const double along = std::abs(f[i]) / cube_.size;
-      if (f_.distance && along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
+      if (along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
+      else if (fits[k] && !represented_reaches(along, represented[i], size, tolerance)) unrepresented.push_back(i);
     }
+    if (!memo_) return;
+    for (size_t i : unrepresented)
+      if (const auto p = unrepresented_surface_point(jobs[cand[leaf[i]]], centres[i], cell_edges[leaf[i]], edges, tolerance))
+        memo_->unrepresented.local().push_back(*p);
+  }
+
+  /// Whether the surface a leaf's planes stand for reaches the ball of radius `along` about an
+  /// octant centre (within the tolerance), or that ball leaves the cell. Where |f| is the
+  /// distance to the surface and the ball lies in the cell, the surface point nearest the
+  /// centre is in the cell and must be represented there.
+  static bool represented_reaches(double along, double represented, double size, double tolerance) {
+    return along > size / 4 || represented <= along + tolerance;
+  }
+
+  /// The surface point f's gradient leads to from octant centre c (one Newton step: the
+  /// surface point nearest c where |f| is the distance), when f confirms it on the surface,
+  /// inside the cell and beyond the tolerance from the surface the leaf's planes stand for.
+  /// Such a point may be a part of the solid lying in the cell apart from the leaf's surface,
+  /// farther from c than a plane's extension but nearer than the surface the planes bound (a
+  /// box 4 units wide hidden in a leaf 16 units wide, 0.6 from an octant centre whose leaf's
+  /// planes meet 3.7 away), or surface the neighbours' vertices draw; the polygons' check
+  /// tells the two apart once the tree is whole. Where |f| falls short of the distance
+  /// (beside an offset's medial axis) the step ends off the surface and nothing is found. Two
+  /// more values of f; none without f's gradient.
+  std::optional<Vec3> unrepresented_surface_point(const Job& j, const Vec3& c, const std::array<uint32_t, 12>& ids,
+                                                  const std::vector<Edge>& edges, double tolerance) {
+    if (!f_.value_gradient && !f_.gradient) return std::nullopt;
+    Vec3 g{0, 0, 0};
+    double fc = 0;
+    if (f_.value_gradient) {
+      fc = f_.value_gradient(world(c), g);
+    } else {
+      fc = f_.value(world(c));
+      g = f_.gradient(world(c));
+    }
+    evaluations += 2;
+    const double g2 = dot3(g, g);
+    if (!(g2 > 0)) return std::nullopt;
+    const Vec3 p = sub3(c, scale3(g, fc / (g2 * cube_.size)));  // unit space
+    const Vec3 lo = j.cell.min_unit();
+    for (int k = 0; k < 3; ++k)
+      if (!(p[k] >= lo[k] && p[k] <= lo[k] + j.cell.size())) return std::nullopt;
+    if (reach(f_.value(world(p))) > tolerance) return std::nullopt;
+    if (represented_distance(p, crease_of(j, ids, edges), ids, edges) <= tolerance) return std::nullopt;
+    return p;
+  }
+
+  /// How a leaf's planes bound its solid: the intersection of their inner sides (a convex
+  /// corner or crease), their union (a concave one), or neither, as its corner signs say.
+  enum class Crease { Convex, Concave, Other };
+  static Crease crease_of(const Job& j, const std::array<uint32_t, 12>& ids, const std::vector<Edge>& edges) {
+    bool convex = true, concave = true;
+    for (int k = 0; k < 8 && (convex || concave); ++k) {
+      const Vec3 x = lattice_unit(j.cell.corner(k));
+      bool all = true, any = false, some = false;
+      for (uint32_t id : ids) {
+        if (id == kNone || !(norm3(edges[id].g) > 0)) continue;
+        const bool in = dot3(edges[id].g, sub3(x, edges[id].x)) < 0;
+        all = all && in, any = any || in, some = true;
+      }
+      if (!some) return Crease::Other;
+      const bool inside = j.v[k] < 0;
+      convex = convex && inside == all;
+      concave = concave && inside == any;
+    }
+    return convex ? Crease::Convex : concave ? Crease::Concave : Crease::Other;
+  }
+
+  /// A lower bound on the distance from c to the surface a leaf's planes stand for: outside the
+  /// intersection of their inner sides (or inside their union), the farthest plane c lies
+  /// beyond (on the wrong side of); else the nearest plane.
+  static double represented_distance(const Vec3& c, Crease crease, const std::array<uint32_t, 12>& ids,
+                                     const std::vector<Edge>& edges) {
+    double nearest = detail::kHuge, beyond = 0;
+    bool all_in = true, any_in = false;
+    for (uint32_t id : ids) {
+      if (id == kNone) continue;
+      const double len = norm3(edges[id].g);
+      if (!(len > 0)) continue;
+      const double d = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
+      nearest = std::min(nearest, std::abs(d));
+      all_in = all_in && d < 0, any_in = any_in || d < 0;
+      if (crease == Crease::Convex && d > 0) beyond = std::max(beyond, d);
+      if (crease == Crease::Concave && d < 0) beyond = std::max(beyond, -d);
+    }
+    if (crease == Crease::Convex && !all_in) return std::max(nearest, beyond);
+    if (crease == Crease::Concave && any_in) return std::max(nearest, beyond);
+    return nearest;
   }
 
   enum class Outcome { Agrees, Disagrees, Unknown };
@@ -538,7 +636,7 @@ class LevelSampler {
   /// bound (offset_bound) and, from the site of the leaf's vertex, an upper bound on c's distance
   /// to s's surface.
   Outcome octant_by_corners(const Job& j, int o, const Vec3& c, uint32_t site, const std::pair<double, double>& plane,
-                            double tolerance) const {
+                            double represented, double tolerance) const {
     const double q = j.cell.size() / 4;
     double low = 0;  // a lower bound on reach(f(c))
     bool negative = false;
@@ -566,8 +664,11 @@ class LevelSampler {
     if (sign_differs && low > tolerance) return Outcome::Disagrees;
     if (sign_differs) return Outcome::Unknown;
     if (!f_.distance) return Outcome::Agrees;
+    // Passes for every |f(c)| at least `along` (surface_as_represented).
     const double along = low * f_.lipschitz, half_diagonal = j.cell.size() * std::sqrt(3.0) / 4;
-    if (along >= half_diagonal || nearest <= along + tolerance) return Outcome::Agrees;
+    const bool planes_pass = along >= half_diagonal || nearest <= along + tolerance;
+    const bool represented_pass = along > j.cell.size() / 4 || represented <= along + tolerance;
+    if (planes_pass && represented_pass) return Outcome::Agrees;
     return Outcome::Unknown;
   }
 
@@ -914,6 +1015,56 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
   return undecided;
 }
 
+/// The distance from p to polygon `poly` (vertex positions `pos`), over both ways of cutting a
+/// quadrilateral into triangles.
+double polygon_distance(const Vec3& p, const MeshPolygon& poly, const std::vector<Vec3>& pos) {
+  const auto at = [&](int i) -> const Vec3& { return pos[poly.v[i]]; };
+  if (poly.count == 3) return std::sqrt(point_triangle_distance2(p, at(0), at(1), at(2)));
+  const double d2 = std::min({point_triangle_distance2(p, at(0), at(1), at(2)), point_triangle_distance2(p, at(0), at(2), at(3)),
+                              point_triangle_distance2(p, at(0), at(1), at(3)), point_triangle_distance2(p, at(1), at(2), at(3))});
+  return std::sqrt(d2);
+}
+
+/// The surface points the octant checks found in a leaf away from its planes
+/// (Memos::unrepresented) that still lie in a leaf wider than 2^kUncheckedLevels finest cells
+/// must lie within `tolerance` (unit space) of a polygon of that leaf's vertex, or of a vertex
+/// beside it (the surface near a cell's side is drawn by its neighbours' polygons too); where
+/// one does not, a part of the solid lies in the leaf apart from its surface, and the leaf is
+/// marked in `off`.
+void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vector<MeshPolygon>& polys, Memos& memo,
+                        double tolerance, std::vector<char>& off) {
+  std::vector<Vec3> points;
+  for (const std::vector<Vec3>& part : memo.unrepresented) points.insert(points.end(), part.begin(), part.end());
+  if (points.empty()) return;
+  // The polygons of each vertex.
+  std::vector<uint32_t> start(g.pos.size() + 1, 0), of;
+  for (const MeshPolygon& poly : polys)
+    for (int i = 0; i < poly.count; ++i) ++start[poly.v[i] + 1];
+  for (size_t v = 0; v < g.pos.size(); ++v) start[v + 1] += start[v];
+  of.resize(start.back());
+  std::vector<uint32_t> next(start.begin(), start.end() - 1);
+  for (uint32_t i = 0; i < polys.size(); ++i)
+    for (int k = 0; k < polys[i].count; ++k) of[next[polys[i].v[k]]++] = i;
+  const int64_t span = int64_t{1} << kMaxLevel;
+  for (const Vec3& p : points) {
+    Lat q;
+    for (int k = 0; k < 3; ++k) q[k] = std::clamp(int64_t(std::floor(p[k] * double(span))), int64_t{0}, span - 1);
+    const LeafRef l = leaf_at(tree, q);
+    const Node& n = tree.nodes[l.node];
+    if (n.kind != CellKind::Gray || l.cell.level + kUncheckedLevels >= tree.max_depth) continue;
+    double best = detail::kHuge;
+    const auto near_polygons_of = [&](uint32_t u) {
+      for (uint32_t i = start[u]; i < start[u + 1] && best > tolerance; ++i)
+        best = std::min(best, polygon_distance(p, polys[of[i]], g.pos));
+    };
+    near_polygons_of(n.index);
+    for (uint32_t i = start[n.index]; i < start[n.index + 1] && best > tolerance; ++i)
+      for (int k = 0; k < polys[of[i]].count; ++k)
+        if (polys[of[i]].v[k] != n.index) near_polygons_of(polys[of[i]].v[k]);
+    if (best > tolerance) off[n.index] = 1;
+  }
+}
+
 /// A coarse leaf's polygons join its vertex to its neighbours' by straight sides, but its
 /// planes come from its own edges' crossings only: a crease inside the cell that no edge
 /// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
@@ -982,6 +1133,7 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
       if (proven_off[i])
         for (uint32_t v : blamed[i])
           if (v != kNone) off[v] = 1;
+    if (resample.memo) mark_unrepresented(tree, g, polys, *resample.memo, tolerance / (f.lipschitz * tree.cube.size), off);
     std::vector<Lat> centres;
     for (size_t v = 0; v < off.size(); ++v)
       if (off[v]) {
