@@ -125,6 +125,7 @@ struct Memos {
   PointMemo points;
   EdgeMemo edges;
   tbb::enumerable_thread_specific<std::vector<VertexValue>> vertices;
+  std::vector<VertexValue> vertices_sorted;  // those gathered so far, by position
   /// Surface points (unit space) the octant checks found in a leaf's cell away from its planes.
   tbb::enumerable_thread_specific<std::vector<Vec3>> unrepresented;
 };
@@ -574,13 +575,14 @@ class LevelSampler {
       fc = f_.value(world(c));
       g = f_.gradient(world(c));
     }
-    evaluations += 2;
+    ++evaluations;
     const double g2 = dot3(g, g);
     if (!(g2 > 0)) return std::nullopt;
     const Vec3 p = sub3(c, scale3(g, fc / (g2 * cube_.size)));  // unit space
     const Vec3 lo = j.cell.min_unit();
     for (int k = 0; k < 3; ++k)
       if (!(p[k] >= lo[k] && p[k] <= lo[k] + j.cell.size())) return std::nullopt;
+    ++evaluations;
     if (reach(f_.value(world(p))) > tolerance) return std::nullopt;
     if (represented_distance(p, crease_of(j, ids, edges), ids, edges) <= tolerance) return std::nullopt;
     return p;
@@ -959,17 +961,19 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
     const double reach = std::abs(offset) - tolerance;
     return n > 0 && spread / n <= 2 * std::abs(offset) * tolerance && reach > 0 && diameter2 / 2 < reach * reach;
   };
-  std::vector<uint32_t> index(g.pos.size(), kNone), used;
-  for (size_t i = 0; i < points.size(); ++i)
-    if (spread_allows(i))
-      for (uint32_t v : from[i])
-        if (v != kNone && index[v] == kNone) index[v] = uint32_t(used.size()), used.push_back(v);
-  std::vector<double> s(used.size()), slack(used.size(), 0);
-  std::vector<uint32_t> site(used.size());
   const auto each = [&](size_t n, auto&& fn) {
     if (parallel) tbb::parallel_for(size_t{0}, n, fn);
     else for (size_t i = 0; i < n; ++i) fn(i);
   };
+  std::vector<char> allowed(points.size());
+  each(points.size(), [&](size_t i) { allowed[i] = spread_allows(i); });
+  std::vector<uint32_t> index(g.pos.size(), kNone), used;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (allowed[i])
+      for (uint32_t v : from[i])
+        if (v != kNone && index[v] == kNone) index[v] = uint32_t(used.size()), used.push_back(v);
+  std::vector<double> s(used.size()), slack(used.size(), 0);
+  std::vector<uint32_t> site(used.size());
   std::vector<char> ask(used.size(), 1);
   each(used.size(), [&](size_t k) {
     const Vec3& at = g.pos[used[k]];
@@ -1013,6 +1017,20 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
   });
   std::erase_if(undecided, [&](size_t i) { return decided[i] != 0; });
   return undecided;
+}
+
+/// The vertex checks' values so far, by position: those found since the last call merged in.
+const std::vector<VertexValue>& sorted_vertex_values(Memos& memo) {
+  const auto by_position = [](const VertexValue& a, const VertexValue& b) { return a.at < b.at; };
+  std::vector<VertexValue>& all = memo.vertices_sorted;
+  const size_t before = all.size();
+  for (std::vector<VertexValue>& part : memo.vertices) {
+    all.insert(all.end(), part.begin(), part.end());
+    part.clear();
+  }
+  tbb::parallel_sort(all.begin() + std::ptrdiff_t(before), all.end(), by_position);
+  std::inplace_merge(all.begin(), all.begin() + std::ptrdiff_t(before), all.end(), by_position);
+  return all;
 }
 
 /// The distance from p to polygon `poly` (vertex positions `pos`), over both ways of cutting a
@@ -1118,10 +1136,8 @@ size_t refine_polygons_off_surface(Octree& tree, LevelSampler& sampler, Function
       std::copy_n(poly.v.begin(), poly.count, from.back().begin());
     }
     std::vector<char> proven_off;
-    std::vector<VertexValue> known;
-    if (resample.memo)
-      for (const std::vector<VertexValue>& part : resample.memo->vertices) known.insert(known.end(), part.begin(), part.end());
-    std::sort(known.begin(), known.end(), [](const VertexValue& a, const VertexValue& b) { return a.at < b.at; });
+    static const std::vector<VertexValue> kNoValues;
+    const std::vector<VertexValue>& known = resample.memo ? sorted_vertex_values(*resample.memo) : kNoValues;
     const std::vector<size_t> asked = undecided_by_bounds(f, tree.cube, g, points, from, tolerance, parallel, known,
                                                           proven_off, sampler.evaluations);
     std::vector<Vec3> at(asked.size());
