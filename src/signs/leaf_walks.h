@@ -24,7 +24,19 @@ void leaves_touching_if(const Octree& t, uint32_t node, const Cell& cell, const 
     out.push_back({node, cell});
     return;
   }
-  for (int c = 0; c < 8; ++c) leaves_touching_if(t, n.index + c, cell.child(c), lo, hi, skip, out);
+  // Only the children whose halves meet the box along every axis, in child order.
+  int first[3], last[3];
+  for (int k = 0; k < 3; ++k) {
+    const int64_t mid = cell.lat[k] + s / 2;
+    first[k] = lo[k] <= mid ? 0 : 1;
+    last[k] = hi[k] >= mid ? 1 : 0;
+  }
+  for (int z = first[2]; z <= last[2]; ++z)
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x) {
+        const int c = x | y << 1 | z << 2;
+        leaves_touching_if(t, n.index + c, cell.child(c), lo, hi, skip, out);
+      }
 }
 
 /// Every leaf up to level `max_level` whose closed cell meets the closed lattice box [lo, hi],
