@@ -116,7 +116,8 @@ using EdgeMemo = ThreadMemo<EdgeHermite, 14>;
 /// site there (ImplicitSolid::value_site).
 struct VertexValue {
   Vec3 at;
-  double f, slack;
+  double f;
+  float slack;  // rounded up
   uint32_t site;
 };
 /// What a function asked one point at a time is memoized in, and what its vertex and octant
@@ -403,14 +404,6 @@ class LevelSampler {
       fv.resize(at.size());
       evaluations += at.size();
       for_each(at.size(), [&](size_t i) { fv[i] = f_.value_site(world(at[i]), site[fitting[i]]); });
-      if (memo_) {
-        std::vector<VertexValue>& kept = memo_->vertices.local();
-        for (size_t i = 0; i < at.size(); ++i) {
-          const Cell& cell = jobs[cand[fitting[i]]].cell;
-          const Vec3 stored = vertex_unit(cell, to_local(cell, at[i]));
-          kept.push_back({stored, fv[i], norm3(sub3(stored, at[i])) * cube_.size, site[fitting[i]]});
-        }
-      }
     } else {
       fv = values(at);
     }
@@ -430,6 +423,17 @@ class LevelSampler {
         out.set_gray(j.slot, j.cell, signs, sol[k].position, ok ? 0 : kFlagCapped);
       } else {
         split.push_back(j);
+      }
+    }
+    // The kept leaves' vertex values, for the polygons' check.
+    if (memo_ && f_.value_site && !f_.values) {
+      std::vector<VertexValue>& kept = memo_->vertices.local();
+      for (size_t i = 0; i < fitting.size(); ++i) {
+        const size_t k = fitting[i];
+        if (!fits[k]) continue;
+        const Cell& cell = jobs[cand[k]].cell;
+        const Vec3 stored = vertex_unit(cell, to_local(cell, sol[k].position));
+        kept.push_back({stored, fv[i], float(norm3(sub3(stored, sol[k].position)) * cube_.size * (1 + 1e-6)), site[k]});
       }
     }
   }
