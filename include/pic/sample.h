@@ -110,8 +110,9 @@ struct ImplicitSolid {
   /// than the Lipschitz one where the surface is far from the cell, which decides many of the
   /// sampler's checks without asking f.
   std::optional<double> offset;
-  /// With `offset` (both optional): f at p and an opaque site there (the surface's feature
-  /// nearest p), and from a site an upper bound on |s| anywhere (the distance to that feature),
+  /// With `offset` (both optional): f at p (the same value as `value`) and an opaque site there
+  /// (the surface's feature nearest p), and from a site an upper bound on |s| anywhere (the
+  /// distance to that feature),
   /// far cheaper than f. With the lower bound above they decide most of the checks of the
   /// polygons between points asked.
   std::function<double(const Vec3&, uint32_t& site)> value_site;

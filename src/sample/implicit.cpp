@@ -117,7 +117,7 @@ using EdgeMemo = ThreadMemo<EdgeHermite, 14>;
 struct VertexValue {
   Vec3 at;
   double f;
-  float slack;  // rounded up
+  float slack;  // rounded up (widened by a millionth before rounding to a float)
   uint32_t site;
 };
 /// What a function asked one point at a time is memoized in, and what its vertex and octant
@@ -136,6 +136,9 @@ struct Memos {
 /// doubled the values an offset takes (spot grown at depth 10: 2.15 M instead of 1.13 M) for
 /// no change measured.
 constexpr int kUncheckedLevels = 2;
+
+/// Newton steps from an octant centre towards the surface, at most (a part hidden in a leaf).
+constexpr int kSurfaceSteps = 6;
 
 /// A cell waiting at its level, with f at its corners.
 struct Job {
@@ -544,10 +547,13 @@ class LevelSampler {
       if (along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
       else if (fits[k] && !represented_reaches(along, represented[i], size, tolerance)) unrepresented.push_back(i);
     }
-    if (!memo_) return;
-    for (size_t i : unrepresented)
-      if (const auto p = unrepresented_surface_point(jobs[cand[leaf[i]]], centres[i], cell_edges[leaf[i]], edges, tolerance))
+    if (!memo_) return;  // a batched f: no hidden-part check
+    for (size_t i : unrepresented) {
+      const size_t k = leaf[i];
+      if (!fits[k]) continue;
+      if (const auto p = unrepresented_surface_point(jobs[cand[k]], centres[i], cell_edges[k], edges, tolerance))
         memo_->unrepresented.local().push_back(*p);
+    }
   }
 
   /// Whether the surface a leaf's planes stand for reaches the ball of radius `along` about an
@@ -558,36 +564,38 @@ class LevelSampler {
     return along > size / 4 || represented <= along + tolerance;
   }
 
-  /// The surface point f's gradient leads to from octant centre c (one Newton step: the
-  /// surface point nearest c where |f| is the distance), when f confirms it on the surface,
-  /// inside the cell and beyond the tolerance from the surface the leaf's planes stand for.
+  /// The surface point f's gradient leads to from octant centre c (Newton steps: the first
+  /// lands on the surface point nearest c where |f| is the distance; where |f| falls short of
+  /// the distance, beside an offset's medial axis, a few more), when f confirms it on the
+  /// surface, inside the cell and beyond the tolerance from the surface the leaf's planes
+  /// stand for.
   /// Such a point may be a part of the solid lying in the cell apart from the leaf's surface,
   /// farther from c than a plane's extension but nearer than the surface the planes bound (a
   /// box 4 units wide hidden in a leaf 16 units wide, 0.6 from an octant centre whose leaf's
   /// planes meet 3.7 away), or surface the neighbours' vertices draw; the polygons' check
-  /// tells the two apart once the tree is whole. Where |f| falls short of the distance
-  /// (beside an offset's medial axis) the step ends off the surface and nothing is found. Two
-  /// more values of f; none without f's gradient.
+  /// tells the two apart once the tree is whole. One more value of f per step; none without
+  /// f's gradient.
   std::optional<Vec3> unrepresented_surface_point(const Job& j, const Vec3& c, const std::array<uint32_t, 12>& ids,
                                                   const std::vector<Edge>& edges, double tolerance) {
     if (!f_.value_gradient && !f_.gradient) return std::nullopt;
-    Vec3 g{0, 0, 0};
-    double fc = 0;
-    if (f_.value_gradient) {
-      fc = f_.value_gradient(world(c), g);
-    } else {
-      fc = f_.value(world(c));
-      g = f_.gradient(world(c));
-    }
-    ++evaluations;
-    const double g2 = dot3(g, g);
-    if (!(g2 > 0)) return std::nullopt;
-    const Vec3 p = sub3(c, scale3(g, fc / (g2 * cube_.size)));  // unit space
+    const auto value_gradient = [&](const Vec3& x, Vec3& g) {
+      ++evaluations;
+      if (f_.value_gradient) return f_.value_gradient(world(x), g);
+      g = f_.gradient(world(x));
+      return f_.value(world(x));
+    };
     const Vec3 lo = j.cell.min_unit();
-    for (int k = 0; k < 3; ++k)
-      if (!(p[k] >= lo[k] && p[k] <= lo[k] + j.cell.size())) return std::nullopt;
-    ++evaluations;
-    if (reach(f_.value(world(p))) > tolerance) return std::nullopt;
+    Vec3 p = c, g;
+    double fp = value_gradient(p, g);
+    for (int step = 0; step < kSurfaceSteps && reach(fp) > tolerance; ++step) {
+      const double g2 = dot3(g, g);
+      if (!(g2 > 0)) return std::nullopt;
+      p = sub3(p, scale3(g, fp / (g2 * cube_.size)));  // unit space
+      for (int k = 0; k < 3; ++k)
+        if (!(p[k] >= lo[k] && p[k] <= lo[k] + j.cell.size())) return std::nullopt;
+      fp = value_gradient(p, g);
+    }
+    if (reach(fp) > tolerance) return std::nullopt;
     if (represented_distance(p, crease_of(j, ids, edges), ids, edges) <= tolerance) return std::nullopt;
     return p;
   }
@@ -630,8 +638,7 @@ class LevelSampler {
       if (crease == Crease::Convex && d > 0) beyond = std::max(beyond, d);
       if (crease == Crease::Concave && d < 0) beyond = std::max(beyond, -d);
     }
-    if (crease == Crease::Convex && !all_in) return std::max(nearest, beyond);
-    if (crease == Crease::Concave && any_in) return std::max(nearest, beyond);
+    if ((crease == Crease::Convex && !all_in) || (crease == Crease::Concave && any_in)) return beyond;
     return nearest;
   }
 
@@ -689,6 +696,8 @@ class LevelSampler {
     double sum = 0, least = detail::kHuge;
     int side = 0;
     for (int k = 0; k < 8; ++k) {
+      // A corner resampled against f's sign holds a hair (the tree's sign), not f's value.
+      if (std::abs(j.v[k]) <= std::numeric_limits<double>::min()) return 0;
       const double s = j.v[k] + offset;
       const int sk = s > 0 ? 1 : s < 0 ? -1 : 0;
       if (sk == 0 || (side != 0 && sk != side)) return 0;
