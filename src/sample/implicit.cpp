@@ -69,6 +69,14 @@ Lat unpack(uint64_t k) { return {int64_t(gather(k)), int64_t(gather(k >> 1)), in
 
 constexpr uint32_t kNone = ~uint32_t{0};
 
+/// The parallelogram law's lower bound on the distance to a set at a mean point c = sum w_k x_k
+/// (weights summing to 1) of points x_k all on one side of its boundary: for any set,
+/// d(c)^2 >= sum w_k d(x_k)^2 - sum w_k |x_k - c|^2. Takes both sums; 0 where they leave nothing.
+double parallelogram_bound(double weighted_d2, double weighted_spread) {
+  const double d2 = weighted_d2 - weighted_spread;
+  return d2 > 0 ? std::sqrt(d2) : 0;
+}
+
 /// Numbers the distinct keys of `refs` (key, owner) by their first owner: each owner's
 /// number goes to `id` (indexed by owner; owners not in `refs` keep kNone). Returns the
 /// count. Numbering by first owner keeps a batch in the order the cells asked, near points
@@ -497,6 +505,14 @@ class LevelSampler {
   /// The planes fit the crossings within sqrt(error): twice that is rounding, not a sheet.
   double sheet_tolerance() const { return 2 * std::sqrt(error_); }
 
+  /// How a leaf's planes bound its solid (crease_of): the intersection of their inner sides (a
+  /// convex corner or crease), their union (a concave one), or neither, as its corner signs say.
+  enum class Crease { Convex, Concave, Other };
+  /// Where a point lies among a leaf's planes (plane_distances).
+  struct PlaneDistances {
+    double nearest, side, represented;
+  };
+
   /// Each octant of the leaves `asked`, at its centre c, but those their own corner clears (|f|
   /// there beyond the octant's diagonal: no surface in it): c on the side of the nearest plane
   /// that f says, unless near both; and, where |f| is a distance, the surface no nearer c than
@@ -507,8 +523,8 @@ class LevelSampler {
     const double tolerance = sheet_tolerance();
     std::vector<size_t> leaf;  // per centre
     std::vector<Vec3> centres;
-    std::vector<std::pair<double, double>> planes;  // per centre: nearest_plane
-    std::vector<double> represented;                 // per centre: represented_distance
+    std::vector<PlaneDistances> planes;  // per centre
+    std::vector<Crease> creases;         // per centre
     for (size_t k : asked) {
       const Job& j = jobs[cand[k]];
       const Vec3 m = j.cell.min_unit();
@@ -518,10 +534,9 @@ class LevelSampler {
         if (reach(j.v[o]) > diagonal) continue;
         const Vec3 c{m[0] + (o & 1 ? 3 : 1) * q, m[1] + (o & 2 ? 3 : 1) * q, m[2] + (o & 4 ? 3 : 1) * q};
         // Within the tolerance of a plane both tests below pass, whatever f says there.
-        const auto plane = nearest_plane(c, cell_edges[k], edges);
-        if (plane.first <= tolerance) continue;
-        const double rep = represented_distance(c, crease, cell_edges[k], edges);
-        const Outcome known = octant_by_corners(j, o, c, site[k], plane, rep, tolerance);
+        const PlaneDistances plane = plane_distances(c, crease, cell_edges[k], edges);
+        if (plane.nearest <= tolerance) continue;
+        const Outcome known = octant_by_corners(j, o, c, site[k], plane, tolerance);
         if (known == Outcome::Agrees) continue;
         if (known == Outcome::Disagrees) {
           fits[k] = 0;
@@ -530,7 +545,7 @@ class LevelSampler {
         leaf.push_back(k);
         centres.push_back(c);
         planes.push_back(plane);
-        represented.push_back(rep);
+        creases.push_back(crease);
       }
     }
     const std::vector<double> f = values(centres);
@@ -538,20 +553,21 @@ class LevelSampler {
     for (size_t i = 0; i < centres.size(); ++i) {
       const size_t k = leaf[i];
       const double size = jobs[cand[k]].cell.size(), r = reach(f[i]), half_diagonal = size * std::sqrt(3.0) / 4;
-      const auto [nearest, side] = planes[i];
+      const auto [nearest, side, represented] = planes[i];
       if (r > tolerance && nearest > tolerance && (f[i] < 0) != (side < 0)) fits[k] = 0;
       if (!f_.distance) continue;
       // Here |f| is taken at slope 1, as the distance along f's gradient to where f is 0: at
       // most the distance to the surface, for a bound steeper than 1 only near it.
       const double along = std::abs(f[i]) / cube_.size;
       if (along < half_diagonal && nearest > along + tolerance) fits[k] = 0;
-      else if (fits[k] && !represented_reaches(along, represented[i], size, tolerance)) unrepresented.push_back(i);
+      else if (fits[k] && !represented_reaches(along, represented, size, tolerance)) unrepresented.push_back(i);
     }
     if (!memo_) return;  // a batched f: no hidden-part check
     for (size_t i : unrepresented) {
       const size_t k = leaf[i];
       if (!fits[k]) continue;
-      if (const auto p = unrepresented_surface_point(jobs[cand[k]], centres[i], cell_edges[k], edges, tolerance))
+      if (const auto p = unrepresented_surface_point(jobs[cand[k]], centres[i], creases[i], cell_edges[k], edges,
+                                                     tolerance))
         memo_->unrepresented.local().push_back(*p);
     }
   }
@@ -575,8 +591,9 @@ class LevelSampler {
   /// planes meet 3.7 away), or surface the neighbours' vertices draw; the polygons' check
   /// tells the two apart once the tree is whole. One more value of f per step; none without
   /// f's gradient.
-  std::optional<Vec3> unrepresented_surface_point(const Job& j, const Vec3& c, const std::array<uint32_t, 12>& ids,
-                                                  const std::vector<Edge>& edges, double tolerance) {
+  std::optional<Vec3> unrepresented_surface_point(const Job& j, const Vec3& c, Crease crease,
+                                                  const std::array<uint32_t, 12>& ids, const std::vector<Edge>& edges,
+                                                  double tolerance) {
     if (!f_.value_gradient && !f_.gradient) return std::nullopt;
     const auto value_gradient = [&](const Vec3& x, Vec3& g) {
       ++evaluations;
@@ -596,13 +613,10 @@ class LevelSampler {
       fp = value_gradient(p, g);
     }
     if (reach(fp) > tolerance) return std::nullopt;
-    if (represented_distance(p, crease_of(j, ids, edges), ids, edges) <= tolerance) return std::nullopt;
+    if (plane_distances(p, crease, ids, edges).represented <= tolerance) return std::nullopt;
     return p;
   }
 
-  /// How a leaf's planes bound its solid: the intersection of their inner sides (a convex
-  /// corner or crease), their union (a concave one), or neither, as its corner signs say.
-  enum class Crease { Convex, Concave, Other };
   static Crease crease_of(const Job& j, const std::array<uint32_t, 12>& ids, const std::vector<Edge>& edges) {
     bool convex = true, concave = true;
     for (int k = 0; k < 8 && (convex || concave); ++k) {
@@ -621,25 +635,26 @@ class LevelSampler {
     return convex ? Crease::Convex : concave ? Crease::Concave : Crease::Other;
   }
 
-  /// A lower bound on the distance from c to the surface a leaf's planes stand for: outside the
+  /// Where c lies among a leaf's planes: the distance to the nearest, c's signed distance to it,
+  /// and a lower bound on the distance to the surface the planes stand for — outside the
   /// intersection of their inner sides (or inside their union), the farthest plane c lies
   /// beyond (on the wrong side of); else the nearest plane.
-  static double represented_distance(const Vec3& c, Crease crease, const std::array<uint32_t, 12>& ids,
-                                     const std::vector<Edge>& edges) {
-    double nearest = detail::kHuge, beyond = 0;
+  static PlaneDistances plane_distances(const Vec3& c, Crease crease, const std::array<uint32_t, 12>& ids,
+                                        const std::vector<Edge>& edges) {
+    double nearest = detail::kHuge, side = 0, beyond = 0;
     bool all_in = true, any_in = false;
     for (uint32_t id : ids) {
       if (id == kNone) continue;
       const double len = norm3(edges[id].g);
       if (!(len > 0)) continue;
       const double d = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
-      nearest = std::min(nearest, std::abs(d));
+      if (std::abs(d) < nearest) nearest = std::abs(d), side = d;
       all_in = all_in && d < 0, any_in = any_in || d < 0;
       if (crease == Crease::Convex && d > 0) beyond = std::max(beyond, d);
       if (crease == Crease::Concave && d < 0) beyond = std::max(beyond, -d);
     }
-    if ((crease == Crease::Convex && !all_in) || (crease == Crease::Concave && any_in)) return beyond;
-    return nearest;
+    const bool outside = (crease == Crease::Convex && !all_in) || (crease == Crease::Concave && any_in);
+    return {nearest, side, outside ? beyond : nearest};
   }
 
   enum class Outcome { Agrees, Disagrees, Unknown };
@@ -648,8 +663,8 @@ class LevelSampler {
   /// and where that is positive f(c) has x_k's sign. For an offset, also the corners' distance
   /// bound (offset_bound) and, from the site of the leaf's vertex, an upper bound on c's distance
   /// to s's surface.
-  Outcome octant_by_corners(const Job& j, int o, const Vec3& c, uint32_t site, const std::pair<double, double>& plane,
-                            double represented, double tolerance) const {
+  Outcome octant_by_corners(const Job& j, int o, const Vec3& c, uint32_t site, const PlaneDistances& plane,
+                            double tolerance) const {
     const double q = j.cell.size() / 4;
     double low = 0;  // a lower bound on reach(f(c))
     bool negative = false;
@@ -672,7 +687,7 @@ class LevelSampler {
       }
     }
     if (!(low > 0)) return Outcome::Unknown;
-    const auto [nearest, side] = plane;
+    const auto [nearest, side, represented] = plane;
     const bool sign_differs = negative != (side < 0);
     if (sign_differs && low > tolerance) return Outcome::Disagrees;
     if (sign_differs) return Outcome::Unknown;
@@ -707,26 +722,12 @@ class LevelSampler {
       least = std::min(least, s * s);
     }
     if (!(least > spread)) return 0;
-    const double d = std::sqrt(sum - spread);
+    const double d = parallelogram_bound(sum, spread);
     // f(c) = s(c) - offset, with s(c) beyond side * d.
     const double beyond = side > 0 ? d - offset : -d - offset;
     if ((side > 0) != (beyond > 0)) return 0;
     negative = beyond < 0;
     return std::abs(beyond);
-  }
-
-  /// The distance from c to the nearest of a leaf's planes, and c's signed distance to it.
-  static std::pair<double, double> nearest_plane(const Vec3& c, const std::array<uint32_t, 12>& ids,
-                                                 const std::vector<Edge>& edges) {
-    double nearest = detail::kHuge, side = 0;
-    for (uint32_t id : ids) {
-      if (id == kNone) continue;
-      const double len = norm3(edges[id].g);
-      if (!(len > 0)) continue;
-      const double d = dot3(edges[id].g, sub3(c, edges[id].x)) / len;
-      if (std::abs(d) < nearest) nearest = std::abs(d), side = d;
-    }
-    return {nearest, side};
   }
 
   /// The surface point on every edge and f's gradient there, for a batched f: the edges'
@@ -1021,9 +1022,8 @@ std::vector<size_t> undecided_by_bounds(const ImplicitSolid& f, const Cube& cube
       ++n;
     }
     if (n == 0 || !(least > diameter2 / 2)) return;
-    const double low2 = (mean_s2 - spread) / n;
-    if (!(low2 > 0)) return;
-    const double low = std::sqrt(low2);
+    const double low = parallelogram_bound(mean_s2 / n, spread / n);
+    if (!(low > 0)) return;
     const double f_lo = side > 0 ? low - offset : -high - offset, f_hi = side > 0 ? high - offset : -low - offset;
     if (f_lo >= -inner && f_hi <= inner) decided[i] = 1;
     else if (f_lo > outer || f_hi < -outer) decided[i] = 1, off[i] = 1;
