@@ -104,10 +104,31 @@ TEST(ComponentsPass, AsksToRefineEveryPointItFlipsFirst) {
     asked.push_back(p);
     EXPECT_EQ(detail::point_sign(t, p), std::optional<bool>(true));  // asked before the flip
   };
-  detail::enforce_one_component(t, nullptr, nullptr, nullptr, false, &refine);
+  detail::enforce_one_component(t, nullptr, {.refine = &refine});
   ASSERT_EQ(asked.size(), 1u);
   EXPECT_TRUE(asked[0] == a || asked[0] == b);
   EXPECT_EQ(detail::point_sign(t, asked[0]), std::optional<bool>(false));
+}
+
+TEST(ComponentsPass, FlipsThePointNearestTheSurfaceWhenTheFunctionIsKnown) {
+  // Cell [1, 2]^3 (level 2) has (1,1,1), (2,1,2) and (2,2,2) inside: (1,1,1) apart from the
+  // other two across a face diagonal, which the cell below shares. Taking (1,1,1) out (the
+  // minority sign) or putting (1,1,2) or (2,1,1) in each leaves one component in both cells;
+  // the sampled function says (1,1,2) lies a hundredth of a cell from the surface and the
+  // others far from it, so its sign is the one to give up.
+  const Lat a = at(2, 1, 1, 1), b = at(2, 2, 1, 2), c = at(2, 2, 2, 2), near = at(2, 1, 1, 2), mid = at(2, 2, 1, 1);
+  const auto inside = [&](const Lat& p) { return p == a || p == b || p == c; };
+  Octree minority = build(2, everywhere, inside);
+  ASSERT_EQ(multi_component_leaves(minority), 2u);
+  detail::enforce_one_component(minority, nullptr);
+  EXPECT_EQ(detail::point_sign(minority, a), std::optional<bool>(false));
+  Octree nearest = build(2, everywhere, inside);
+  const std::function<double(const Lat&)> margin = [&](const Lat& p) { return p == near ? 0.01 : p == mid ? 0.5 : 0.9; };
+  const detail::TopologyFix fix = detail::enforce_one_component(nearest, nullptr, {.margin = &margin});
+  EXPECT_EQ(fix.flipped, 1u);
+  EXPECT_EQ(multi_component_leaves(nearest), 0u);
+  EXPECT_EQ(detail::point_sign(nearest, near), std::optional<bool>(true));
+  EXPECT_EQ(detail::point_sign(nearest, a), std::optional<bool>(true));
 }
 
 // ---- islands on coarse faces (islands.cpp) ----

@@ -1275,7 +1275,11 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   // Leaves the cap stopped with two surface components get one, as after any sampling; a
   // point the settling flips at a coarser leaf is refined around first.
   const std::vector<Node> sampled = tree.nodes;
-  settle_sampled(tree, SettleRegion{}, &from_function);
+  const double finest = tree.cube.size / double(int64_t{1} << options.depth) * solid.lipschitz;
+  const std::function<double(const Lat&)> margin = [&](const Lat& p) {
+    return std::abs(sampler.values({lattice_unit(p)})[0]) / finest;
+  };
+  settle_sampled(tree, SettleRegion{}, &from_function, &margin);
   sampler.evaluations += resample.evaluations;
   capped += resample.capped;
   sampler.evaluations += move_cap_vertices_onto_surface(tree, sampled, solid, options.error, options.parallel);

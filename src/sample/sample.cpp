@@ -242,7 +242,7 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
       refine_around(tree, p, from_input, [](uint32_t) {});
     };
     if (capped > 0) {
-      const size_t flipped = enforce_one_component(tree, nullptr, nullptr, nullptr, false, &refine).flipped;
+      const size_t flipped = enforce_one_component(tree, nullptr, {.refine = &refine}).flipped;
       if (flipped + erode_around_capped(tree, nullptr) > 0) repair_cracks(tree, nullptr);
     }
   } else {

@@ -3,6 +3,7 @@
 #include "signs/consistency.h"
 #include "signs/leaf_walks.h"
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -24,9 +25,7 @@ bool emptied_coarse_leaf(const Octree& t, const Around& a, uint8_t flipped) {
 
 }  // namespace
 
-TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched, const PinnedPoints* pinned,
-                                  bool spare_coarse, const std::function<void(const Lat&)>* refine) {
+TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active, const ComponentFlips& how) {
   TopologyFix fix;
   for (int pass = 0; pass < 6; ++pass) {
     // Only subtrees with active nodes are visited: a sculpting stroke stays local.
@@ -40,25 +39,27 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
       const uint8_t s = t.nodes[l.node].signs;
       if (!multi_component(s)) continue;  // fixed by an earlier flip
       // Try each corner; keep the flip that leaves the fewest multi-component leaves around it,
-      // preferring to flip the minority sign (removing the thinner feature).
-      int best = -1, best_cost = 1 << 30;
+      // preferring the point nearest the surface (or of the minority sign: the thinner feature).
+      int best = -1;
+      double best_cost = 1e30;
       bool best_breaks_coarse = false;  // the best flip leaves a coarser leaf two components
       const bool minority_inside = __builtin_popcount(s) <= 4;
       for (int k = 0; k < 8; ++k) {
         if (multi_component(uint8_t(s ^ (1 << k)))) continue;
         const auto around = leaves_around(t, l.cell.corner(k));
         const bool inside = !((s >> k) & 1);
-        int cost = 0;
+        double cost = 0;
         bool breaks_coarse = false;
         for (const auto& a : around) {
           const uint8_t flipped = with_corner(signs_of(t.nodes[a.node]), a.corner, inside);
           cost += 2 * multi_component(flipped);
-          cost += spare_coarse && emptied_coarse_leaf(t, a, flipped);
+          cost += how.spare_coarse && emptied_coarse_leaf(t, a, flipped);
           breaks_coarse = breaks_coarse || (a.cell.level < t.max_depth && multi_component(flipped));
         }
-        cost += (((s >> k) & 1) != 0) != minority_inside;
+        if (how.margin) cost += std::min((*how.margin)(l.cell.corner(k)), 1.0);
+        else cost += (((s >> k) & 1) != 0) != minority_inside;
         // Undoing what remove_islands just set would bring its defect back.
-        if (pinned && pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;
+        if (how.pinned && how.pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;
         if (cost < best_cost) {
           best_cost = cost;
           best = k;
@@ -74,8 +75,8 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
         continue;
       }
       const Lat p = l.cell.corner(best);
-      if (refine) (*refine)(p);
-      set_point_sign(t, p, !((s >> best) & 1), touched);
+      if (how.refine) (*how.refine)(p);
+      set_point_sign(t, p, !((s >> best) & 1), how.touched);
       ++fix.flipped;
     }
   }

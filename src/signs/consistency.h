@@ -33,17 +33,30 @@ struct TopologyFix {
   size_t remaining = 0;  // leaves still holding more than one component
 };
 
-/// Works on the leaves for which `active` is true (all leaves when null); `touched` is called
-/// for every node on the way to a leaf whose signs changed (so a later partial pass sees it).
-/// With `spare_coarse` (CSG), a flip that leaves a coarser gray leaf without a sign change
-/// costs more: another flip usually does, and the coarse leaf keeps its surface.
-/// With `refine`, called before each flip with the point, the leaves coarser than the finest
-/// level that hold the point are split first (refine_around), so no flip moves the surface by
-/// more than a finest cell.
+/// How enforce_one_component chooses and makes its flips.
+struct ComponentFlips {
+  /// Called for every node on the way to a leaf whose signs changed (so a later partial pass
+  /// sees it).
+  const std::function<void(uint32_t)>* touched = nullptr;
+  /// Points another pass set in this operation: flipped back only when nothing else will do.
+  const PinnedPoints* pinned = nullptr;
+  /// CSG: a flip that leaves a coarser gray leaf without a sign change costs more (another
+  /// flip usually does, and the coarse leaf keeps its surface).
+  bool spare_coarse = false;
+  /// Called before each flip with the point: the leaves coarser than the finest level that
+  /// hold it are split first (refine_around), so no flip moves the surface by more than a
+  /// finest cell.
+  const std::function<void(const std::array<int64_t, 3>&)>* refine = nullptr;
+  /// How far a lattice point lies from the sampled surface, in finest cells (|f| there over
+  /// f's slope), where the sampled function is known: among flips that leave as many leaves
+  /// with two components, the point nearest the surface goes, whose new sign moves the
+  /// surface least. Without it, the point of the cell's minority sign (the thinner feature).
+  const std::function<double(const std::array<int64_t, 3>&)>* margin = nullptr;
+};
+
+/// Works on the leaves for which `active` is true (all leaves when null).
 TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>* active,
-                                  const std::function<void(uint32_t)>* touched = nullptr,
-                                  const PinnedPoints* pinned = nullptr, bool spare_coarse = false,
-                                  const std::function<void(const std::array<int64_t, 3>&)>* refine = nullptr);
+                                  const ComponentFlips& how = {});
 
 /// Flips inside corners of two-component leaves to outside until no leaf has two components.
 /// Every flip takes a point out of the solid, so it ends (at worst with every point outside),

@@ -40,8 +40,9 @@ size_t settle(Octree& t, const SettlePlan& plan, PinnedPoints& pinned) {
   bool kept_two = false;   // and left leaves with two components (capped ones)
   for (int round = 0; round < 4; ++round) {
     const size_t islands = remove_islands(t, plan.active, &touched, &pinned, &rounds);
-    const TopologyFix fix = enforce_one_component(t, component_scope, &touched, &pinned, plan.spare_coarse,
-                                                  plan.refine ? &plan.refine : nullptr);
+    const ComponentFlips how{&touched, &pinned, plan.spare_coarse, plan.refine ? &plan.refine : nullptr,
+                             plan.margin ? &plan.margin : nullptr};
+    const TopologyFix fix = enforce_one_component(t, component_scope, how);
     converged = islands == 0 && fix.flipped == 0;
     kept_two = fix.remaining > 0;
     // Rounds repeat until one changes no sign: only then may the erosions below stay around
@@ -131,7 +132,8 @@ std::vector<uint8_t> nodes_in(const Octree& t, const SettleRegion& region) {
 
 }  // namespace
 
-void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample) {
+void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample,
+                    const std::function<double(const std::array<int64_t, 3>&)>* margin) {
   std::vector<uint8_t> in;
   if (!region.everywhere) in = nodes_in(tree, region);
   const std::function<bool(uint32_t)> active = [&](uint32_t n) { return in[n] != 0; };
@@ -150,6 +152,7 @@ void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf
   const std::function<void(uint32_t)> ignore = [](uint32_t) {};
   if (resample)
     plan.refine = [&](const std::array<int64_t, 3>& p) { refine_around(tree, p, *resample, region.everywhere ? ignore : touched); };
+  if (margin) plan.margin = *margin;
   PinnedPoints pinned;
   settle(tree, plan, pinned);
 }

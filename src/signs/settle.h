@@ -25,6 +25,9 @@ struct SettlePlan {
   /// Splits the coarser leaves holding a point before the one-component pass flips it (null:
   /// flip in place); see enforce_one_component.
   std::function<void(const std::array<int64_t, 3>&)> refine;
+  /// A lattice point's distance to the sampled surface in finest cells (null: unknown); see
+  /// ComponentFlips::margin.
+  std::function<double(const std::array<int64_t, 3>&)> margin;
   SpeckSearch specks;
   /// After a round that changed no sign, still run the erosions (erode_until_valid) around
   /// every capped leaf, which may hold any pattern. Sampling does; the CSG clean-up erodes
@@ -60,6 +63,8 @@ struct SettleRegion {
 /// level set can cross a cell without touching its corners): finer neighbours can then show
 /// islands and cracks on their faces. Visits the region, plus every leaf a flip touched.
 /// With `resample`, a flip at the corner of a coarser leaf splits it first (refine_around).
-void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample = nullptr);
+/// `margin`: see ComponentFlips::margin.
+void settle_sampled(Octree& tree, const SettleRegion& region, const ResampleLeaf* resample = nullptr,
+                    const std::function<double(const std::array<int64_t, 3>&)>* margin = nullptr);
 
 }  // namespace pic::detail
