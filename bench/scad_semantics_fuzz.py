@@ -14,8 +14,9 @@ than 0.5 % at DEPTH and two levels deeper still by more than 0.1 % and more than
 does not refuse (exit 2) but fails on: an invalid solid written (exit 4), an internal error, a
 crash or a timeout. OpenSCAD itself fails on some models (a twisted
 extrusion to a point with a hole is not closed, and CGAL then drops it from the Boolean): its
-stderr is kept in OUTDIR/SEED/openscad.err and a reported line says when it holds an ERROR:
-read it before calling a case PIC's. A negative OpenSCAD volume (a polyhedron whose faces
+stderr is kept in OUTDIR/SEED/openscad.err and a reported line says when it holds an ERROR,
+or when OpenSCAD's mesh crosses itself (its signed volume is then no solid's): read it before
+calling a case PIC's. A negative OpenSCAD volume (a polyhedron whose faces
 turn inward, written as given) is compared by its size.
 """
 import json
@@ -131,6 +132,16 @@ def volume(path):
         return None
 
 
+def self_intersects(path):
+    """Whether a mesh crosses itself (meshcheck's exact test): its signed volume then counts
+    overlapping parts twice or against each other, no solid's volume."""
+    try:
+        out = subprocess.run([MESHCHECK, path], capture_output=True, text=True, timeout=300).stdout
+        return json.loads(out).get("self_intersections", 0) > 0
+    except (subprocess.SubprocessError, ValueError, OSError):
+        return False
+
+
 def pic_volume(csg, out, depth):
     """PIC's volume, or None and the reason; the reason starts with FAILED when PIC did not
     refuse the model (exit 2) but wrote an invalid solid (exit 4), failed inside (3) or crashed."""
@@ -190,8 +201,12 @@ def main():
                 reported += 1
                 # OpenSCAD's own ERROR (a mesh it cannot close is left out of its Boolean) is
                 # more often the cause than PIC: said on the line.
-                print(seed, "DIFF pic %.6g (depth %d: %.6g) openscad %.6g%s" % (
-                    got, depth + 2, finer or 0, expected, " (openscad reported an ERROR)" if failed else ""))
+                # So is a mesh OpenSCAD writes crossing itself (a twisted extrusion whose wall
+                # quads fold): PIC takes its winding number's solid.
+                crossed = self_intersects(ref)
+                print(seed, "DIFF pic %.6g (depth %d: %.6g) openscad %.6g%s%s" % (
+                    got, depth + 2, finer or 0, expected, " (openscad reported an ERROR)" if failed else "",
+                    " (openscad's mesh crosses itself)" if crossed else ""))
             else:
                 print(seed, "ok %.2e at depth %d (%.2e at %d)" % (off_finer, depth + 2, off, depth))
             continue
