@@ -126,25 +126,35 @@ TEST(Minkowski, CubePlusAFacetedSphereHasFlatFacesAtTheSupport) {
   const TriMesh m = contour(t);
   expect_valid(m);
   // Faces move out by the ball's support along their normals (its extent from its centre),
-  // and the whole sum by the centre.
+  // and the whole sum by the centre. The sum is a polyhedron: a leaf holding the face and
+  // the first facets of the round beside it (a shallow crease, 2.8 degrees) may take one
+  // plane for both, its vertex a hair off the face; the others lie on it.
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k) lo[k] = 1e300, hi[k] = -1e300;
   for (const Vec3& p : ball.positions)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
   const Vec3 c{0.3, -0.2, 0.1};
-  size_t flat = 0;
+  size_t flat = 0, exact_on_face = 0;
+  double worst = 0;
   const double c2 = 2 * finest_cell(t);
   for (const Vec3& p : m.positions) {
     int inside = 0;
     for (int k = 0; k < 3; ++k) inside += p[k] - c[k] > c2 && p[k] - c[k] < 1 - c2;
     if (inside != 2) continue;
     ++flat;
+    double off = 0;
     for (int k = 0; k < 3; ++k) {
-      if (p[k] - c[k] <= c2) EXPECT_NEAR(p[k], lo[k], 1e-6);
-      if (p[k] - c[k] >= 1 - c2) EXPECT_NEAR(p[k], 1 + hi[k], 1e-6);
+      if (p[k] - c[k] <= c2) off = std::abs(p[k] - lo[k]);
+      if (p[k] - c[k] >= 1 - c2) off = std::abs(p[k] - 1 - hi[k]);
     }
+    worst = std::max(worst, off);
+    exact_on_face += off <= 1e-6;
   }
-  EXPECT_GT(flat, 0u);
+  EXPECT_GT(flat, 100u);
+  EXPECT_LE(worst, 0.05 * finest_cell(t));
+  EXPECT_GE(exact_on_face, flat * 9 / 10);
+  std::printf("face vertices: %zu, %zu on the face within 1e-6, worst %.3f cells off\n", flat, exact_on_face,
+              worst / finest_cell(t));
   // Volume: the box grown by a ball of about the same radius (facets 0.1 % deep).
   const double exact = grown_box_volume(1, 1, 1, 0.1);
   EXPECT_NEAR(volume(m), exact, 3e-3 * exact);
@@ -178,9 +188,10 @@ TEST(Minkowski, IndexedSupportIsTheWholeScans) {
 }
 
 TEST(Minkowski, GradientIsTheNormalOfTheSumsSurface) {
-  // f = d - h(u): over a box's edges and corners u turns with p, and so does the support h.
-  // The gradient must be f's own (central differences), not the distance's alone (u): the
-  // sampler's planes are tangent to f's zero set only then.
+  // f is a polytope's facet planes where one of them is highest, and d - h(u) off them (u
+  // the direction from the nearest point, turning with p over a box's edges and corners, and
+  // the support h with it). The gradient must be f's own (central differences), not the
+  // distance's alone (u): the sampler's planes are tangent to f's zero set only then.
   const detail::RoundBody body = *detail::round_body_if_round(make_sphere({0, 0, 0}, 0.1, 24).positions);
   const TriMesh box = make_box({0, 0, 0}, {1, 1, 1});
   const detail::RoundSum sum(box, body);

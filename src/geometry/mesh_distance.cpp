@@ -670,6 +670,16 @@ double MeshDistance::distance_to_hint(const Vec3& p, uint32_t hint) const {
   return std::sqrt(point_triangle_distance2(p, t.a, t.b, t.c));
 }
 
+void MeshDistance::triangles_within(const Vec3& p, double r, std::vector<uint32_t>& ids) const {
+  // The bounds are rounded outward, so the search's cut-off is a hair above r: each triangle
+  // it offers is measured exactly.
+  const double r2 = r * r;
+  double cut2 = r2 * (1 + 1e-6) + kTinyDivisor;
+  search(p, cut2, [&](const LeafTriangle& t, double) {
+    if (point_triangle_distance2(p, t.a, t.b, t.c) <= r2) ids.push_back(t.id);
+  });
+}
+
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;

@@ -51,6 +51,8 @@ class MeshDistance {
   /// the nearest of them within r is taken; else the search ends at the first one found. The
   /// hint is set to the triangle taken, `found` (optional) to its distance, at most r.
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
+  /// Appends to `ids` every triangle (its index in the mesh) within r of p.
+  void triangles_within(const Vec3& p, double r, std::vector<uint32_t>& ids) const;
   /// The hint that names the mesh's triangle t (for a point next to it).
   uint32_t hint_of(uint32_t t) const { return slot_of_[t]; }
   /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when

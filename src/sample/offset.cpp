@@ -185,10 +185,10 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
     sum(p, g, &hints.local());
     return g;
   };
-  // Near the level set (d ~ r) the support turns with u at most by its facet depth, which
-  // the bound covers for every cell wider than that depth (see docs/algorithms.md).
-  f.lipschitz = 2;
-  // Along u, f falls at slope 1 towards its zero (d falls, u and h stay): |f| is a distance.
+  // |f| is never more than the distance to the sum's surface, and next to it equal to it
+  // (a polytope's signed distance, or below it off a facet by the cosine of half the angle
+  // between two facets): it bounds as a distance does.
+  f.lipschitz = 1;
   f.distance = true;
   // The surface lies where d = h(u), between the body's inner and outer radii; f's own
   // bound at the centre first (what the sampler would ask without this).
@@ -198,7 +198,8 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
     double d = 0;
     const double fc = sum(centre, grad, &hints.local(), &d, &nearest);
     if (std::abs(fc) > f.lipschitz * detail::norm3(detail::sub3(hi, lo)) / 2) return true;
-    return clear_of_bands(sum.distance().mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest);
+    if (clear_of_bands(sum.distance().mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest)) return true;
+    return sum.box_clear(lo, hi);
   };
   SampleOptions o = options;
   o.cube = cube;
