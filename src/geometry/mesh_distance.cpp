@@ -680,6 +680,20 @@ void MeshDistance::triangles_within(const Vec3& p, double r, std::vector<uint32_
   });
 }
 
+Nearest MeshDistance::nearest_among(const Vec3& p, const std::vector<uint32_t>& ids, std::vector<Nearest>& each) const {
+  each.clear();
+  size_t best = 0;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const LeafTriangle& t = tris_[slot_of_[ids[i]]];
+    each.push_back(nearest_on_triangle2(p, t.a, t.b, t.c));
+    each.back().triangle = ids[i];
+    const Nearest &n = each.back(), &b = each[best];
+    if (n.distance < b.distance || (n.distance == b.distance && n.triangle < b.triangle)) best = i;
+  }
+  for (Nearest& n : each) n.distance = std::sqrt(n.distance);
+  return each[best];
+}
+
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {
   double best2 = std::numeric_limits<double>::infinity();
   Nearest best;
@@ -867,6 +881,10 @@ double SignedDistance::with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hi
   const Nearest n = distance_.nearest(p, hint);
   if (nearest) *nearest = n.point;
   if (feature) *feature = n;
+  return signed_at(p, n, gradient);
+}
+
+double SignedDistance::signed_at(const Vec3& p, const Nearest& n, Vec3& gradient) const {
   const auto& t = mesh_.triangles[n.triangle];
   Vec3 pseudo{0, 0, 0};
   switch (n.feature) {

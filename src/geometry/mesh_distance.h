@@ -53,6 +53,10 @@ class MeshDistance {
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
   /// Appends to `ids` every triangle (its index in the mesh) within r of p.
   void triangles_within(const Vec3& p, double r, std::vector<uint32_t>& ids) const;
+  /// Of the triangles `ids` (indices in the mesh; the point nearest p among them, as
+  /// `nearest` would rank them: least distance, then least index), with each one's answer
+  /// in `each` (distances not squared). `ids` must not be empty.
+  Nearest nearest_among(const Vec3& p, const std::vector<uint32_t>& ids, std::vector<Nearest>& each) const;
   /// The hint that names the mesh's triangle t (for a point next to it).
   uint32_t hint_of(uint32_t t) const { return slot_of_[t]; }
   /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when
@@ -179,6 +183,9 @@ class SignedDistance {
   /// triangle and which feature of it).
   double with_gradient(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr, Vec3* nearest = nullptr,
                        Nearest* feature = nullptr) const;
+  /// The signed distance and gradient (as with_gradient) from the mesh point nearest p,
+  /// found already.
+  double signed_at(const Vec3& p, const Nearest& n, Vec3& gradient) const;
   const MeshDistance& mesh_distance() const { return distance_; }
 
  private:

@@ -166,57 +166,70 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
 }
 
 double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, double* distance, Vec3* nearest) const {
-  Vec3 near{0, 0, 0};
-  const double d = distance_.with_gradient(p, gradient, hint, &near);
+  // Next to the sum's surface (d between inner and outer) the triangles within d + outer -
+  // inner serve twice: the nearest of them gives d and its sign, all of them the sum. A
+  // nearby point's nearest triangle (the hint) bounds d to gather them in one search.
+  thread_local std::vector<uint32_t> around;
+  thread_local std::vector<Nearest> each;
+  around.clear();
+  const MeshDistance& mesh = distance_.mesh_distance();
+  const double spread = body_.outer - body_.inner;
+  const double bound = hint ? mesh.distance_to_hint(p, *hint) : kHuge;
+  Nearest n;
+  if (bound <= 2 * body_.outer) {
+    mesh.triangles_within(p, (bound + spread) * (1 + 1e-9) + kTinyDivisor, around);
+  }
+  if (!around.empty()) {
+    n = mesh.nearest_among(p, around, each);
+    *hint = mesh.hint_of(n.triangle);
+  } else {
+    n = mesh.nearest(p, hint);
+  }
+  const double d = distance_.signed_at(p, n, gradient);
   if (distance) *distance = d;
-  if (nearest) *nearest = near;
+  if (nearest) *nearest = n.point;
   if (!(d > 0)) return d - body_.inner;
+  if (around.empty()) {
+    mesh.triangles_within(p, (d + spread) * (1 + 1e-9) + kTinyDivisor, around);
+    mesh.nearest_among(p, around, each);
+  }
   uint32_t winner = 0;
-  return outside(p, d, gradient, winner);
+  return outside(p, d, around, each, gradient, winner);
 }
 
-double RoundSum::outside(const Vec3& p, double d, Vec3& gradient, uint32_t& winner) const {
-  // F_T is at least d_T - outer (the support along T's own direction is at most outer), and
-  // the nearest triangle's at most d - inner: only triangles within d + outer - inner of p
-  // can come lower.
-  thread_local std::vector<uint32_t> around;
-  around.clear();
-  const double reach = d + (body_.outer - body_.inner);
-  distance_.mesh_distance().triangles_within(p, reach * (1 + 1e-9) + kTinyDivisor, around);
+double RoundSum::outside(const Vec3& p, double d, const std::vector<uint32_t>& around, const std::vector<Nearest>& each,
+                         Vec3& gradient, uint32_t& winner) const {
+  // `around`: every triangle within d + outer - inner of p (F_T is at least d_T - outer, the
+  // nearest triangle's at most d - inner: no other can come lower), `each` its nearest point.
   // Nearest first: F_T is at least its value along u_T, d_T - h_B(u_T), so a triangle whose
   // value there is no lower than the best so far needs no search of its facets.
-  thread_local std::vector<Nearest> nearest_points;
-  nearest_points.clear();
   thread_local std::vector<uint32_t> order;
   order.resize(around.size());
-  for (size_t i = 0; i < around.size(); ++i) {
-    nearest_points.push_back(nearest_point(around[i], p));
-    order[i] = uint32_t(i);
-  }
+  std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
-    return nearest_points[x].distance < nearest_points[y].distance ||
-           (nearest_points[x].distance == nearest_points[y].distance && around[x] < around[y]);
+    return each[x].distance < each[y].distance || (each[x].distance == each[y].distance && around[x] < around[y]);
   });
   // Skipping a triangle whose bound is no lower keeps f at most the distance to S's surface
   // outside (that T + B is no nearer than `best`) and inside (it holds p no deeper).
   double best = d - body_.inner;  // the nearest triangle's bound, should none be found
   bool found = false;
-  double best_support = 0;  // B's support along the best normal so far
+  Vec3 best_plane{0, 0, 0};  // the plane of the best value so far ...
+  double best_support = 0;   // ... and B's support along it
   for (uint32_t i : order) {
-    const double dt = nearest_points[i].distance;
-    const Vec3& point = nearest_points[i].point;
+    const double dt = each[i].distance;
     if (found && dt >= 0.5 * body_.inner) {
       // Any direction n gives n.p - h_T(n) - h_B(n), at most the distance to T + B outside
-      // it and at most F_T inside: along u_T, and along the best normal so far (a triangle
-      // beside the best one, on its plane or sharing its edge, usually gives the same).
-      if (dot3(gradient, p) - support_of(around[i], gradient) - best_support >= best) continue;
-      if (dt - body_.support(scale3(sub3(p, point), 1 / dt)) >= best) continue;
+      // it and at most F_T inside: along the best normal so far (a triangle beside the best
+      // one, on its plane or sharing its edge, usually gives the same), and along u_T.
+      if (dot3(best_plane, p) - support_of(around[i], best_plane) - best_support >= best) continue;
+      if (dt - body_.support(scale3(sub3(p, each[i].point), 1 / dt)) >= best) continue;
     }
-    Vec3 g;
-    const double v = triangle_sum(around[i], p, nearest_points[i], g);
+    Vec3 g, plane;
+    double support = 0;
+    const double v = triangle_sum(around[i], p, each[i], g, &plane, &support);
     if (!found || v < best) {
       best = v, gradient = g, winner = around[i];
-      best_support = body_.support(g);
+      best_plane = plane, best_support = support;
     }
     found = true;
   }
@@ -244,8 +257,15 @@ bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi) const {
   Vec3 g;
   const double d = distance_.with_gradient(c, g);
   if (!(d > half)) return false;  // the box may meet the solid itself
+  thread_local std::vector<uint32_t> near_c;
+  thread_local std::vector<Nearest> each;
+  near_c.clear();
+  const MeshDistance& mesh = distance_.mesh_distance();
+  mesh.triangles_within(c, (d + body_.outer - body_.inner) * (1 + 1e-9) + kTinyDivisor, near_c);
+  if (near_c.empty()) return false;
+  mesh.nearest_among(c, near_c, each);
   uint32_t winner = 0;
-  const double f = outside(c, d, g, winner);
+  const double f = outside(c, d, near_c, each, g, winner);
   if (f < 0) {
     // Inside T + B, a convex polytope, with all eight corners: the box is in the sum.
     for (int k = 0; k < 8; ++k) {
@@ -274,6 +294,15 @@ namespace {
 
 /// How far x lies inside the side from p to q of triangle pqr, along the triangle's plane
 /// (x on that plane; negative outside).
+/// A number that grows with the angle of (x, y) from the x axis, once round from -pi to pi
+/// (the position on the square |x| + |y| = 1 about the origin): an order without atan2.
+double pseudo_angle(double x, double y) {
+  const double sum = std::abs(x) + std::abs(y);
+  if (!(sum > 0)) return 0;
+  const double t = y / sum;  // -1 .. 1 on each half
+  return x >= 0 ? t : (y >= 0 ? 2 - t : -2 - t);
+}
+
 double inside_side(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& x) {
   const Vec3 e = sub3(q, p), w = sub3(r, p);
   const double len2 = dot3(e, e);
@@ -339,7 +368,7 @@ const RoundSum::Zone& RoundSum::zone(uint32_t t, int k) const {
       const double m_len = norm3(m);
       if (!(m_len > 0)) continue;
       const Vec3 n = scale3(m, 1 / m_len);
-      order.push_back({std::atan2(dot3(n, z->a2), dot3(n, z->a1)), z->normal.size()});
+      order.push_back({pseudo_angle(dot3(n, z->a1), dot3(n, z->a2)), z->normal.size()});
       z->normal.push_back(n);
       z->support.push_back(dot3(n, arc.at));
     }
@@ -428,7 +457,8 @@ bool RoundSum::above_face_inside(uint32_t t, const Vec3& near, double dt, double
   return true;
 }
 
-double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane) const {
+double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane,
+                              double* plane_support) const {
   const auto& tri = surface_.triangles[t];
   const Vec3 &a = surface_.positions[tri[0]], &b = surface_.positions[tri[1]], &c = surface_.positions[tri[2]];
   const Vec3& near = at.point;
@@ -439,6 +469,7 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
   if (dt < 0.5 * body_.inner) {
     gradient = dt > 0 ? scale3(x, 1 / dt) : gradient;
     if (plane) *plane = gradient;
+    if (plane_support) *plane_support = body_.support(gradient);
     return dt - body_.inner;
   }
   const Vec3 u = scale3(x, 1 / dt);
@@ -449,6 +480,7 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
   double best = dt - support_u;
   gradient = along_gradient(t, at.feature, u, dt, top);
   if (plane) *plane = u;
+  if (plane_support) *plane_support = support_u;
   // Any facet normal n does at most n.(p - near) - inner = d_T cos(n, u) - inner: those with
   // cos(n, u) at or below `cut` cannot beat `best`.
   const double cut = (best + body_.inner) / dt;
@@ -458,6 +490,7 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
     if (v > best) {
       best = v, gradient = n;
       if (plane) *plane = n;
+      if (plane_support) *plane_support = support_b;
     }
   };
   const RoundBody::Near near_u = body_.near(u);
@@ -469,26 +502,25 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
   }
   // Facets of T + B that an edge of T sweeps along an edge of B: their normals are
   // perpendicular to the edge, where B's arcs cross the circle of such directions (the zone,
-  // one per side of the surface). Each lies at least asin |u.e| from u, and those within
-  // acos(cut) of u within a span of angles about u's direction across the edge.
+  // one per side of the surface), in order around it. n.u falls away from u's own direction
+  // across the edge both ways round: from there, the entries with n.u above the cut.
   for (int k = 0; k < 3; ++k) {
     const Zone& z = zone(t, k);
+    const size_t count = z.normal.size();
     const Vec3 across = sub3(u, scale3(z.axis, dot3(u, z.axis)));
-    const double len = norm3(across);
-    if (!(len > cut) || z.angle.empty()) continue;
-    const double mid = std::atan2(dot3(across, z.a2), dot3(across, z.a1));
-    const double span = cut > 0 ? std::acos(std::min(cut / len, 1.0)) : std::numbers::pi;
-    // The entries within span of mid, the circle's wrap included.
-    const auto visit = [&](double lo, double hi) {
-      for (auto it = std::lower_bound(z.angle.begin(), z.angle.end(), lo); it != z.angle.end() && *it <= hi; ++it) {
-        const size_t i = size_t(it - z.angle.begin());
-        if (dot3(z.normal[i], u) > cut) consider(z.normal[i], z.support[i]);
-      }
-    };
-    const double pi = std::numbers::pi;
-    visit(std::max(mid - span, -pi), std::min(mid + span, pi));
-    if (mid - span < -pi) visit(mid - span + 2 * pi, pi);
-    if (mid + span > pi) visit(-pi, mid + span - 2 * pi);
+    if (!(norm3(across) > cut) || count == 0) continue;
+    const double at = pseudo_angle(dot3(across, z.a1), dot3(across, z.a2));
+    const size_t mid = size_t(std::lower_bound(z.angle.begin(), z.angle.end(), at) - z.angle.begin());
+    for (size_t step = 0; step < count; ++step) {  // upwards from mid
+      const size_t i = (mid + step) % count;
+      if (!(dot3(z.normal[i], u) > cut)) break;
+      consider(z.normal[i], z.support[i]);
+    }
+    for (size_t step = 1; step < count; ++step) {  // downwards from below mid
+      const size_t i = (mid + count - step) % count;
+      if (!(dot3(z.normal[i], u) > cut)) break;
+      consider(z.normal[i], z.support[i]);
+    }
   }
   return best;
 }

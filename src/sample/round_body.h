@@ -92,16 +92,18 @@ class RoundSum {
 
  private:
   /// f at p outside the solid (`d`: its distance), its gradient and the triangle whose F_T it is.
-  double outside(const Vec3& p, double d, Vec3& gradient, uint32_t& winner) const;
+  double outside(const Vec3& p, double d, const std::vector<uint32_t>& around, const std::vector<Nearest>& each,
+                 Vec3& gradient, uint32_t& winner) const;
   /// Triangle t's support along n.
   double support_of(uint32_t t, const Vec3& n) const;
   /// The distance from p to triangle t and its point nearest p.
   Nearest nearest_point(uint32_t t, const Vec3& p) const;
   /// F_T(p) for triangle t (the nearest point of its triangle to p: `near`), and its
   /// gradient.
-  /// `plane`, when given, gets the normal of the plane whose value F_T is (T + B lies below
-  /// it by that much at p: n.x <= h_T(n) + h_B(n)).
-  double triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane = nullptr) const;
+  /// `plane`, when given, gets the normal n of the plane whose value F_T is (T + B lies below
+  /// it by that much at p: n.x <= h_T(n) + h_B(n)), `plane_support` h_B(n).
+  double triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane = nullptr,
+                      double* plane_support = nullptr) const;
   /// The gradient of d_T - h_B(u) (u the direction from T's point nearest p, `feature` the
   /// part of T holding it, `top` the vertex of B reaching the support along u).
   Vec3 along_gradient(uint32_t t, Feature feature, const Vec3& u, double dt, const Vec3& top) const;
