@@ -393,6 +393,22 @@ TEST(ScadMinkowski, SumsOfConvexPartsAndTheirUnions) {
   EXPECT_EQ(stats.leaves, 1u);
 }
 
+TEST(ScadMinkowski, AnEmptyOperandIsLeftOut) {
+  // OpenSCAD leaves an empty child out of minkowski(): an intersection of two cubes apart plus
+  // a ball is the ball (OpenSCAD 2021 renders it so), not nothing. Through each path: a
+  // faceted sphere with what would be a non-convex operand, and a cube.
+  EvalOptions o;
+  o.depth = 8;
+  const std::string empty = "intersection() { cube(size = [1, 1, 1]); "
+                            "multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) { cube(size = [1, 1, 1]); } }";
+  const TriMesh ball = contour(eval_csg("minkowski() { " + empty + " sphere(r = 2, $fn = 24); }", o));
+  const TriMesh alone = contour(eval_csg("sphere(r = 2, $fn = 24);", o));
+  EXPECT_TRUE(test::IsClosedManifold(ball));
+  EXPECT_NEAR(volume(ball), volume(alone), 1e-4 * volume(alone));  // sampled in another root cube
+  const TriMesh box = contour(eval_csg("minkowski() { " + empty + " cube(size = [2, 3, 4]); }", o));
+  EXPECT_NEAR(volume(box), 24, 24 * 1e-6);
+}
+
 // A non-convex operand plus a convex one: the operand cut into convex pieces (a difference of
 // convex parts, a prism), or moved, with the hull of each flat piece of its surface.
 TEST(ScadMinkowski, NonConvexOperandPlusConvexOne) {

@@ -735,8 +735,12 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o, bool e
   std::vector<const Solid*> given;
   for (const Solid& s : operands) {
     if (s.kind == Solid::Kind::Empty) continue;
-    all.emplace_back();
-    parts_of(s, o, all.back());
+    std::vector<Part> parts;
+    parts_of(s, o, parts);
+    // An operand with no solid in it (an intersection of parts apart) is left out, as
+    // OpenSCAD leaves out an empty child: the sum of the others, not nothing.
+    if (parts.empty()) continue;
+    all.push_back(std::move(parts));
     given.push_back(&s);
   }
   // A solid that is not one convex part plus a faceted sphere: one distance sampling instead
@@ -763,11 +767,9 @@ Solid minkowski(const std::vector<Solid>& operands, const EvalOptions& o, bool e
   std::vector<Part> acc;
   bool first = true, single = true;
   const Solid* only = nullptr;
-  size_t next_parts = 0;
-  for (const Solid& s : operands) {
-    if (s.kind == Solid::Kind::Empty) continue;
-    std::vector<Part> parts = std::move(all[next_parts++]);
-    only = &s;
+  for (size_t i = 0; i < given.size(); ++i) {
+    std::vector<Part> parts = std::move(all[i]);
+    only = given[i];
     if (first) {
       acc = std::move(parts);
       first = false;
