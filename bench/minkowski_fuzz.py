@@ -8,7 +8,8 @@ bench/scad_fuzz.py (cubes, prisms and coarse spheres on integers) that is not on
 so PIC takes its one-sampling path for a round body (docs/algorithms.md, "Minkowski sums with a
 round body"). OpenSCAD writes the tree (`openscad -o m.csg`); Manifold (WASM,
 ../shared/tools/manifold/scad.mjs) evaluates the same tree exactly. A case is reported when
-PIC fails other than by refusing (exit 2), when its mesh is not closed, 2-manifold and free of
+PIC fails, or refuses (exit 2) calling the model empty where Manifold's sum is not, when its
+mesh is not closed, 2-manifold and free of
 self-intersections (meshcheck), or when its raw contour's volume (`--simplify 0`) is off
 Manifold's by more than 0.5 % and by more than a finest cell's layer over the sum's area,
 or when it lies more than 1.5 finest cells from Manifold's mesh either way. Every case is
@@ -61,7 +62,9 @@ def run_case(seed, depth, outdir):
     p = subprocess.run([PIC, "eval", csg, "-o", out, "--depth", str(depth), "--simplify", "0", "--json"],
                        capture_output=True, text=True, timeout=900)
     if p.returncode == 2:
-        return "skipped: refused: " + p.stderr.strip().splitlines()[-1]
+        # A refusal is fine where the sum is beyond PIC's limits, wrong where PIC calls it empty.
+        why = p.stderr.strip().splitlines()[-1]
+        return ("REPORT refused, Manifold's volume %g: " % mf["volume"] if "empty" in why else "skipped: refused: ") + why
     if p.returncode != 0:
         return "REPORT pic exit %d: %s" % (p.returncode, p.stderr.strip().splitlines()[-1:])
     j = json.loads(p.stdout)
