@@ -670,28 +670,23 @@ double MeshDistance::distance_to_hint(const Vec3& p, uint32_t hint) const {
   return std::sqrt(point_triangle_distance2(p, t.a, t.b, t.c));
 }
 
-void MeshDistance::triangles_within(const Vec3& p, double r, std::vector<uint32_t>& ids) const {
+size_t MeshDistance::nearest_within(const Vec3& p, double r, std::vector<Nearest>& out) const {
+  out.clear();
   // The bounds are rounded outward, so the search's cut-off is a hair above r: each triangle
   // it offers is measured exactly.
   const double r2 = r * r;
   double cut2 = r2 * (1 + 1e-6) + kTinyDivisor;
-  search(p, cut2, [&](const LeafTriangle& t, double) {
-    if (point_triangle_distance2(p, t.a, t.b, t.c) <= r2) ids.push_back(t.id);
-  });
-}
-
-Nearest MeshDistance::nearest_among(const Vec3& p, const std::vector<uint32_t>& ids, std::vector<Nearest>& each) const {
-  each.clear();
   size_t best = 0;
-  for (size_t i = 0; i < ids.size(); ++i) {
-    const LeafTriangle& t = tris_[slot_of_[ids[i]]];
-    each.push_back(nearest_on_triangle2(p, t.a, t.b, t.c));
-    each.back().triangle = ids[i];
-    const Nearest &n = each.back(), &b = each[best];
-    if (n.distance < b.distance || (n.distance == b.distance && n.triangle < b.triangle)) best = i;
-  }
-  for (Nearest& n : each) n.distance = std::sqrt(n.distance);
-  return each[best];
+  search(p, cut2, [&](const LeafTriangle& t, double) {
+    Nearest n = nearest_on_triangle2(p, t.a, t.b, t.c);  // distance squared, ranked so
+    if (!(n.distance <= r2)) return;
+    n.triangle = t.id;
+    out.push_back(n);
+    const Nearest& b = out[best];
+    if (n.distance < b.distance || (n.distance == b.distance && n.triangle < b.triangle)) best = out.size() - 1;
+  });
+  for (Nearest& n : out) n.distance = std::sqrt(n.distance);
+  return out.empty() ? 0 : best;
 }
 
 Nearest MeshDistance::nearest(const Vec3& p, uint32_t* hint) const {

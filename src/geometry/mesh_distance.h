@@ -51,12 +51,10 @@ class MeshDistance {
   /// the nearest of them within r is taken; else the search ends at the first one found. The
   /// hint is set to the triangle taken, `found` (optional) to its distance, at most r.
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
-  /// Appends to `ids` every triangle (its index in the mesh) within r of p.
-  void triangles_within(const Vec3& p, double r, std::vector<uint32_t>& ids) const;
-  /// Of the triangles `ids` (indices in the mesh; the point nearest p among them, as
-  /// `nearest` would rank them: least distance, then least index), with each one's answer
-  /// in `each` (distances not squared). `ids` must not be empty.
-  Nearest nearest_among(const Vec3& p, const std::vector<uint32_t>& ids, std::vector<Nearest>& each) const;
+  /// Every triangle within r of p, with its point nearest p (`triangle`: its index in the
+  /// mesh), into `out` (cleared first). Returns the place in `out` of the nearest, as
+  /// `nearest` ranks them (least distance, then least index), or out.size() when none.
+  size_t nearest_within(const Vec3& p, double r, std::vector<Nearest>& out) const;
   /// The hint that names the mesh's triangle t (for a point next to it).
   uint32_t hint_of(uint32_t t) const { return slot_of_[t]; }
   /// Whether every triangle lies farther than r from the box [lo, hi], proven (false when

@@ -166,21 +166,19 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
 }
 
 double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, double* distance, Vec3* nearest) const {
-  // Next to the sum's surface (d between inner and outer) the triangles within d + outer -
-  // inner serve twice: the nearest of them gives d and its sign, all of them the sum. A
-  // nearby point's nearest triangle (the hint) bounds d to gather them in one search.
-  thread_local std::vector<uint32_t> around;
-  thread_local std::vector<Nearest> each;
+  // F_T is at least d_T - outer, the nearest triangle's at most d - inner: only triangles
+  // within d + outer - inner of p can give the least. Next to the sum's surface one search
+  // gathers them, bounded by a nearby point's nearest triangle (the hint), and gives d too.
+  thread_local std::vector<Nearest> around;
   around.clear();
   const MeshDistance& mesh = distance_.mesh_distance();
   const double spread = body_.outer - body_.inner;
   const double bound = hint ? mesh.distance_to_hint(p, *hint) : kHuge;
   Nearest n;
-  if (bound <= 2 * body_.outer) {
-    mesh.triangles_within(p, (bound + spread) * (1 + 1e-9) + kTinyDivisor, around);
-  }
+  size_t least = 0;
+  if (bound <= 2 * body_.outer) least = mesh.nearest_within(p, (bound + spread) * (1 + 1e-9) + kTinyDivisor, around);
   if (!around.empty()) {
-    n = mesh.nearest_among(p, around, each);
+    n = around[least];
     *hint = mesh.hint_of(n.triangle);
   } else {
     n = mesh.nearest(p, hint);
@@ -189,25 +187,26 @@ double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, doubl
   if (distance) *distance = d;
   if (nearest) *nearest = n.point;
   if (!(d > 0)) return d - body_.inner;
-  if (around.empty()) {
-    mesh.triangles_within(p, (d + spread) * (1 + 1e-9) + kTinyDivisor, around);
-    mesh.nearest_among(p, around, each);
-  }
+  const double reach = (d + spread) * (1 + 1e-9) + kTinyDivisor;
+  if (around.empty()) mesh.nearest_within(p, reach, around);
+  // The hint's bound gathers a wider shell: on a mesh of small triangles several times as many.
+  std::erase_if(around, [&](const Nearest& t) { return t.distance > reach; });
   uint32_t winner = 0;
-  return outside(p, d, around, each, gradient, winner);
+  return outside(p, d, around, gradient, winner);
 }
 
-double RoundSum::outside(const Vec3& p, double d, const std::vector<uint32_t>& around, const std::vector<Nearest>& each,
-                         Vec3& gradient, uint32_t& winner) const {
+double RoundSum::outside(const Vec3& p, double d, const std::vector<Nearest>& around, Vec3& gradient,
+                         uint32_t& winner) const {
   // `around`: every triangle within d + outer - inner of p (F_T is at least d_T - outer, the
-  // nearest triangle's at most d - inner: no other can come lower), `each` its nearest point.
+  // nearest triangle's at most d - inner: no other can come lower) with its point nearest p.
   // Nearest first: F_T is at least its value along u_T, d_T - h_B(u_T), so a triangle whose
   // value there is no lower than the best so far needs no search of its facets.
   thread_local std::vector<uint32_t> order;
   order.resize(around.size());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
-    return each[x].distance < each[y].distance || (each[x].distance == each[y].distance && around[x] < around[y]);
+    return around[x].distance < around[y].distance ||
+           (around[x].distance == around[y].distance && around[x].triangle < around[y].triangle);
   });
   // Skipping a triangle whose bound is no lower keeps f at most the distance to S's surface
   // outside (that T + B is no nearer than `best`) and inside (it holds p no deeper).
@@ -216,19 +215,19 @@ double RoundSum::outside(const Vec3& p, double d, const std::vector<uint32_t>& a
   Vec3 best_plane{0, 0, 0};  // the plane of the best value so far ...
   double best_support = 0;   // ... and B's support along it
   for (uint32_t i : order) {
-    const double dt = each[i].distance;
-    if (found && dt >= 0.5 * body_.inner) {
+    const Nearest& at = around[i];
+    if (found && at.distance >= 0.5 * body_.inner) {
       // Any direction n gives n.p - h_T(n) - h_B(n), at most the distance to T + B outside
-      // it and at most F_T inside: along the best normal so far (a triangle beside the best
+      // it and at most F_T inside: along the best plane so far (a triangle beside the best
       // one, on its plane or sharing its edge, usually gives the same), and along u_T.
-      if (dot3(best_plane, p) - support_of(around[i], best_plane) - best_support >= best) continue;
-      if (dt - body_.support(scale3(sub3(p, each[i].point), 1 / dt)) >= best) continue;
+      if (dot3(best_plane, p) - support_of(at.triangle, best_plane) - best_support >= best) continue;
+      if (at.distance - body_.support(scale3(sub3(p, at.point), 1 / at.distance)) >= best) continue;
     }
     Vec3 g, plane;
     double support = 0;
-    const double v = triangle_sum(around[i], p, each[i], g, &plane, &support);
+    const double v = triangle_sum(at.triangle, p, at, g, &plane, &support);
     if (!found || v < best) {
-      best = v, gradient = g, winner = around[i];
+      best = v, gradient = g, winner = at.triangle;
       best_plane = plane, best_support = support;
     }
     found = true;
@@ -257,15 +256,12 @@ bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi) const {
   Vec3 g;
   const double d = distance_.with_gradient(c, g);
   if (!(d > half)) return false;  // the box may meet the solid itself
-  thread_local std::vector<uint32_t> near_c;
-  thread_local std::vector<Nearest> each;
-  near_c.clear();
+  thread_local std::vector<Nearest> near_c;
   const MeshDistance& mesh = distance_.mesh_distance();
-  mesh.triangles_within(c, (d + body_.outer - body_.inner) * (1 + 1e-9) + kTinyDivisor, near_c);
+  mesh.nearest_within(c, (d + body_.outer - body_.inner) * (1 + 1e-9) + kTinyDivisor, near_c);
   if (near_c.empty()) return false;
-  mesh.nearest_among(c, near_c, each);
   uint32_t winner = 0;
-  const double f = outside(c, d, near_c, each, g, winner);
+  const double f = outside(c, d, near_c, g, winner);
   if (f < 0) {
     // Inside T + B, a convex polytope, with all eight corners: the box is in the sum.
     for (int k = 0; k < 8; ++k) {
@@ -278,13 +274,10 @@ bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi) const {
   // Outside: every T + B that may reach the box (T within outer of it) lies beyond the plane
   // its facet search at the centre found (a supporting plane of T + B), the box on the other
   // side of it.
-  thread_local std::vector<uint32_t> around;
-  around.clear();
-  distance_.mesh_distance().triangles_within(c, (body_.outer + half) * (1 + 1e-9) + kTinyDivisor, around);
-  for (uint32_t t : around) {
-    const Nearest at = nearest_point(t, c);
+  mesh.nearest_within(c, (body_.outer + half) * (1 + 1e-9) + kTinyDivisor, near_c);
+  for (const Nearest& at : near_c) {
     Vec3 g, n;
-    const double v = triangle_sum(t, c, at, g, &n);
+    const double v = triangle_sum(at.triangle, c, at, g, &n);
     if (!(at.distance >= 0.5 * body_.inner) || !(v - width(n) > 0)) return false;
   }
   return true;

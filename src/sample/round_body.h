@@ -92,8 +92,7 @@ class RoundSum {
 
  private:
   /// f at p outside the solid (`d`: its distance), its gradient and the triangle whose F_T it is.
-  double outside(const Vec3& p, double d, const std::vector<uint32_t>& around, const std::vector<Nearest>& each,
-                 Vec3& gradient, uint32_t& winner) const;
+  double outside(const Vec3& p, double d, const std::vector<Nearest>& around, Vec3& gradient, uint32_t& winner) const;
   /// Triangle t's support along n.
   double support_of(uint32_t t, const Vec3& n) const;
   /// The distance from p to triangle t and its point nearest p.
