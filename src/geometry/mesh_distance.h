@@ -52,8 +52,9 @@ class MeshDistance {
   /// hint is set to the triangle taken, `found` (optional) to its distance, at most r.
   bool within(const Vec3& p, double r, uint32_t* hint = nullptr, double* found = nullptr) const;
   /// Every triangle within r of p, with its point nearest p (`triangle`: its index in the
-  /// mesh), into `out` (cleared first). Returns the place in `out` of the nearest, as
-  /// `nearest` ranks them (least distance, then least index), or out.size() when none.
+  /// mesh), into `out` (cleared first). Returns the place in `out` of the nearest (least
+  /// distance, then least index: `nearest`'s answer, but where p lies on the mesh, which
+  /// `nearest` takes as the first at distance 0 it meets), or 0 when none.
   size_t nearest_within(const Vec3& p, double r, std::vector<Nearest>& out) const;
   /// The hint that names the mesh's triangle t (for a point next to it).
   uint32_t hint_of(uint32_t t) const { return slot_of_[t]; }

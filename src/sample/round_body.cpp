@@ -64,8 +64,6 @@ void RoundBody::index_directions() {
   candidates_.clear();
   facet_first_.assign(size_t(cells) + 1, 0);
   facet_list_.clear();
-  all_facets_.resize(facet_normal.size());
-  std::iota(all_facets_.begin(), all_facets_.end(), 0u);
   for (int cell = 0; cell < cells; ++cell) {
     const int face = cell / (side_ * side_), i = (cell / side_) % side_, j = cell % side_;
     const auto at = [&](double t) { return 2 * t / side_ - 1; };
@@ -89,8 +87,8 @@ void RoundBody::index_directions() {
     // angular radius of mid (a hair more for rounding).
     const double radius = 2 * std::asin(std::min(chord / 2, 1.0)) + 1e-9;
     const double facet_cos = std::cos(std::min(near_angle() + radius, std::numbers::pi));
-    for (uint32_t j = 0; j < facet_normal.size(); ++j)
-      if (dot3(facet_normal[j], mid) >= facet_cos) facet_list_.push_back(j);
+    for (uint32_t f = 0; f < facet_normal.size(); ++f)
+      if (dot3(facet_normal[f], mid) >= facet_cos) facet_list_.push_back(f);
     facet_first_[size_t(cell) + 1] = uint32_t(facet_list_.size());
   }
 }
@@ -101,9 +99,8 @@ double RoundBody::near_angle() const {
 }
 
 RoundBody::Near RoundBody::near(const Vec3& u) const {
-  const int cell = side_ > 0 ? cell_of(u) : -1;
-  if (cell < 0)
-    return {all_facets_.data(), all_facets_.data() + all_facets_.size()};
+  const int cell = cell_of(u);
+  if (cell < 0) return {nullptr, nullptr};
   return {facet_list_.data() + facet_first_[cell], facet_list_.data() + facet_first_[cell + 1]};
 }
 
@@ -285,8 +282,6 @@ bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi) const {
 
 namespace {
 
-/// How far x lies inside the side from p to q of triangle pqr, along the triangle's plane
-/// (x on that plane; negative outside).
 /// A number that grows with the angle of (x, y) from the x axis, once round from -pi to pi
 /// (the position on the square |x| + |y| = 1 about the origin): an order without atan2.
 double pseudo_angle(double x, double y) {
@@ -296,6 +291,8 @@ double pseudo_angle(double x, double y) {
   return x >= 0 ? t : (y >= 0 ? 2 - t : -2 - t);
 }
 
+/// How far x lies inside the side from p to q of triangle pqr, along the triangle's plane
+/// (x on that plane; negative outside).
 double inside_side(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& x) {
   const Vec3 e = sub3(q, p), w = sub3(r, p);
   const double len2 = dot3(e, e);
@@ -477,7 +474,7 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
   // Any facet normal n does at most n.(p - near) - inner = d_T cos(n, u) - inner: those with
   // cos(n, u) at or below `cut` cannot beat `best`.
   const double cut = (best + body_.inner) / dt;
-  if (above_face_inside(t, near, dt, cut, best >= 0)) return best;
+  if (at.feature == Feature::Face && above_face_inside(t, near, dt, cut, best >= 0)) return best;
   const auto consider = [&](const Vec3& n, double support_b) {
     const double v = dot3(n, p) - support_t(n) - support_b;
     if (v > best) {
@@ -486,9 +483,14 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
       if (plane_support) *plane_support = support_b;
     }
   };
-  const RoundBody::Near near_u = body_.near(u);
-  for (const uint32_t* j = near_u.facets; j != near_u.facets_end; ++j)
-    if (dot3(body_.facet_normal[*j], u) > cut) consider(body_.facet_normal[*j], body_.facet_support[*j]);
+  if (body_.indexed()) {
+    const RoundBody::Near near_u = body_.near(u);
+    for (const uint32_t* j = near_u.facets; j != near_u.facets_end; ++j)
+      if (dot3(body_.facet_normal[*j], u) > cut) consider(body_.facet_normal[*j], body_.facet_support[*j]);
+  } else {
+    for (size_t j = 0; j < body_.facet_normal.size(); ++j)
+      if (dot3(body_.facet_normal[j], u) > cut) consider(body_.facet_normal[j], body_.facet_support[j]);
+  }
   if (const Face& face = face_[t]; norm3(face.normal) > 0) {
     if (dot3(face.normal, u) > cut) consider(face.normal, face.up);
     if (-dot3(face.normal, u) > cut) consider(scale3(face.normal, -1), face.down);

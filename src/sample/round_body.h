@@ -38,9 +38,9 @@ struct RoundBody {
   /// Bins the directions so that support_point looks at a few candidate vertices, not all,
   /// and a sum's facet search only the facets near a direction.
   void index_directions();
-  /// The facets (indices into facet_normal) whose normals may lie within
-  /// `reach` of u, where reach is the angle index_directions was given room for
-  /// (near_angle): all of them when not indexed.
+  bool indexed() const { return side_ > 0; }
+  /// The facets (indices into facet_normal) whose normals may lie within near_angle of u
+  /// (indexed bodies only; none for a u of no length).
   struct Near {
     const uint32_t *facets, *facets_end;
   };
@@ -55,7 +55,7 @@ struct RoundBody {
   /// and the facets within near_angle of some direction in it.
   int side_ = 0;
   std::vector<uint32_t> first_, candidates_;
-  std::vector<uint32_t> facet_first_, facet_list_, all_facets_;
+  std::vector<uint32_t> facet_first_, facet_list_;
   int cell_of(const Vec3& u) const;
 };
 
@@ -106,9 +106,9 @@ class RoundSum {
   /// The gradient of d_T - h_B(u) (u the direction from T's point nearest p, `feature` the
   /// part of T holding it, `top` the vertex of B reaching the support along u).
   Vec3 along_gradient(uint32_t t, Feature feature, const Vec3& u, double dt, const Vec3& top) const;
-  /// Whether T's face value d_T - h_B(u) may stand for F_T (p above T's inside, far from its
-  /// sides; `outside`: p outside the sum, where sides a coplanar triangle continues count
-  /// as inside).
+  /// Whether T's face value d_T - h_B(u) may stand for F_T (`near` inside T, so u is T's
+  /// normal, and far from its sides; `outside`: p outside the sum, where sides a coplanar
+  /// triangle continues count as inside).
   bool above_face_inside(uint32_t t, const Vec3& near, double dt, double cut, bool outside) const;
   static constexpr uint32_t kNoTriangle = ~uint32_t{0};
   /// Per triangle side (3 t + k, from corner k): the coplanar triangle across it, or kNoTriangle.

@@ -56,8 +56,15 @@ TopologyFix enforce_one_component(Octree& t, const std::function<bool(uint32_t)>
           cost += how.spare_coarse && emptied_coarse_leaf(t, a, flipped);
           breaks_coarse = breaks_coarse || (a.cell.level < t.max_depth && multi_component(flipped));
         }
-        if (how.margin) cost += std::min((*how.margin)(l.cell.corner(k)), 1.0);
-        else cost += (((s >> k) & 1) != 0) != minority_inside;
+        // A point a cell or more from the surface moves it as much as any other: among
+        // those the minority sign still decides (a hair of cost).
+        const bool majority = (((s >> k) & 1) != 0) != minority_inside;
+        if (how.margin) {
+          const double m = (*how.margin)(l.cell.corner(k));
+          cost += (m < 1 ? m : 1) + 1e-3 * majority;  // NaN counts as far
+        } else {
+          cost += majority;
+        }
         // Undoing what remove_islands just set would bring its defect back.
         if (how.pinned && how.pinned->count(lattice_key(l.cell.corner(k)))) cost += 16;
         if (cost < best_cost) {
