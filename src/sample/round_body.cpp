@@ -449,39 +449,39 @@ bool RoundSum::above_face_inside(uint32_t t, const Vec3& near, double dt, double
 
 double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane,
                               double* plane_support) const {
+  const Vec3 x = sub3(p, at.point);
+  const double dt = norm3(x);
+  Best best;
+  if (dt < 0.5 * body_.inner) {
+    // Deep in T + B: a ball of radius inner - d_T about p lies in it, and F_T is at most
+    // d_T - inner. That value, not F_T, serves: it keeps |f| below the distance to S's surface.
+    best.value = dt - body_.inner;
+    best.gradient = best.plane = dt > 0 ? scale3(x, 1 / dt) : gradient;
+    best.support = body_.support(best.plane);
+  } else {
+    // Along u itself (T's support there is reached at its nearest point): d_T - h_B(u), with
+    // u turning as p moves over T's sides and corners.
+    const Vec3 u = scale3(x, 1 / dt);
+    const auto [support_u, top] = body_.support_point(u);
+    best = {dt - support_u, along_gradient(t, at.feature, u, dt, top), u, support_u};
+    // Any facet normal n does at most n.(p - near) - inner = d_T cos(n, u) - inner: those
+    // with cos(n, u) at or below `cut` cannot beat it.
+    const double cut = (best.value + body_.inner) / dt;
+    if (at.feature != Feature::Face || !above_face_inside(t, at.point, dt, cut, best.value >= 0))
+      facet_planes(t, p, u, cut, best);
+  }
+  gradient = best.gradient;
+  if (plane) *plane = best.plane;
+  if (plane_support) *plane_support = best.support;
+  return best.value;
+}
+
+void RoundSum::facet_planes(uint32_t t, const Vec3& p, const Vec3& u, double cut, Best& best) const {
   const auto& tri = surface_.triangles[t];
   const Vec3 &a = surface_.positions[tri[0]], &b = surface_.positions[tri[1]], &c = surface_.positions[tri[2]];
-  const Vec3& near = at.point;
-  const Vec3 x = sub3(p, near);
-  const double dt = norm3(x);
-  // Deep in T + B: a ball of radius inner - d_T about p lies in it, and F_T is at most
-  // d_T - inner. That value, not F_T, serves: it keeps |f| below the distance to S's surface.
-  if (dt < 0.5 * body_.inner) {
-    gradient = dt > 0 ? scale3(x, 1 / dt) : gradient;
-    if (plane) *plane = gradient;
-    if (plane_support) *plane_support = body_.support(gradient);
-    return dt - body_.inner;
-  }
-  const Vec3 u = scale3(x, 1 / dt);
-  const auto support_t = [&](const Vec3& n) { return std::max({dot3(n, a), dot3(n, b), dot3(n, c)}); };
-  // Along u itself (T's support there is reached at `near`): d_T - h_B(u), with u turning
-  // as p moves over T's sides and corners.
-  const auto [support_u, top] = body_.support_point(u);
-  double best = dt - support_u;
-  gradient = along_gradient(t, at.feature, u, dt, top);
-  if (plane) *plane = u;
-  if (plane_support) *plane_support = support_u;
-  // Any facet normal n does at most n.(p - near) - inner = d_T cos(n, u) - inner: those with
-  // cos(n, u) at or below `cut` cannot beat `best`.
-  const double cut = (best + body_.inner) / dt;
-  if (at.feature == Feature::Face && above_face_inside(t, near, dt, cut, best >= 0)) return best;
   const auto consider = [&](const Vec3& n, double support_b) {
-    const double v = dot3(n, p) - support_t(n) - support_b;
-    if (v > best) {
-      best = v, gradient = n;
-      if (plane) *plane = n;
-      if (plane_support) *plane_support = support_b;
-    }
+    const double v = dot3(n, p) - std::max({dot3(n, a), dot3(n, b), dot3(n, c)}) - support_b;
+    if (v > best.value) best = {v, n, n, support_b};
   };
   if (body_.indexed()) {
     const RoundBody::Near near_u = body_.near(u);
@@ -504,8 +504,8 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
     const size_t count = z.normal.size();
     const Vec3 across = sub3(u, scale3(z.axis, dot3(u, z.axis)));
     if (!(norm3(across) > cut) || count == 0) continue;
-    const double at = pseudo_angle(dot3(across, z.a1), dot3(across, z.a2));
-    const size_t mid = size_t(std::lower_bound(z.angle.begin(), z.angle.end(), at) - z.angle.begin());
+    const double angle_u = pseudo_angle(dot3(across, z.a1), dot3(across, z.a2));
+    const size_t mid = size_t(std::lower_bound(z.angle.begin(), z.angle.end(), angle_u) - z.angle.begin());
     for (size_t step = 0; step < count; ++step) {  // upwards from mid
       const size_t i = (mid + step) % count;
       if (!(dot3(z.normal[i], u) > cut)) break;
@@ -517,7 +517,6 @@ double RoundSum::triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3
       consider(z.normal[i], z.support[i]);
     }
   }
-  return best;
 }
 
 }  // namespace pic::detail

@@ -97,12 +97,19 @@ class RoundSum {
   double support_of(uint32_t t, const Vec3& n) const;
   /// The distance from p to triangle t and its point nearest p.
   Nearest nearest_point(uint32_t t, const Vec3& p) const;
-  /// F_T(p) for triangle t (the nearest point of its triangle to p: `near`), and its
-  /// gradient.
-  /// `plane`, when given, gets the normal n of the plane whose value F_T is (T + B lies below
-  /// it by that much at p: n.x <= h_T(n) + h_B(n)), `plane_support` h_B(n).
+  /// F_T(p) for triangle t (`at`: its point nearest p) and its gradient. `plane`, when
+  /// given, gets the normal n of the plane whose value F_T is (T + B lies below it by that
+  /// much at p: n.x <= h_T(n) + h_B(n)), `plane_support` h_B(n).
   double triangle_sum(uint32_t t, const Vec3& p, const Nearest& at, Vec3& gradient, Vec3* plane = nullptr,
                       double* plane_support = nullptr) const;
+  /// The highest plane value so far: its gradient, its plane's normal n and B's support h_B(n).
+  struct Best {
+    double value = 0;
+    Vec3 gradient{0, 0, 0}, plane{0, 0, 0};
+    double support = 0;
+  };
+  /// Raises `best` to the highest of T + B's facet planes within acos(cut) of u at p.
+  void facet_planes(uint32_t t, const Vec3& p, const Vec3& u, double cut, Best& best) const;
   /// The gradient of d_T - h_B(u) (u the direction from T's point nearest p, `feature` the
   /// part of T holding it, `top` the vertex of B reaching the support along u).
   Vec3 along_gradient(uint32_t t, Feature feature, const Vec3& u, double dt, const Vec3& top) const;
@@ -116,8 +123,8 @@ class RoundSum {
 
   const TriMesh& surface_;
   /// The normals of the facets an edge of the surface sweeps along B's edges: where B's arcs
-  /// cross the circle of directions perpendicular to it (`axis`), by angle about it (from
-  /// a1 towards a2), with B's support there.
+  /// cross the circle of directions perpendicular to it (`axis`), in order round it (`angle`:
+  /// a pseudo-angle from a1 towards a2), with B's support there.
   struct Zone {
     Vec3 axis{0, 0, 0}, a1{0, 0, 0}, a2{0, 0, 0};
     std::vector<double> angle, support;
