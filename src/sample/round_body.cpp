@@ -26,6 +26,13 @@ Vec3 face_direction(int face, double x, double y) {
   return scale3(d, 1 / norm3(d));
 }
 
+/// Triangle t's normal scaled by twice its area (zero for a triangle without area).
+Vec3 area_normal(const TriMesh& mesh, size_t t) {
+  const auto& tri = mesh.triangles[t];
+  const Vec3& a = mesh.positions[tri[0]];
+  return cross3(sub3(mesh.positions[tri[1]], a), sub3(mesh.positions[tri[2]], a));
+}
+
 }  // namespace
 
 int RoundBody::cell_of(const Vec3& u) const {
@@ -120,13 +127,11 @@ RoundBody round_body(const std::vector<Vec3>& points) {
   b.inner = hull.triangles.empty() ? 0 : kHuge;
   std::vector<Vec3> normal(hull.triangles.size(), Vec3{0, 0, 0});
   for (size_t i = 0; i < hull.triangles.size(); ++i) {
-    const auto& t = hull.triangles[i];
-    const Vec3& a = hull.positions[t[0]];
-    const Vec3 n = cross3(sub3(hull.positions[t[1]], a), sub3(hull.positions[t[2]], a));
+    const Vec3 n = area_normal(hull, i);
     const double len = norm3(n);
     if (!(len > 0)) continue;
     normal[i] = scale3(n, 1 / len);
-    const double support = dot3(normal[i], sub3(a, b.centre));
+    const double support = dot3(normal[i], sub3(hull.positions[hull.triangles[i][0]], b.centre));
     b.inner = std::min(b.inner, support);
     // Pieces of one facet (a quad split in two) give it once.
     const bool seen = std::any_of(b.facet_normal.begin(), b.facet_normal.end(),
@@ -318,9 +323,7 @@ RoundSum::RoundSum(const TriMesh& surface, const RoundBody& body)
   // Each triangle's unit normal and B's supports along it, either way.
   face_.resize(surface.triangles.size());
   for (size_t t = 0; t < surface.triangles.size(); ++t) {
-    const auto& tri = surface.triangles[t];
-    const Vec3& a = surface.positions[tri[0]];
-    const Vec3 n = cross3(sub3(surface.positions[tri[1]], a), sub3(surface.positions[tri[2]], a));
+    const Vec3 n = area_normal(surface, t);
     const double len = norm3(n);
     if (!(len > 0)) continue;
     face_[t].normal = scale3(n, 1 / len);
@@ -382,16 +385,11 @@ std::vector<uint32_t> RoundSum::flat_neighbours(const TriMesh& surface) {
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> side;  // directed side -> 3 t + k
   for (uint32_t t = 0; t < surface.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) side.emplace(std::pair{surface.triangles[t][k], surface.triangles[t][(k + 1) % 3]}, 3 * t + k);
-  const auto normal = [&](uint32_t t) {
-    const auto& tri = surface.triangles[t];
-    const Vec3& a = surface.positions[tri[0]];
-    return cross3(sub3(surface.positions[tri[1]], a), sub3(surface.positions[tri[2]], a));
-  };
   for (uint32_t t = 0; t < surface.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const auto it = side.find({surface.triangles[t][(k + 1) % 3], surface.triangles[t][k]});
       if (it == side.end()) continue;
-      const Vec3 n = normal(t), m = normal(it->second / 3);
+      const Vec3 n = area_normal(surface, t), m = area_normal(surface, it->second / 3);
       const double nn = norm3(n), mm = norm3(m);
       // Coplanar: the two share the side's line, so parallel normals make one plane.
       if (nn > 0 && mm > 0 && dot3(n, m) >= (1 - kSamePlaneCosine) * nn * mm) across[3 * t + k] = it->second / 3;
