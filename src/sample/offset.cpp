@@ -196,10 +196,11 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
     const Vec3 centre = detail::scale3(detail::add3(lo, hi), 0.5);
     Vec3 grad, nearest;
     double d = 0;
-    const double fc = sum(centre, grad, &hints.local(), &d, &nearest);
+    uint32_t winner = 0;
+    const double fc = sum(centre, grad, &hints.local(), &d, &nearest, &winner);
     if (std::abs(fc) > f.lipschitz * detail::norm3(detail::sub3(hi, lo)) / 2) return true;
     if (clear_of_bands(sum.distance().mesh_distance(), {{body.inner, body.outer}}, lo, hi, d, nearest)) return true;
-    return sum.box_clear(lo, hi);
+    return sum.box_clear(lo, hi, d, fc, winner);
   };
   SampleOptions o = options;
   o.cube = cube;

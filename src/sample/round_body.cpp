@@ -167,7 +167,8 @@ std::optional<RoundBody> round_body_if_round(const std::vector<Vec3>& points) {
   return b;
 }
 
-double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, double* distance, Vec3* nearest) const {
+double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, double* distance, Vec3* nearest,
+                            uint32_t* winner) const {
   // F_T is at least d_T - outer, the nearest triangle's at most d - inner: only triangles
   // within d + outer - inner of p can give the least. Next to the sum's surface one search
   // gathers them, bounded by a nearby point's nearest triangle (the hint), and gives d too.
@@ -193,8 +194,10 @@ double RoundSum::operator()(const Vec3& p, Vec3& gradient, uint32_t* hint, doubl
   if (around.empty()) mesh.nearest_within(p, reach, around);
   // The hint's bound gathers a wider shell: on a mesh of small triangles several times as many.
   std::erase_if(around, [&](const Nearest& t) { return t.distance > reach; });
-  uint32_t winner = 0;
-  return outside(p, d, around, gradient, winner);
+  uint32_t won = 0;
+  const double f = outside(p, d, around, gradient, won);
+  if (winner) *winner = won;
+  return f;
 }
 
 double RoundSum::outside(const Vec3& p, double d, const std::vector<Nearest>& around, Vec3& gradient,
@@ -248,22 +251,16 @@ Nearest RoundSum::nearest_point(uint32_t t, const Vec3& p) const {
   return nearest_on_triangle(p, surface_.positions[tri[0]], surface_.positions[tri[1]], surface_.positions[tri[2]]);
 }
 
-bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi) const {
+bool RoundSum::box_clear(const Vec3& lo, const Vec3& hi, double d, double f, uint32_t winner) const {
   const Vec3 c = scale3(add3(lo, hi), 0.5), half_side = scale3(sub3(hi, lo), 0.5);
   const double half = norm3(half_side);
   // How far the box reaches along n from its centre.
   const auto width = [&](const Vec3& n) {
     return std::abs(n[0]) * half_side[0] + std::abs(n[1]) * half_side[1] + std::abs(n[2]) * half_side[2];
   };
-  Vec3 g;
-  const double d = distance_.with_gradient(c, g);
   if (!(d > half)) return false;  // the box may meet the solid itself
   thread_local std::vector<Nearest> near_c;
   const MeshDistance& mesh = distance_.mesh_distance();
-  mesh.nearest_within(c, (d + body_.outer - body_.inner) * (1 + 1e-9) + kTinyDivisor, near_c);
-  if (near_c.empty()) return false;
-  uint32_t winner = 0;
-  const double f = outside(c, d, near_c, g, winner);
   if (f < 0) {
     // Inside T + B, a convex polytope, with all eight corners: the box is in the sum.
     for (int k = 0; k < 8; ++k) {

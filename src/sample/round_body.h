@@ -80,13 +80,14 @@ class RoundSum {
   RoundSum& operator=(const RoundSum&) = delete;
   /// f at p and its gradient (the winning facet's normal). `hint`: see MeshDistance::nearest;
   /// `distance` and `nearest`, when given, get the signed distance d and the surface point
-  /// nearest p.
+  /// nearest p; `winner` the triangle whose F_T f is (outside the solid; else unchanged).
   double operator()(const Vec3& p, Vec3& gradient, uint32_t* hint = nullptr, double* distance = nullptr,
-                    Vec3* nearest = nullptr) const;
+                    Vec3* nearest = nullptr, uint32_t* winner = nullptr) const;
   /// Whether the box [lo, hi] lies proven inside or outside the sum (a box beside the surface
   /// that no ball about its centre clears: inside one T + B with all its corners, or beyond
-  /// a supporting plane of every T + B that may reach it). False when unsure.
-  bool box_clear(const Vec3& lo, const Vec3& hi) const;
+  /// a supporting plane of every T + B that may reach it). False when unsure. `d`, `f` and
+  /// `winner`: what operator() gave at the box's centre.
+  bool box_clear(const Vec3& lo, const Vec3& hi, double d, double f, uint32_t winner) const;
   const SignedDistance& distance() const { return distance_; }
   const RoundBody& body() const { return body_; }
 
