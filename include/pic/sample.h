@@ -132,6 +132,12 @@ struct ImplicitSolid {
   /// several threads at once.
   std::function<void(const Vec3& lo, const Vec3& hi, const Vec3& vertex, std::vector<std::array<Vec3, 2>>& bends)>
       bends;
+  /// Points at or beside the surface's own features (optional, world units): for an offset of
+  /// a mesh, each vertex, edge middle and face centre of the mesh moved along its normal by the
+  /// offset. Each is moved onto f's zero by Newton steps, and a leaf above the cap it lands in
+  /// must have a polygon within the sampling tolerance of it, else that leaf is split: a dent
+  /// or a bump smaller than a coarse leaf, between all the points the sampler asks, is drawn.
+  std::function<void(std::vector<Vec3>& points)> features;
 };
 /// Samples an implicit solid in `options.cube` (required) with the paper's rules: corner signs
 /// from f (0 counts as outside), edge crossings by root finding, Hermite normals from the

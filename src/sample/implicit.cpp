@@ -1096,6 +1096,47 @@ void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vect
   }
 }
 
+/// The points of f.features moved onto f's zero (Newton steps along the gradient, within a
+/// tenth of `tolerance`, f's units) that lie in a leaf above the cap, into memo.unrepresented:
+/// mark_unrepresented then asks for each to be drawn. A point already in a leaf near the cap
+/// before its steps is not asked (its surface is sampled finely there). Returns f's values asked.
+size_t add_feature_points(const ImplicitSolid& f, const Octree& tree, Memos& memo, double tolerance, bool parallel) {
+  std::vector<Vec3> seeds;
+  f.features(seeds);
+  const int64_t span = int64_t{1} << kMaxLevel;
+  const auto lattice_of = [&](const Vec3& u, Lat& q) {
+    for (int k = 0; k < 3; ++k) {
+      if (!(u[k] >= 0 && u[k] < 1)) return false;
+      q[k] = int64_t(std::floor(u[k] * double(span)));
+    }
+    return true;
+  };
+  std::atomic<size_t> asked{0};
+  const auto one = [&](size_t i) {
+    Lat q;
+    Vec3 x = seeds[i];
+    if (!lattice_of(world_to_unit(tree.cube, x), q) || leaf_at(tree, q).cell.level + kUncheckedLevels >= tree.max_depth)
+      return;
+    size_t n = 0;
+    Vec3 g;
+    double fx = f.value_gradient(x, g);
+    ++n;
+    for (int step = 0; step < kSurfaceSteps && std::abs(fx) > tolerance / 10; ++step) {
+      const double g2 = dot3(g, g);
+      if (!(g2 > 0)) break;
+      x = sub3(x, scale3(g, fx / g2));
+      fx = f.value_gradient(x, g);
+      ++n;
+    }
+    asked += n;
+    if (std::abs(fx) <= tolerance / 10 && lattice_of(world_to_unit(tree.cube, x), q))
+      memo.unrepresented.local().push_back(world_to_unit(tree.cube, x));
+  };
+  if (parallel) tbb::parallel_for(size_t{0}, seeds.size(), one);
+  else for (size_t i = 0; i < seeds.size(); ++i) one(i);
+  return asked;
+}
+
 /// A coarse leaf's polygons join its vertex to its neighbours' by straight sides, but its
 /// planes come from its own edges' crossings only: a crease inside the cell that no edge
 /// crosses, or one in a neighbour, can lie between two vertices, and the polygon then cuts
@@ -1268,6 +1309,10 @@ Octree sample(const ImplicitSolid& solid, const SampleOptions& options, SampleSt
   tree.vertices = std::move(b.vertices);
   FunctionResample resample{solid, options, tree, solid.values ? nullptr : &memo, {}};
   const ResampleLeaf from_function = [&](const LeafRef& l, const Lat& p) { return resample(l, p); };
+  if (solid.features && solid.value_gradient && !solid.values)
+    sampler.evaluations += add_feature_points(
+        solid, tree, memo, detail::bend_tolerance(tree.cube, tree.max_depth, options.error) * solid.lipschitz,
+        options.parallel);
   // The coarse sides' resampling makes new coarse leaves: their polygons are asked in turn.
   const size_t checked = refine_polygons_off_surface(tree, sampler, resample, from_function, solid, 0);
   refine_coarse_sides(tree, resample, from_function);

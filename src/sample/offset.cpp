@@ -152,6 +152,12 @@ Octree sample_distance(const TriMesh& surface, const Cube& cube, const SampleOpt
     return v;
   };
   solid.site_distance = [&](const Vec3& p, uint32_t site) { return sd.mesh_distance().distance_to_hint(p, site); };
+  solid.features = [&](std::vector<Vec3>& points) {
+    std::vector<double> distances;
+    for (const Band& b : levels)
+      if (b.lo == b.hi) distances.push_back(b.lo);
+    points = detail::offset_feature_points(surface, distances, tolerance);
+  };
   SampleOptions o = options;
   o.cube = cube;
   return sample_with_mesh(solid, o, stats, mesh);

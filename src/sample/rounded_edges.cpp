@@ -1,9 +1,10 @@
-// The rounds an offset makes of a mesh's sharp edges (rounded_edges.h).
+// The rounds and features an offset makes of a mesh's sharp edges (rounded_edges.h).
 #include "sample/rounded_edges.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 
 #include "geometry/edge_faces.h"
 #include "geometry/vec3.h"
@@ -79,6 +80,54 @@ void RoundedEdges::points(const Vec3& lo, const Vec3& hi, const Vec3& vertex,
       if (r[k] < lo[k] || r[k] > hi[k]) return;
     out.push_back({r, n});
   });
+}
+
+std::vector<Vec3> offset_feature_points(const TriMesh& m, const std::vector<double>& distances, double tolerance) {
+  std::vector<Vec3> face(m.triangles.size(), Vec3{0, 0, 0}), vertex(m.positions.size(), Vec3{0, 0, 0});
+  for (size_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    const Vec3 n = cross3(sub3(m.positions[t[1]], m.positions[t[0]]), sub3(m.positions[t[2]], m.positions[t[0]]));
+    const double len = norm3(n);
+    if (!(len > 0)) continue;
+    face[f] = scale3(n, 1 / len);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 a = sub3(m.positions[t[(k + 1) % 3]], m.positions[t[k]]);
+      const Vec3 b = sub3(m.positions[t[(k + 2) % 3]], m.positions[t[k]]);
+      const double angle = std::atan2(norm3(cross3(a, b)), dot3(a, b));
+      vertex[t[k]] = add3(vertex[t[k]], scale3(face[f], angle));
+    }
+  }
+  const auto moved = [](const Vec3& p, const Vec3& n, double d) {
+    const double len = norm3(n);
+    return len > 0 ? add3(p, scale3(n, d / len)) : p;
+  };
+  const std::vector<std::pair<uint64_t, uint32_t>> edges = edge_faces(m);
+  std::vector<Vec3> out;
+  for (double d : distances) {
+    // A round of radius |d| about faces meeting at angle a bulges |d| (1 - cos(a / 2)) off them.
+    const double bulge = std::abs(d) > tolerance ? 2 * std::acos(1 - tolerance / std::abs(d)) : std::numbers::pi;
+    const double min_cos = std::cos(std::min(std::numbers::pi / 18, bulge));
+    std::vector<uint8_t> vertex_on(m.positions.size(), 0), face_on(m.triangles.size(), 0);
+    for (size_t i = 0; i + 1 < edges.size(); ++i) {
+      if (edges[i].first != edges[i + 1].first) continue;
+      const uint32_t f1 = edges[i].second, f2 = edges[i + 1].second;
+      ++i;
+      if (!(dot3(face[f1], face[f2]) < min_cos)) continue;
+      const uint32_t a = uint32_t(edges[i].first >> 32), b = uint32_t(edges[i].first & 0xffffffffu);
+      vertex_on[a] = vertex_on[b] = face_on[f1] = face_on[f2] = 1;
+      out.push_back(moved(scale3(add3(m.positions[a], m.positions[b]), 0.5),
+                          add3(face[f1], face[f2]), d));
+    }
+    for (size_t v = 0; v < m.positions.size(); ++v)
+      if (vertex_on[v]) out.push_back(moved(m.positions[v], vertex[v], d));
+    for (size_t f = 0; f < m.triangles.size(); ++f)
+      if (face_on[f]) {
+        const auto& t = m.triangles[f];
+        const Vec3 c = scale3(add3(add3(m.positions[t[0]], m.positions[t[1]]), m.positions[t[2]]), 1.0 / 3);
+        out.push_back(moved(c, face[f], d));
+      }
+  }
+  return out;
 }
 
 double bend_tolerance(const Cube& cube, int depth, double error) {

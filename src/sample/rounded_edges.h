@@ -1,5 +1,6 @@
 // The rounds an offset makes of a mesh's sharp edges, for the implicit sampler's bends
-// (ImplicitSolid::bends): where a coarse cell's crossings could all miss one.
+// (ImplicitSolid::bends): where a coarse cell's crossings could all miss one; and the points
+// where its creases put features of the offset (ImplicitSolid::features).
 #pragma once
 
 #include <array>
@@ -33,6 +34,17 @@ class RoundedEdges {
   std::vector<std::array<Vec3, 2>> segments_;
   std::unique_ptr<BoxTree> tree_;
 };
+
+/// Where the offsets of a closed surface by each of `distances` have features of their own, for
+/// the implicit sampler's feature points (ImplicitSolid::features): at each crease (an edge
+/// whose faces meet at more than 10 degrees, or at less where the offset's round of it would
+/// bulge beyond `tolerance`), its middle, its ends and its faces' centres, each moved along its
+/// normal by the distance (a face's unit normal; an edge's faces' summed; a vertex's faces'
+/// weighted by their angles there, its pseudonormal). A vertex's point lies on its offset's
+/// round or corner, a face's on its plane. Flat and gently curved parts have none: the
+/// sampler's own questions see their offsets.
+std::vector<Vec3> offset_feature_points(const TriMesh& surface, const std::vector<double>& distances,
+                                        double tolerance);
 
 /// The distance the implicit sampler holds a leaf's surface to (its polygons, its bends), in
 /// world units: the planes' own fit 2δ (δ² = `error`, in root-cube units), at most half a
