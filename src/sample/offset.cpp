@@ -210,6 +210,12 @@ Octree minkowski_round(const TriMesh& solid, const std::vector<Vec3>& round, con
   };
   SampleOptions o = options;
   o.cube = cube;
+  // The solid's creases moved by the body's radius: on the sum's surface where the body rounds
+  // them, Newton steps away where it fills them.
+  const double tolerance = detail::bend_tolerance(cube, o.depth, o.error);
+  f.features = [&](std::vector<Vec3>& points) {
+    points = detail::offset_feature_points(surface, {(body.inner + body.outer) / 2}, tolerance);
+  };
   return sample_with_mesh(f, o, stats, mesh);
 }
 
@@ -310,6 +316,11 @@ Octree thicken(const TriMesh& surface, double thickness, const SampleOptions& op
   solid.distance = true;
   SampleOptions o = options;
   o.cube = cube_around(surface, half, options);
+  // Both faces of the slab have the surface's creases, moved either way.
+  const double tolerance = detail::bend_tolerance(*o.cube, o.depth, o.error);
+  solid.features = [&](std::vector<Vec3>& points) {
+    points = detail::offset_feature_points(surface, {half, -half}, tolerance);
+  };
   return sample_with_mesh(solid, o, stats, mesh);
 }
 
