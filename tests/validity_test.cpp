@@ -72,6 +72,20 @@ TEST(SelfIntersect, CoincidentPositionsAreOneVertex) {
   EXPECT_EQ(v.boundary_edges, 4u);
 }
 
+TEST(Topology, CopiesAtOnePositionAreOneVertexToAReaderThatWelds) {
+  // Two boxes touching at a corner, each with its own copy of that corner: 2-manifold by index,
+  // but an STL file has no shared vertices, and a reader merging equal positions sees two
+  // fans at one vertex.
+  const TriMesh two = joined(make_box({0, 0, 0}, {1, 1, 1}), make_box({1, 1, 1}, {2, 2, 2}));
+  EXPECT_EQ(analyze_topology(two).nonmanifold_vertices, 0u);
+  EXPECT_TRUE(analyze_topology(two).manifold());
+  EXPECT_EQ(analyze_welded_topology(two).nonmanifold_vertices, 1u);
+  EXPECT_FALSE(analyze_welded_topology(two).manifold());
+  // Apart, nothing merges.
+  const TriMesh apart = joined(make_box({0, 0, 0}, {1, 1, 1}), make_box({1.5, 1.5, 1.5}, {2, 2, 2}));
+  EXPECT_TRUE(analyze_welded_topology(apart).manifold());
+}
+
 TEST(SelfIntersect, Orient3dAgreesWithIntegerArithmetic) {
   // Points on a grid of 2^-10 (their differences exact in doubles): a sliver triangle abc
   // (c nearly on the line ab) and d in its plane, then moved by one grid step or none. The

@@ -96,7 +96,9 @@ void write_contoured(ContourFile& f, const std::string& path, const ContourOptio
   // positions it cannot store.
   if (stores_float32(path)) f.mesh = round_to_float32(f.mesh);
   write_mesh(f.mesh, path);
-  f.written = {path, analyze_topology(f.mesh), known_crossings(o)};
+  // An STL file has no shared vertices: a reader merges equal positions.
+  const bool welded = extension(path) == ".stl";
+  f.written = {path, welded ? analyze_welded_topology(f.mesh) : analyze_topology(f.mesh), known_crossings(o)};
 }
 
 std::string info_json(const Octree& tree, size_t file_bytes) {

@@ -25,6 +25,10 @@ struct MeshTopology {
   }
 };
 MeshTopology analyze_topology(const TriMesh& mesh);
+/// analyze_topology of the mesh with equal positions merged: what a reader of a file without
+/// shared vertices (STL) sees. Two sheets touching at a point that the mesh keeps apart by
+/// index only, with their copies of the vertex at one position, are one non-manifold vertex.
+MeshTopology analyze_welded_topology(const TriMesh& mesh);
 
 /// @name Validity of a mesh as a solid's boundary (src/self_intersect.cpp).
 /// Vertices at bit-identical positions count as one vertex (as a mesh file reader sees them).

@@ -5,6 +5,7 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
+#include "geometry/weld.h"
 #include "measure/topology.h"
 #include "octree/cell.h"
 
@@ -152,6 +153,8 @@ MeshTopology analyze_topology(const TriMesh& mesh, std::vector<uint8_t>* off_fan
 }  // namespace detail
 
 MeshTopology analyze_topology(const TriMesh& mesh) { return detail::analyze_topology(mesh, nullptr); }
+
+MeshTopology analyze_welded_topology(const TriMesh& mesh) { return analyze_topology(detail::weld(mesh)); }
 
 double volume(const TriMesh& mesh) {
   double v = 0;

@@ -7,13 +7,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/weld.h"
 #include "pic/sample.h"
 #include "pic/types.h"
 
 namespace pic::detail {
-
-/// Equal positions merged (exactly; -0 == +0); triangles re-indexed, in their order.
-TriMesh weld(const TriMesh& mesh);
 
 struct CleanMesh {
   TriMesh mesh;         ///< welded; no degenerate or duplicated triangles; parts oriented
