@@ -99,7 +99,9 @@ def root_cube(lo, hi, steps, depth):
 
 def offset(d, ref, name, distance, cube_args, cell):
     """PIC's offset of the input, checked against the exact offset (it is half a reference)."""
-    out = os.path.join(d, name + ".stl")
+    # OFF holds the doubles (an STL rounds them to floats, folding slivers a sign test then
+    # misreads).
+    out = os.path.join(d, name + ".off")
     pic(d, ["offset", ref, "-o", out, "--distance", "%.17g" % distance] + cube_args, name, refusable=True)
     valid(out, name)
     ab, ba = compare(out, ref, cell, distance)
