@@ -1065,8 +1065,13 @@ double polygon_distance(const Vec3& p, const MeshPolygon& poly, const std::vecto
 void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vector<MeshPolygon>& polys, Memos& memo,
                         double tolerance, std::vector<char>& off) {
   std::vector<Vec3> points;
-  for (const std::vector<Vec3>& part : memo.unrepresented) points.insert(points.end(), part.begin(), part.end());
+  for (std::vector<Vec3>& part : memo.unrepresented) {
+    points.insert(points.end(), part.begin(), part.end());
+    part.clear();
+  }
   if (points.empty()) return;
+  // Only the points not drawn yet are asked again next round (leaves only grow finer).
+  std::vector<Vec3>& left = memo.unrepresented.local();
   // The polygons of each vertex.
   std::vector<uint32_t> start(g.pos.size() + 1, 0), of;
   for (const MeshPolygon& poly : polys)
@@ -1092,7 +1097,7 @@ void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vect
     for (uint32_t i = start[n.index]; i < start[n.index + 1] && best > tolerance; ++i)
       for (int k = 0; k < polys[of[i]].count; ++k)
         if (polys[of[i]].v[k] != n.index) near_polygons_of(polys[of[i]].v[k]);
-    if (best > tolerance) off[n.index] = 1;
+    if (best > tolerance) off[n.index] = 1, left.push_back(p);
   }
 }
 
@@ -1103,6 +1108,24 @@ void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vect
 size_t add_feature_points(const ImplicitSolid& f, const Octree& tree, Memos& memo, double tolerance, bool parallel) {
   std::vector<Vec3> seeds;
   f.features(seeds);
+  // In Morton order: each thread's nearest-triangle hint then serves the next point.
+  const auto spread = [](uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    return (x | x << 2) & 0x1249249249249249ULL;
+  };
+  std::vector<std::pair<uint64_t, Vec3>> keyed(seeds.size());
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    const Vec3 u = world_to_unit(tree.cube, seeds[i]);
+    uint64_t key = 0;
+    for (int k = 0; k < 3; ++k) key |= spread(uint64_t(std::clamp(u[k], 0.0, 1.0) * double(0x1fffff))) << k;
+    keyed[i] = {key, seeds[i]};
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (size_t i = 0; i < seeds.size(); ++i) seeds[i] = keyed[i].second;
   const int64_t span = int64_t{1} << kMaxLevel;
   const auto lattice_of = [&](const Vec3& u, Lat& q) {
     for (int k = 0; k < 3; ++k) {
