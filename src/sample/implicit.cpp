@@ -1087,7 +1087,11 @@ void mark_unrepresented(const Octree& tree, const GrayLeaves& g, const std::vect
     for (int k = 0; k < 3; ++k) q[k] = std::clamp(int64_t(std::floor(p[k] * double(span))), int64_t{0}, span - 1);
     const LeafRef l = leaf_at(tree, q);
     const Node& n = tree.nodes[l.node];
-    if (n.kind != CellKind::Gray || l.cell.level + kUncheckedLevels >= tree.max_depth) continue;
+    if (l.cell.level + kUncheckedLevels >= tree.max_depth) continue;
+    if (n.kind != CellKind::Gray) {
+      left.push_back(p);
+      continue;
+    }
     double best = detail::kHuge;
     const auto near_polygons_of = [&](uint32_t u) {
       for (uint32_t i = start[u]; i < start[u + 1] && best > tolerance; ++i)
