@@ -21,13 +21,8 @@ import random
 import subprocess
 import sys
 
+from fuzz_tools import PIC, SCAD_MJS, meshcheck
 from scad_fuzz import model
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
-SHARED = os.path.join(HERE, "..", "..", "shared", "tools")
-MESHCHECK = os.environ.get("MESHCHECK", os.path.join(SHARED, "build", "meshcheck"))
-SCAD_MJS = os.path.join(SHARED, "manifold", "scad.mjs")
 
 
 def case(seed):
@@ -35,10 +30,6 @@ def case(seed):
     return "minkowski() { %s sphere(r=%g, $fn=%d); }" % (
         model(r), r.choice([0.3, 0.5, 0.8, 1.2, 2]), r.choice([24, 32]))
 
-
-def meshcheck(path):
-    out = subprocess.run([MESHCHECK, path], capture_output=True, text=True, timeout=600).stdout
-    return json.loads(out)
 
 
 def run_case(seed, depth, outdir):
@@ -68,7 +59,7 @@ def run_case(seed, depth, outdir):
     if p.returncode != 0:
         return "REPORT pic exit %d: %s" % (p.returncode, p.stderr.strip().splitlines()[-1:])
     j = json.loads(p.stdout)
-    c = meshcheck(out)
+    c = meshcheck(out) or {}
     if not (c.get("closed") and c.get("manifold") and c.get("nonmanifold_vertices", 0) == 0
             and c.get("self_intersections", 0) == 0):
         return "REPORT invalid mesh: %s" % {k: c.get(k) for k in ("closed", "manifold", "self_intersections")}

@@ -23,17 +23,11 @@ import random
 import subprocess
 import sys
 
+from fuzz_tools import PIC, meshcheck
 from scad_fuzz import model
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
-MESHCHECK = os.environ.get("MESHCHECK", os.path.join(HERE, "..", "..", "shared", "tools", "build", "meshcheck"))
 LIMIT_CELLS = 1.5
 
-
-def meshcheck(path):
-    p = subprocess.run([MESHCHECK, path], capture_output=True, text=True, timeout=600)
-    return json.loads(p.stdout) if p.returncode == 0 and p.stdout.strip() else None
 
 
 def run_case(seed, depth, out):

@@ -22,8 +22,7 @@ import sys
 
 from scad_semantics_fuzz import volume as mesh_volume  # meshcheck's volume of a mesh file
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
+from fuzz_tools import PIC
 
 
 def primitive(r):

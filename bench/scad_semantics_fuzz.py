@@ -25,9 +25,7 @@ import random
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
-MESHCHECK = os.environ.get("MESHCHECK", os.path.join(HERE, "..", "..", "shared", "tools", "build", "meshcheck"))
+from fuzz_tools import MESHCHECK, PIC
 
 
 def num(r, lo, hi):

@@ -17,8 +17,7 @@ import random
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
+from fuzz_tools import PIC
 
 STRINGS = ["Hello", "og8", "PIC 0.1", "Ångström", "(x+y)=z!", "WAVE", "fi fl", "ÄÖÜ äöü ß", "a\\tb", "123",
            "i.j,k;", "@#%&", "Qq", "mm"]

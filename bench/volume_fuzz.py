@@ -29,13 +29,8 @@ import random
 import subprocess
 import sys
 
+from fuzz_tools import PIC, SCAD_MJS, meshcheck
 from scad_fuzz import model
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
-SHARED = os.path.join(HERE, "..", "..", "shared", "tools")
-MESHCHECK = os.environ.get("MESHCHECK", os.path.join(SHARED, "build", "meshcheck"))
-SCAD_MJS = os.path.join(SHARED, "manifold", "scad.mjs")
 LIMIT_CELLS = 1.5
 OPERATIONS = ["shell", "shell_outward", "thicken", "round_convex", "round_concave"]
 
@@ -47,10 +42,6 @@ class Report(Exception):
 class Skip(Exception):
     """No verdict: the case cannot be measured (the render, an operation that leaves nothing)."""
 
-
-def meshcheck(path):
-    p = subprocess.run([MESHCHECK, path], capture_output=True, text=True, timeout=600)
-    return json.loads(p.stdout) if p.returncode == 0 and p.stdout.strip() else None
 
 
 def valid(path, what):
