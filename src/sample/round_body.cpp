@@ -380,13 +380,16 @@ const RoundSum::Zone& RoundSum::zone(uint32_t t, int k) const {
 std::vector<uint32_t> RoundSum::flat_neighbours(const TriMesh& surface) {
   std::vector<uint32_t> across(3 * surface.triangles.size(), kNoTriangle);
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> side;  // directed side -> 3 t + k
-  for (uint32_t t = 0; t < surface.triangles.size(); ++t)
+  std::vector<Vec3> normal(surface.triangles.size());
+  for (uint32_t t = 0; t < surface.triangles.size(); ++t) {
+    normal[t] = area_normal(surface, t);
     for (int k = 0; k < 3; ++k) side.emplace(std::pair{surface.triangles[t][k], surface.triangles[t][(k + 1) % 3]}, 3 * t + k);
+  }
   for (uint32_t t = 0; t < surface.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const auto it = side.find({surface.triangles[t][(k + 1) % 3], surface.triangles[t][k]});
       if (it == side.end()) continue;
-      const Vec3 n = area_normal(surface, t), m = area_normal(surface, it->second / 3);
+      const Vec3 &n = normal[t], &m = normal[it->second / 3];
       const double nn = norm3(n), mm = norm3(m);
       // Coplanar: the two share the side's line, so parallel normals make one plane.
       if (nn > 0 && mm > 0 && dot3(n, m) >= (1 - kSamePlaneCosine) * nn * mm) across[3 * t + k] = it->second / 3;
