@@ -2,6 +2,7 @@
 import json
 import os
 import subprocess
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PIC = os.environ.get("PIC", os.path.join(HERE, "..", "build", "pic"))
@@ -19,3 +20,12 @@ def meshcheck(path, exact=True):
         return json.loads(p.stdout) if p.returncode == 0 and p.stdout.strip() else None
     except (subprocess.SubprocessError, ValueError, OSError):
         return None
+
+
+def arguments(usage, depth, out):
+    """FIRST_SEED COUNT [DEPTH] [OUTDIR] from the command line, with these defaults; `usage`
+    (the script's docstring) and exit without the first two."""
+    if len(sys.argv) < 3:
+        sys.exit(usage)
+    return (int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]) if len(sys.argv) > 3 else depth,
+            sys.argv[4] if len(sys.argv) > 4 else out)

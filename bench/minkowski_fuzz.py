@@ -19,9 +19,8 @@ import json
 import os
 import random
 import subprocess
-import sys
 
-from fuzz_tools import PIC, SCAD_MJS, meshcheck
+from fuzz_tools import PIC, SCAD_MJS, arguments, meshcheck
 from scad_fuzz import model
 
 
@@ -77,11 +76,7 @@ def run_case(seed, depth, outdir):
 
 
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    first, count = int(sys.argv[1]), int(sys.argv[2])
-    depth = int(sys.argv[3]) if len(sys.argv) > 3 else 9
-    outdir = sys.argv[4] if len(sys.argv) > 4 else "/tmp/pic_minkowski_fuzz"
+    first, count, depth, outdir = arguments(__doc__, 9, "/tmp/pic_minkowski_fuzz")
     reported = 0
     for seed in range(first, first + count):
         line = run_case(seed, depth, outdir)

@@ -23,7 +23,7 @@ import random
 import subprocess
 import sys
 
-from fuzz_tools import PIC, meshcheck
+from fuzz_tools import PIC, arguments, meshcheck
 from scad_fuzz import model
 
 LIMIT_CELLS = 1.5
@@ -87,10 +87,7 @@ def run_case(seed, depth, out):
 
 
 def main():
-    first = int(sys.argv[1])
-    count = int(sys.argv[2])
-    depth = int(sys.argv[3]) if len(sys.argv) > 3 else 9
-    out = sys.argv[4] if len(sys.argv) > 4 else "/tmp/pic_offset_fuzz"
+    first, count, depth, out = arguments(__doc__, 9, "/tmp/pic_offset_fuzz")
     reported = 0
     for seed in range(first, first + count):
         ok, text = run_case(seed, depth, out)

@@ -18,11 +18,10 @@ import json
 import os
 import random
 import subprocess
-import sys
 
 from scad_semantics_fuzz import volume as mesh_volume  # meshcheck's volume of a mesh file
 
-from fuzz_tools import PIC
+from fuzz_tools import PIC, arguments
 
 
 def primitive(r):
@@ -79,11 +78,7 @@ def run_case(seed, depth, out):
 
 
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    first, count = int(sys.argv[1]), int(sys.argv[2])
-    depth = int(sys.argv[3]) if len(sys.argv) > 3 else 10
-    out = sys.argv[4] if len(sys.argv) > 4 else "/tmp/pic_scad_fuzz"
+    first, count, depth, out = arguments(__doc__, 10, "/tmp/pic_scad_fuzz")
     reported = 0
     for seed in range(first, first + count):
         why = run_case(seed, depth, out)

@@ -23,9 +23,8 @@ import json
 import os
 import random
 import subprocess
-import sys
 
-from fuzz_tools import MESHCHECK, PIC
+from fuzz_tools import MESHCHECK, PIC, arguments
 
 
 def num(r, lo, hi):
@@ -156,11 +155,7 @@ def pic_volume(csg, out, depth):
 
 
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    first, count = int(sys.argv[1]), int(sys.argv[2])
-    depth = int(sys.argv[3]) if len(sys.argv) > 3 else 9
-    outdir = sys.argv[4] if len(sys.argv) > 4 else "/tmp/pic_scad_semantics"
+    first, count, depth, outdir = arguments(__doc__, 9, "/tmp/pic_scad_semantics")
     reported = 0
     for seed in range(first, first + count):
         d = os.path.join(outdir, str(seed))

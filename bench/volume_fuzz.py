@@ -29,7 +29,7 @@ import random
 import subprocess
 import sys
 
-from fuzz_tools import PIC, SCAD_MJS, meshcheck
+from fuzz_tools import PIC, SCAD_MJS, arguments, meshcheck
 from scad_fuzz import model
 LIMIT_CELLS = 1.5
 OPERATIONS = ["shell", "shell_outward", "thicken", "round_convex", "round_concave"]
@@ -167,11 +167,7 @@ def run_case(seed, depth, out):
 
 
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    first, count = int(sys.argv[1]), int(sys.argv[2])
-    depth = int(sys.argv[3]) if len(sys.argv) > 3 else 9
-    out = sys.argv[4] if len(sys.argv) > 4 else "/tmp/pic_volume_fuzz"
+    first, count, depth, out = arguments(__doc__, 9, "/tmp/pic_volume_fuzz")
     reported = 0
     for seed in range(first, first + count):
         try:
