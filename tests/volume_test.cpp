@@ -492,6 +492,30 @@ TEST(Offset, TheOffsetDistanceSeesAMissingPart) {
               own.back_worst / cell);
 }
 
+TEST(Offset, TheOffsetDistanceIsNotFooledByAFoldedSliver) {
+  // A unit cube whose top is a fan around a vertex just past its edge x = 1 (as rounding to
+  // floats folds a sliver over): the fan's triangle on that edge faces down, into the cube.
+  // Points 0.1 above it lie on the exact offset by 0.1; the nearest face's normal alone would
+  // put them inside, 0.2 from it.
+  const double e = 1e-4, h = 0.1;
+  TriMesh cube;
+  cube.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, {1 + e, 0.5, 1}};
+  cube.triangles = {{0, 2, 1}, {0, 3, 2}, {0, 1, 5}, {0, 5, 4}, {1, 2, 6}, {1, 6, 5}, {2, 3, 7},
+                    {2, 7, 6}, {3, 0, 4}, {3, 4, 7}, {4, 5, 8}, {5, 6, 8}, {6, 7, 8}, {7, 4, 8}};
+  ASSERT_FALSE(self_intersecting_pairs(cube).empty());
+  TriMesh above;
+  const double x = 1 + e / 2;
+  above.positions = {{x - e / 8, 0.5 - e / 8, 1 + h}, {x + e / 8, 0.5 - e / 8, 1 + h}, {x, 0.5 + e / 8, 1 + h}};
+  above.triangles = {{0, 1, 2}};
+  const OffsetDistance d = offset_distance(above, cube, h, 100);
+  EXPECT_LT(d.worst, 1e-9);
+  // The way back: every point of the exact offset lies outside the cube, at distance h.
+  for (const Vec3& p : offset_surface_points(cube, h, 2000)) {
+    const bool inside = p[0] > 0 && p[0] < 1 && p[1] > 0 && p[1] < 1 && p[2] > 0 && p[2] < 1;
+    EXPECT_FALSE(inside) << p[0] << " " << p[1] << " " << p[2];
+  }
+}
+
 // A leaf may stand only for the surface its corners, crossings and polygons account for: in
 // each case below a coarse cell's data alone fit a wrong surface, which would still contour to
 // a valid solid, the wrong part as wide as that cell at any depth.

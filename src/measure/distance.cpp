@@ -12,6 +12,7 @@
 #include "geometry/mesh_distance.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
+#include "geometry/winding.h"
 #include "pic/measure.h"
 #include "pic/types.h"
 
@@ -178,9 +179,68 @@ std::vector<Sweep> offset_sweeps(const TriMesh& m, double r) {
   return sweeps;
 }
 
-}  // namespace
+/// Signed distances to a closed, consistently oriented mesh. The nearest feature's
+/// pseudonormal gives the side, exactly where the mesh around that feature is embedded; beside
+/// a triangle that crosses another (a sliver folded over by rounding to floats, overlapping
+/// shells) or has no area, that normal can point into the solid, and the side is taken from
+/// the winding number instead (inside where it is 1/2 or more).
+class SidedDistance {
+ public:
+  explicit SidedDistance(const TriMesh& mesh) : mesh_(mesh), sd_(mesh), suspect_(mesh.positions.size(), 0) {
+    auto mark = [&](uint32_t f) {
+      for (uint32_t v : mesh.triangles[f]) suspect_[v] = 1;
+    };
+    for (const auto& [i, j] : self_intersecting_pairs(mesh)) mark(i), mark(j);
+    for (uint32_t f = 0; f < mesh.triangles.size(); ++f) {
+      const auto& t = mesh.triangles[f];
+      const Vec3 n = cross3(sub3(mesh.positions[t[1]], mesh.positions[t[0]]), sub3(mesh.positions[t[2]], mesh.positions[t[0]]));
+      if (n[0] == 0 && n[1] == 0 && n[2] == 0) mark(f);
+    }
+  }
+  /// The distance with its pseudonormal's sign, and whether that sign needs the winding number.
+  double pseudonormal(const Vec3& p, bool& doubtful) const {
+    Vec3 g;
+    detail::Nearest n;
+    const double d = sd_.with_gradient(p, g, nullptr, nullptr, &n);
+    const auto& t = mesh_.triangles[n.triangle];
+    doubtful = suspect_[t[0]] || suspect_[t[1]] || suspect_[t[2]];
+    return d;
+  }
+  /// The distance signed by the winding number (every triangle: for the doubtful points only).
+  double by_winding(const Vec3& p, double d) const {
+    double w = 0;
+    for (const auto& t : mesh_.triangles)
+      w += detail::triangle_winding(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
+    return w >= 0.5 ? -std::abs(d) : std::abs(d);
+  }
+  /// Signed distances at `pts`; \throws InvalidInput when so many points lie beside crossing
+  /// triangles that their winding numbers would take minutes.
+  std::vector<double> operator()(const std::vector<Vec3>& pts) const {
+    std::vector<double> d(pts.size());
+    std::vector<char> doubtful(pts.size(), 0);
+    tbb::parallel_for(size_t{0}, pts.size(), [&](size_t i) {
+      bool x = false;
+      d[i] = pseudonormal(pts[i], x);
+      doubtful[i] = x;
+    });
+    const size_t n = size_t(std::count(doubtful.begin(), doubtful.end(), 1));
+    if (double(n) * double(mesh_.triangles.size()) > 2e9)
+      throw InvalidInput("the offset's reference crosses itself beside " + std::to_string(n) +
+                         " of the points measured: too many to decide their side by the winding number");
+    tbb::parallel_for(size_t{0}, pts.size(), [&](size_t i) {
+      if (doubtful[i]) d[i] = by_winding(pts[i], d[i]);
+    });
+    return d;
+  }
 
-std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset, size_t samples, uint64_t seed) {
+ private:
+  const TriMesh& mesh_;
+  detail::SignedDistance sd_;
+  std::vector<char> suspect_;  // per vertex: of a crossing or zero-area triangle
+};
+
+std::vector<Vec3> offset_points(const TriMesh& reference, const SidedDistance& sided, double offset, size_t samples,
+                                uint64_t seed) {
   const double r = std::abs(offset), side = offset < 0 ? -1 : 1;
   const std::vector<Sweep> sweeps = offset_sweeps(reference, r);
   std::vector<double> cum(sweeps.size());
@@ -219,24 +279,29 @@ std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset,
   }
   // Kept where the mesh is nowhere nearer than r (else the point lies inside the offset's
   // other parts, or on the wrong side of a concave crease or corner).
-  const std::vector<double> d = distance_to_mesh(reference, candidates);
+  // On the offset's side too: a face whose normal points into the solid (a folded sliver)
+  // moves its points inside.
+  const std::vector<double> d = sided(candidates);
   std::vector<Vec3> kept;
   for (size_t i = 0; i < candidates.size(); ++i)
-    if (d[i] >= r * (1 - 1e-9)) kept.push_back(candidates[i]);
+    if (side * d[i] >= r * (1 - 1e-9)) kept.push_back(candidates[i]);
   return kept;
+}
+
+}  // namespace
+
+std::vector<Vec3> offset_surface_points(const TriMesh& reference, double offset, size_t samples, uint64_t seed) {
+  return offset_points(reference, SidedDistance(reference), offset, samples, seed);
 }
 
 OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference, double offset, size_t samples) {
   const MeshTopology t = analyze_topology(reference);
   if (!t.closed() || !t.manifold() || t.inconsistent_edges != 0)
     throw InvalidInput("the offset's reference must be closed, 2-manifold and consistently oriented");
-  const detail::SignedDistance sd(reference);
+  const SidedDistance sided(reference);
   const std::vector<Vec3> pts = sample_surface(surface, samples, 12345);
-  std::vector<double> d(pts.size());
-  tbb::parallel_for(size_t{0}, pts.size(), size_t{4096}, [&](size_t begin) {
-    const size_t end = std::min(pts.size(), begin + 4096);
-    for (size_t i = begin; i < end; ++i) d[i] = std::abs(sd(pts[i]) - offset);
-  });
+  std::vector<double> d = sided(pts);
+  for (double& x : d) x = std::abs(x - offset);
   OffsetDistance r;
   for (size_t i = 0; i < d.size(); ++i) {
     if (d[i] > r.worst) r.worst = d[i], r.where = pts[i];
@@ -244,7 +309,7 @@ OffsetDistance offset_distance(const TriMesh& surface, const TriMesh& reference,
     r.mean += d[i];
   }
   if (!d.empty()) r.mean /= double(d.size());
-  const std::vector<Vec3> back = offset_surface_points(reference, offset, std::max<size_t>(samples, 1000));
+  const std::vector<Vec3> back = offset_points(reference, sided, offset, std::max<size_t>(samples, 1000), 777);
   worst_and_mean(distance_to_mesh(surface, back), back, r.back_worst, r.back_mean, r.back_where);
   r.back_points = back.size();
   return r;
