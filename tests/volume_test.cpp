@@ -385,6 +385,35 @@ TEST(Offset, VolumeMeshVerticesLieOnTheExactOffset) {
               plain.worst_vertex / cell, offset_distance(vm.mesh, spot, d, 0).mean / cell, plain.mean / cell);
 }
 
+TEST(Offset, ACreaseThroughLatticePointsIsKept) {
+  // A square prism turned 45 degrees about x, its end caps in lattice planes and its long
+  // edges on lattice lines: each cap's creases with the slanted sides run diagonally through
+  // lattice points. Where a side between two vertices on such a crease meets a cell face only
+  // at the face's corner, the face point it needs must stay on the crease: put where the
+  // surface around crosses the face, it lay on a slanted side, and the triangles from it cut
+  // the crease by up to two finest cells.
+  TriMesh prism;
+  for (const double x : {-4.0, -2.0})
+    for (const auto& [y, z] : std::array<std::array<double, 2>, 4>{{{4, 3}, {-2, 9}, {-8, 3}, {-2, -3}}})
+      prism.positions.push_back({x, y, z});
+  prism.triangles = {{0, 3, 2}, {0, 2, 1}, {4, 5, 6}, {4, 6, 7}};
+  for (uint32_t i = 0; i < 4; ++i) {
+    const uint32_t j = (i + 1) % 4;
+    prism.triangles.push_back({i, j, 4 + j});
+    prism.triangles.push_back({i, 4 + j, 4 + i});
+  }
+  ASSERT_NEAR(volume(prism), 144, 1e-9);
+  SampleOptions o = at_depth(9);
+  o.cube = Cube{{-14.25, -18, -13.25}, 32};
+  VolumeMesh vm;
+  const Octree t = offset(prism, 0, o, nullptr, &vm);
+  const double cell = finest_cell(t);
+  expect_valid(vm.mesh);
+  const OffsetDistance d = offset_distance(vm.mesh, prism, 0, 20000);
+  std::printf("  [measure] two-sided distance %.3f / %.3f finest cells\n", d.worst / cell, d.back_worst / cell);
+  EXPECT_LE(d.hausdorff(), 0.25 * cell);
+}
+
 TEST(Offset, EveryVertexWithinAQuarterCellOfTheExactOffset) {
   // spot grown by 0.05 at depth 10. Beside a concave ridge of the distance (where the grown
   // surface folds) f crosses a coarse leaf's edge twice between its corners: the finer leaves

@@ -87,6 +87,19 @@ bool crosses_inside(const Face& face, const Vec3& xa, const Vec3& xb, Vec3& q, d
   return inside;
 }
 
+// Whether q (in the face's plane) lies on the face's border: within `inset` plus a rounding
+// error of the vertices (stored to about 1e-7 of their cell) of the closed face, not inside it.
+bool on_border(const Face& face, const Vec3& q, double inset) {
+  bool within = true, inside = true;
+  for (int d = 0; d < 3; ++d) {
+    if (d == face.axis) continue;
+    const double tol = inset + (face.hi[d] - face.lo[d]) * 1e-6;
+    within = within && q[d] >= face.lo[d] - tol && q[d] <= face.hi[d] + tol;
+    inside = inside && q[d] > face.lo[d] + tol && q[d] < face.hi[d] - tol;
+  }
+  return within && !inside;
+}
+
 // The point of the face (`margin` inside its border) nearest where the plain split of the
 // polygons `near` (but those with vertex `skip`) crosses the face's plane; among points where
 // it crosses the face itself, the one nearest q. Candidates better than (best_off, best_q)
@@ -615,6 +628,16 @@ std::vector<Tri> triangulate(std::vector<Vec3>& x, const std::vector<VertexCell>
     Vec3 q;
     crosses_inside(face, x[a], x[b], q);
     Vec3 f = q;
+    if (on_border(face, q, inset)) {
+      // The side itself passes through the face's border (a crease through a lattice point
+      // or along a lattice line, both its vertices on it): its own crossing, just inside,
+      // keeps the polygons on the crease, where the plain surface would cut across it.
+      for (int d = 0; d < 3; ++d)
+        if (d != face.axis) f[d] = std::clamp(q[d], face.lo[d] + inset, face.hi[d] - inset);
+      if (level) onto_level_in_face(level, face, inset, f);
+      face_x[j] = f;
+      return;
+    }
     double off = std::numeric_limits<double>::infinity(), dq = off;
     for (const uint32_t v : {a, b}) {  // polygons around a, then those around b only
       const auto [list, count] = surface.near(v);
