@@ -53,6 +53,11 @@ inline constexpr double kInsideCellSlack = 1e-9;
 /// How much more than the QEF's minimum a tip corner's error may be, in cell sizes squared.
 inline constexpr double kTipTolerance = 1e-12;
 
+/// A feature thinner than a capped cell is kept when the faces an edge crosses it through turn
+/// by more than about 162 degrees (their normals' cosine below minus this): a wall, or a wedge
+/// under 18 degrees, which dropped would be cut back by three cells or more.
+inline constexpr double kThinFeatureTurn = 0.95;
+
 // ---- contour/ ------------------------------------------------------------------------------
 
 /// Two cells whose gap along an axis is below this (relative to their half sizes) touch along

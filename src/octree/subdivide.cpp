@@ -99,6 +99,43 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
 
 constexpr uint8_t kAll = 0xff;
 
+/// A capped cell can hold a feature of one sign passing between two corners of the other (its
+/// edge crossing the surface twice). Where the feature is thin — the edge crosses it through faces
+/// that turn by more than kThinFeatureTurn (a wall, a blade, a wedge under 18 degrees; a slot, a
+/// crevice) — dropping it would cut it back by h / tan(angle), a whole wall's width: both ends
+/// of each such edge are asked to take the feature's sign, a row of lattice points two deep
+/// along it, which every cell across holds as one component. The feature stays, up to a cell
+/// thicker. A wider wedge is cut back by at most about three cells (a box's edge by less than
+/// one) and is left as is, unless it lies beside a thin feature (two thin walls at an angle).
+void record_thin_feature(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
+                         uint8_t written, EdgeCountMemo* memo, ThinFeaturePoints& thin) {
+  const I3 lo = lattice_to_grid(cell.lat);
+  const int64_t s = lattice_to_grid(cell.span());
+  std::vector<std::pair<std::array<int64_t, 3>, bool>> found, beside;
+  std::vector<Vec3> normals;
+  for (int e = 0; e < 12; ++e) {
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const bool end_sign = (written >> c0) & 1;
+    if (end_sign != bool((written >> c1) & 1)) continue;
+    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
+    if (edge_crossings(tris, idx, a, axis, s, memo) < 2) continue;
+    normals.clear();
+    for (uint32_t k : idx)
+      if (crosses(tris[k], a, axis, s)) normals.push_back(tris[k].unit_normal);
+    bool thin_here = false;
+    for (size_t i = 0; i < normals.size() && !thin_here; ++i)
+      for (size_t j = i + 1; j < normals.size() && !thin_here; ++j)
+        thin_here = dot3(normals[i], normals[j]) < -kThinFeatureTurn;
+    auto& to = thin_here ? found : beside;
+    to.push_back({cell.corner(c0), !end_sign});
+    to.push_back({cell.corner(c1), !end_sign});
+  }
+  if (found.empty() && beside.empty()) return;
+  const std::lock_guard<std::mutex> hold(thin.lock);
+  thin.points.insert(thin.points.end(), found.begin(), found.end());
+  thin.beside.insert(thin.beside.end(), beside.begin(), beside.end());
+}
+
 }  // namespace
 
 void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& cell, uint8_t signs,
@@ -121,7 +158,10 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
     const bool meets = src.surface_matters(cell, signs, wind, idx) ||
                        (!at_cap && has_double_crossing(src.tris(), idx, cell, signs, p.edge_memo));
     if (!meets || at_cap) {
-      if (meets) ++capped;  // a feature thinner than the deepest cell is dropped
+      if (meets) {
+        ++capped;
+        if (p.thin) record_thin_feature(src.tris(), idx, cell, written, p.edge_memo, *p.thin);
+      }
       out.set_uniform(slot, (written & 1) != 0);
       return;
     }
@@ -140,6 +180,7 @@ void sample_cell(const SurfaceSource& src, const SampleParams& p, const Cell& ce
                     !has_double_crossing(src.tris(), idx, cell, signs, p.edge_memo);
     if (ok || at_cap) {
       if (!ok) ++capped;
+      if (!ok && p.thin) record_thin_feature(src.tris(), idx, cell, written, p.edge_memo, *p.thin);
       out.set_gray(slot, cell, written, sol.position, ok ? 0 : kFlagCapped);
       return;
     }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "geometry/clip.h"
@@ -88,6 +89,16 @@ struct EdgeCount {
 };
 using EdgeCountMemo = ThreadMemo<EdgeCount, 13>;
 
+/// Lattice points that capped cells ask to take the other sign (see sample_cell): both ends
+/// of every edge of theirs that a feature thinner than the cell crosses twice.
+struct ThinFeaturePoints {
+  std::mutex lock;
+  std::vector<std::pair<std::array<int64_t, 3>, bool>> points;  // point, inside
+  /// Ends of edges whose faces turn by less (a wedge's edge, or where two thin walls meet):
+  /// kept only next to a thin feature's point of the same sign.
+  std::vector<std::pair<std::array<int64_t, 3>, bool>> beside;
+};
+
 struct SampleParams {
   int max_depth = 12;
   double error = kDefaultQefError;
@@ -107,6 +118,8 @@ struct SampleParams {
   /// vertex beside its minority corners (split, its child grid would disagree with its
   /// neighbours: no crossing inside explains its corners' signs).
   bool partial_contour = false;
+  /// Set: capped cells whose corners miss a feature thinner than a cell record it here.
+  ThinFeaturePoints* thin = nullptr;
 };
 
 

@@ -1,12 +1,14 @@
 // Sampling (paper section 4): the public entry points. A clean closed mesh runs the sampler
 // kernel (octree/subdivide.h) over crossing parity; any other mesh over its winding number, a point
 // cloud over the points' winding number (sources.h); both then settle their signs (signs/).
+#include "octree/point_signs.h"
 #include "octree/subdivide.h"
 
 #include "sample/sources.h"
 #include "mesh/clean.h"
 #include "signs/invariants.h"
 #include "signs/settle.h"
+#include "geometry/bvh.h"
 #include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
 #include "geometry/vec3.h"
@@ -17,6 +19,9 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <mutex>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace pic {
 
@@ -122,11 +127,36 @@ SampleParams params_of(const SampleOptions& options, EdgeCountMemo& memo) {
 
 /// A leaf of a sampled tree sampled again from the input, split down to the finest level
 /// around lattice point p (refine_around); `winding`: the source when it carries winding numbers.
+/// The input's triangles in a box tree, built when a leaf is first resampled (most samplings
+/// resample none); safe to ask from several threads.
+class LazyTriangleTree {
+ public:
+  explicit LazyTriangleTree(const std::vector<ITri>& tris) : tris_(tris) {}
+  /// The triangles meeting `box`, in input order.
+  void meeting(const IBox& box, std::vector<uint32_t>& idx) const {
+    std::call_once(built_, [&] { tree_.build(tris_); });
+    std::vector<uint32_t> near;
+    tree_.query(tris_, box.lo, box.hi, near);
+    std::sort(near.begin(), near.end());
+    filter_box(tris_, near, box, idx);
+  }
+
+ private:
+  const std::vector<ITri>& tris_;
+  mutable std::once_flag built_;
+  mutable TriangleBvh tree_;
+};
+
 Builder resample_from_input(const SurfaceSource& src, const WindingSource* winding, const Octree& t,
-                            const LeafRef& leaf, const Lat& p, double error) {
-  std::vector<uint32_t> all(src.tris().size()), idx;
-  for (uint32_t k = 0; k < all.size(); ++k) all[k] = k;
-  filter_box(src.tris(), all, leaf.cell.box(), idx);
+                            const LeafRef& leaf, const Lat& p, double error, const LazyTriangleTree* near = nullptr) {
+  std::vector<uint32_t> idx;
+  if (near) {
+    near->meeting(leaf.cell.box(), idx);
+  } else {
+    std::vector<uint32_t> all(src.tris().size());
+    for (uint32_t k = 0; k < all.size(); ++k) all[k] = k;
+    filter_box(src.tris(), all, leaf.cell.box(), idx);
+  }
   SampleParams params;
   params.max_depth = t.max_depth;
   params.error = error;
@@ -144,19 +174,65 @@ Builder resample_from_input(const SurfaceSource& src, const WindingSource* windi
 
 /// Runs the sampler from the root and assembles the tree.
 Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const Cube& cube, uint8_t root_signs,
-                   const Wind8* root_wind, size_t& capped) {
+                   const Wind8* root_wind, size_t& capped, ThinFeaturePoints* thin = nullptr) {
   std::vector<uint32_t> idx(src.tris().size());
   for (uint32_t k = 0; k < idx.size(); ++k) idx[k] = k;
   Builder b;
   b.nodes.resize(1);
   EdgeCountMemo memo;
-  sample_cell(src, params_of(options, memo), Cell{}, root_signs, idx, b, 0, capped, root_wind);
+  SampleParams params = params_of(options, memo);
+  params.thin = thin;
+  sample_cell(src, params, Cell{}, root_signs, idx, b, 0, capped, root_wind);
   Octree tree;
   tree.cube = cube;
   tree.max_depth = options.depth;
   tree.nodes = std::move(b.nodes);
   tree.vertices = std::move(b.vertices);
   return tree;
+}
+
+/// Gives the lattice points that capped cells asked for (ThinFeaturePoints) their sign, the
+/// coarser leaves around them split first. A point asked both ways (a thin wall beside a thin
+/// slot) keeps its own.
+void keep_thin_features(Octree& tree, ThinFeaturePoints& thin, const ResampleLeaf& resample, bool parallel) {
+  auto& asked = thin.points;
+  if (asked.empty()) return;
+  // Points beside the thin features' own (finest-lattice neighbours, the same sign) join them,
+  // and then their neighbours, along the junction of two thin walls.
+  const auto key = [](const Lat& p, bool inside) { return lattice_key(p) * 2 + uint64_t(inside); };
+  std::unordered_set<uint64_t> kept;
+  for (const auto& [p, inside] : asked) kept.insert(key(p, inside));
+  std::unordered_map<uint64_t, Lat> waiting;
+  for (const auto& [p, inside] : thin.beside)
+    if (!kept.count(key(p, inside))) waiting.emplace(key(p, inside), p);
+  const int64_t step = int64_t{1} << (kMaxLevel - tree.max_depth);
+  std::vector<std::pair<Lat, bool>> work(asked.begin(), asked.end());
+  while (!work.empty() && !waiting.empty()) {
+    const auto [p, inside] = work.back();
+    work.pop_back();
+    for (int a = 0; a < 3; ++a)
+      for (const int64_t d : {-step, step}) {
+        Lat q = p;
+        q[a] += d;
+        const auto it = waiting.find(key(q, inside));
+        if (it == waiting.end()) continue;
+        asked.push_back({q, inside});
+        work.push_back({q, inside});
+        waiting.erase(it);
+      }
+  }
+  std::sort(asked.begin(), asked.end());
+  asked.erase(std::unique(asked.begin(), asked.end()), asked.end());
+  std::vector<std::pair<Lat, bool>> set;
+  for (size_t i = 0; i < asked.size(); ++i) {
+    const bool both = (i + 1 < asked.size() && asked[i + 1].first == asked[i].first) ||
+                      (i > 0 && asked[i - 1].first == asked[i].first);
+    if (!both) set.push_back(asked[i]);
+  }
+  std::vector<Lat> points(set.size());
+  for (size_t i = 0; i < set.size(); ++i) points[i] = set[i].first;
+  refine_all_around(tree, points, resample, parallel);
+  for (const auto& [p, inside] : set) set_point_sign(tree, p, inside, nullptr);
 }
 
 Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const SampleOptions& options,
@@ -172,7 +248,8 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
   uint8_t signs = 0;
   for (int c = 0; c < 8; ++c)
     signs |= uint8_t(src.inside(lattice_to_grid(Cell{}.corner(c)), 0)) << c;
-  Octree tree = sample_tree(src, options, cube, signs, &root_wind, capped);
+  ThinFeaturePoints thin;
+  Octree tree = sample_tree(src, options, cube, signs, &root_wind, capped, &thin);
   // Islands and cracks come from the caps' decisions and from uniform cells whose triangles
   // showed no sign change (the sampler's only departures from crossing parity): settle there,
   // with room for the leaves around them.
@@ -182,9 +259,17 @@ Octree sample_winding(const CleanMesh& clean, const std::vector<I3>& grid, const
     const double s = c.size();
     region.boxes.push_back({{lo[0] - s, lo[1] - s, lo[2] - s}, {lo[0] + 2 * s, lo[1] + 2 * s, lo[2] + 2 * s}});
   }
+  const LazyTriangleTree near(src.tris());
   const ResampleLeaf from_input = [&](const LeafRef& l, const Lat& p) {
-    return resample_from_input(src, &src, tree, l, p, options.error);
+    return resample_from_input(src, &src, tree, l, p, options.error, &near);
   };
+  keep_thin_features(tree, thin, from_input, options.parallel);
+  // Their flips make islands and components like the caps': settle around them too.
+  constexpr double kUnit = 1.0 / double(int64_t{1} << kMaxLevel);
+  for (const auto& [p, inside] : thin.points) {
+    const Vec3 u{double(p[0]) * kUnit, double(p[1]) * kUnit, double(p[2]) * kUnit};
+    region.boxes.push_back({{u[0] - 2 * cell, u[1] - 2 * cell, u[2] - 2 * cell}, {u[0] + 2 * cell, u[1] + 2 * cell, u[2] + 2 * cell}});
+  }
   settle_sampled(tree, region, &from_input);
   if (tree.vertices.empty())
     throw InvalidInput("mesh encloses no solid: its winding number never reaches 1/2 (an open sheet or stray triangles?)");
@@ -232,12 +317,15 @@ Octree sample(const TriMesh& mesh, const SampleOptions& options, SampleStats* st
     const std::vector<ITri> tris = grid_triangles(clean.mesh.triangles, grid);
     // Root corners are outside: the mesh lies strictly inside the cube.
     const MeshSource src(tris);
-    tree = sample_tree(src, options, cube, 0, nullptr, capped);
+    ThinFeaturePoints thin;
+    tree = sample_tree(src, options, cube, 0, nullptr, capped, &thin);
     // Leaves at the depth cap may hold two components; make each hold one, splitting coarser
     // leaves at the corners that change sign first.
+    const LazyTriangleTree near(tris);
     const ResampleLeaf from_input = [&](const LeafRef& l, const Lat& p) {
-      return resample_from_input(src, nullptr, tree, l, p, options.error);
+      return resample_from_input(src, nullptr, tree, l, p, options.error, &near);
     };
+    keep_thin_features(tree, thin, from_input, options.parallel);
     const std::function<void(const Lat&)> refine = [&](const Lat& p) {
       refine_around(tree, p, from_input, [](uint32_t) {});
     };
