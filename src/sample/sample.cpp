@@ -125,8 +125,6 @@ SampleParams params_of(const SampleOptions& options, EdgeCountMemo& memo) {
   return p;
 }
 
-/// A leaf of a sampled tree sampled again from the input, split down to the finest level
-/// around lattice point p (refine_around); `winding`: the source when it carries winding numbers.
 /// The input's triangles in a box tree, built when a leaf is first resampled (most samplings
 /// resample none); safe to ask from several threads.
 class LazyTriangleTree {
@@ -147,6 +145,9 @@ class LazyTriangleTree {
   mutable TriangleBvh tree_;
 };
 
+/// A leaf of a sampled tree sampled again from the input, split down to the finest level
+/// around lattice point p (refine_around); `winding`: the source when it carries winding numbers;
+/// `near`: its triangles in a box tree (null: every triangle is tested against the leaf).
 Builder resample_from_input(const SurfaceSource& src, const WindingSource* winding, const Octree& t,
                             const LeafRef& leaf, const Lat& p, double error, const LazyTriangleTree* near = nullptr) {
   std::vector<uint32_t> idx;
