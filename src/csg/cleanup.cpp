@@ -4,6 +4,7 @@
 #include "csg/refine.h"
 #include "signs/refine.h"
 #include "signs/settle.h"
+#include "signs/thin_features.h"
 
 namespace pic::detail {
 namespace {
@@ -122,11 +123,34 @@ HintedFlip examine_hint(const Octree& t, const SignHint& h, const std::function<
 void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::function<bool(uint32_t)>& stamped,
                       PinnedPoints& pinned, const std::function<void(const Lat&)>& refine) {
   for (const SignHint& h : hints) {
+    if (h.kind != SignHint::Kind::Join) continue;
     const HintedFlip f = examine_hint(t, h, stamped);
     if (!f.possible || !f.needed || f.after >= f.before) continue;
     refine(h.point);
     set_point_sign(t, h.point, h.inside, nullptr);
     pinned.insert(lattice_key(h.point));
+  }
+}
+
+/// Gives the lattice points that capped cells found across a thin feature (thin_feature_hints,
+/// joined by thin_feature_signs) the feature's sign, the coarser leaves around them split
+/// first. The leaves that change are flagged capped: their vertices stand for a feature
+/// thinner than the cell, not for its exact surface. The points are pinned, as the other
+/// hints' are.
+void keep_thin_features(Octree& t, const std::vector<SignHint>& hints, PinnedPoints& pinned,
+                        const std::function<void(const Lat&)>& refine, const std::function<void(uint32_t)>& touched) {
+  std::vector<AskedSign> asked, beside;
+  for (const SignHint& h : hints) {
+    if (h.kind == SignHint::Kind::Thin) asked.push_back({h.point, h.inside});
+    if (h.kind == SignHint::Kind::BesideThin) beside.push_back({h.point, h.inside});
+  }
+  if (asked.empty()) return;
+  for (const auto& [p, inside] : thin_feature_signs(asked, beside, int64_t{1} << (kMaxLevel - t.max_depth))) {
+    refine(p);
+    set_point_sign(t, p, inside, &touched);
+    for (const auto& l : leaves_around(t, p))
+      if (t.nodes[l.node].kind == CellKind::Gray) t.nodes[l.node].flags |= kFlagCapped;
+    pinned.insert(lattice_key(p));
   }
 }
 
@@ -148,6 +172,7 @@ void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::ve
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
+  keep_thin_features(a, hints, pinned, refine, stamp_it);
   apply_sign_hints(a, hints, stamped, pinned, refine);
   SettlePlan plan;
   plan.active = &stamped;

@@ -21,8 +21,13 @@ using Stamps = std::vector<uint32_t>;
 
 /// A lattice point whose sign the clean-up should set to `inside` (see sign_hint in csg.cpp).
 struct SignHint {
+  /// Join: a finest leaf's corners made one component (sign_hint). Thin: an end of a capped
+  /// edge across a feature thinner than a cell; BesideThin: an end of a capped edge crossed
+  /// twice through faces turning by less, kept only next to a Thin point (thin_feature_hints).
+  enum class Kind : uint8_t { Join, Thin, BesideThin };
   std::array<int64_t, 3> point;
   bool inside;
+  Kind kind = Kind::Join;
 };
 
 /// Clean-up of the leaves whose `stamps` entry is `stamp` after `a op b` was combined into `a`: crack

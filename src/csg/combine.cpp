@@ -375,6 +375,18 @@ class Combiner {
         if (const std::optional<Node> leaf = gray_leaf(cell, a, b, sr, ev, at_cap, pg)) return *leaf;
     }
     if (at_cap) {
+      if (!unresolved(a) && !unresolved(b)) {
+        // A feature thinner than the cell: the clean-up gives it lattice points; the leaves
+        // around them must be finest cells (a contact).
+        thin_.clear();
+        thin_feature_hints(op_, a_, a, b_, b, cell, sr, error_, thin_);
+        for (const SignHint& h : thin_)
+          if (h.kind == SignHint::Kind::Thin) {
+            out_.contact(cell);
+            break;
+          }
+        for (const SignHint& h : thin_) out_.hint(h);
+      }
       if (sr == 0 || sr == 0xff) return uniform(sr != 0);
       const CellQefs q = cell_qefs(a_, a, b_, b, cell);
       if (!one_component(sr)) {
@@ -437,6 +449,7 @@ class Combiner {
   const FocusCells* focus_;  // cells to split down to the finest level whatever they hold
   CombineCounts& stats_;
   std::vector<uint32_t> scratch_;
+  std::vector<SignHint> thin_;
 };
 
 }  // namespace

@@ -17,6 +17,15 @@ namespace pic::detail {
 /// clean-up to flip a corner of the other sign. Nothing when it joins neither.
 std::optional<SignHint> sign_hint(CsgOp op, Operand& xa, Operand& xb, const Cell& cell, uint8_t sr);
 
+/// A capped cell's edges whose ends agree in the result but which cross it twice, through
+/// faces turning by more than kThinFeatureTurn (a wall between A's face and B's, a blade, a
+/// slot thinner than the cell): both ends of each are hinted to the feature's sign, which
+/// keeps the feature about a cell thick where the plain signs would drop it. Edges crossed
+/// twice through faces turning by less give BesideThin hints (junctions of thin walls). Features
+/// narrower than the operands' own accuracy (sqrt of the QEF threshold `error`) are left out.
+void thin_feature_hints(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell,
+                        uint8_t sr, double error, std::vector<SignHint>& out);
+
 /// What the cell's edges say: whether either operand's surface is visible in the result
 /// there, and whether the cell must split.
 struct EdgeVerdict {

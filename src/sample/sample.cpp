@@ -8,6 +8,7 @@
 #include "mesh/clean.h"
 #include "signs/invariants.h"
 #include "signs/settle.h"
+#include "signs/thin_features.h"
 #include "geometry/bvh.h"
 #include "geometry/stopwatch.h"
 #include "geometry/tolerances.h"
@@ -196,40 +197,9 @@ Octree sample_tree(const SurfaceSource& src, const SampleOptions& options, const
 /// coarser leaves around them split first. A point asked both ways (a thin wall beside a thin
 /// slot) keeps its own.
 void keep_thin_features(Octree& tree, ThinFeaturePoints& thin, const ResampleLeaf& resample, bool parallel) {
-  auto& asked = thin.points;
-  if (asked.empty()) return;
-  // Points beside the thin features' own (finest-lattice neighbours, the same sign) join them,
-  // and then their neighbours, along the junction of two thin walls.
-  const auto key = [](const Lat& p, bool inside) { return lattice_key(p) * 2 + uint64_t(inside); };
-  std::unordered_set<uint64_t> kept;
-  for (const auto& [p, inside] : asked) kept.insert(key(p, inside));
-  std::unordered_map<uint64_t, Lat> waiting;
-  for (const auto& [p, inside] : thin.beside)
-    if (!kept.count(key(p, inside))) waiting.emplace(key(p, inside), p);
-  const int64_t step = int64_t{1} << (kMaxLevel - tree.max_depth);
-  std::vector<std::pair<Lat, bool>> work(asked.begin(), asked.end());
-  while (!work.empty() && !waiting.empty()) {
-    const auto [p, inside] = work.back();
-    work.pop_back();
-    for (int a = 0; a < 3; ++a)
-      for (const int64_t d : {-step, step}) {
-        Lat q = p;
-        q[a] += d;
-        const auto it = waiting.find(key(q, inside));
-        if (it == waiting.end()) continue;
-        asked.push_back({q, inside});
-        work.push_back({q, inside});
-        waiting.erase(it);
-      }
-  }
-  std::sort(asked.begin(), asked.end());
-  asked.erase(std::unique(asked.begin(), asked.end()), asked.end());
-  std::vector<std::pair<Lat, bool>> set;
-  for (size_t i = 0; i < asked.size(); ++i) {
-    const bool both = (i + 1 < asked.size() && asked[i + 1].first == asked[i].first) ||
-                      (i > 0 && asked[i - 1].first == asked[i].first);
-    if (!both) set.push_back(asked[i]);
-  }
+  if (thin.points.empty()) return;
+  const std::vector<AskedSign> set =
+      thin_feature_signs(thin.points, thin.beside, int64_t{1} << (kMaxLevel - tree.max_depth));
   std::vector<Lat> points(set.size());
   for (size_t i = 0; i < set.size(); ++i) points[i] = set[i].first;
   refine_all_around(tree, points, resample, parallel);
