@@ -180,6 +180,31 @@ TEST(Eval, CoarseFacetsKeepTheirShapeWhereABooleanResamplesThem) {
   }
 }
 
+// Three boxes and a prism stacked face to face, turned: where two operands' faces coincide
+// their contours stand a few hundredths of a cell apart (further beside leaves accepted at the
+// cap, whose vertices fit no plane). No such gap is a feature: the union is one solid without
+// a void.
+TEST(Eval, StackedPartsLeaveNoVoidBetweenThem) {
+  for (const int depth : {7, 8, 9}) {
+    const Result r = eval_file("stacked_turned_boxes.csg", depth);
+    EXPECT_EQ(test::component_count(r.mesh), 1u) << "depth " << depth;
+    // 10 x 10 x 10 + 10 x 3 x 10 + the 7-gon prism (r 2, h 3).
+    const double prism = 3 * 0.5 * 7 * 4 * std::sin(2 * std::numbers::pi / 7);
+    expect_volume(r, 1300 + prism, 2e-3);
+  }
+}
+
+// A hollow cube, its walls 0.02 of 10 thick (0.14 of a finest cell at depth 7), turned: the
+// difference leaves walls thinner than a cell, kept about a cell thick (without that, 100
+// fragments): closed, at most two sheets (the outside's and the cavity's), at least the exact
+// walls' volume.
+TEST(Eval, ThinWallsOfADifferenceAreKept) {
+  const Result r = eval_file("hollow_box_thin_walls.csg", 7);
+  EXPECT_TRUE(test::IsClosedManifold(r.mesh));
+  EXPECT_LE(test::component_count(r.mesh), 2u);
+  EXPECT_GE(r.volume, 1000 - std::pow(9.96, 3));
+}
+
 TEST(Eval, RotateExtrudeFn4) { expect_volume(eval_file("rotate_square.csg"), 6, 1e-3); }
 
 TEST(Eval, PolyhedronClockwiseFaces) { expect_volume(eval_file("polyhedron.csg"), 2000.0 / 3, 1e-3); }

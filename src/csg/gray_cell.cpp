@@ -171,6 +171,7 @@ void thin_feature_hints(CsgOp op, const Operand& xa, const Side& a, const Operan
     double t;
     Vec3 normal;  // as the result's surface would face there
     bool of_b;
+    bool rough;   // the triangle's polygon holds a capped leaf (PartialContour::rough)
   };
   const I3 lo = lattice_to_grid(cell.lat);
   const i64 len = lattice_to_grid(cell.span());
@@ -183,13 +184,18 @@ void thin_feature_hints(CsgOp op, const Operand& xa, const Side& a, const Operan
     const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
     xs.clear();
     for (uint32_t k : a.idx)
-      if (crosses(xa.tris[k], p, axis, len)) xs.push_back({crossing_param(xa.tris[k], p, axis, len), xa.tris[k].unit_normal, false});
+      if (crosses(xa.tris[k], p, axis, len))
+        xs.push_back({crossing_param(xa.tris[k], p, axis, len), xa.tris[k].unit_normal, false, xa.pc.rough[k] != 0});
     const double flip_b = op == CsgOp::Subtract ? -1 : 1;
     for (uint32_t k : b.idx)
       if (crosses(xb.tris[k], p, axis, len))
-        xs.push_back({crossing_param(xb.tris[k], p, axis, len), scale3(xb.tris[k].unit_normal, flip_b), true});
+        xs.push_back({crossing_param(xb.tris[k], p, axis, len), scale3(xb.tris[k].unit_normal, flip_b), true,
+                      xb.pc.rough[k] != 0});
     if (xs.size() < 2) continue;
     std::sort(xs.begin(), xs.end(), [](const Crossing& u, const Crossing& v) { return u.t < v.t; });
+    // A capped leaf's polygons may stand a cell off the solid: a gap beside them is no
+    // evidence of a feature (two coinciding faces near a crease of either operand).
+    if (std::any_of(xs.begin(), xs.end(), [](const Crossing& x) { return x.rough; })) continue;
     // The 1D Boolean along the edge: a crossing the result shows changes its sign. Crossings
     // within kCoincident of each other (faces the operands share) pass as one.
     bool in_a = (a.signs >> c0) & 1, in_b = (b.signs >> c0) & 1;

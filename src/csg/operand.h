@@ -47,6 +47,9 @@ inline uint8_t apply_mask(CsgOp op, uint8_t a, uint8_t b) {
 /// shared by all the tasks of an operation.
 struct PartialContour {
   std::vector<ITri> tris;
+  /// Per triangle: one of its polygon's leaves was accepted at the depth cap, so the triangle
+  /// may lie up to a cell off the solid (its vertex fits no plane there).
+  std::vector<uint8_t> rough;
   TriangleBvh bvh;
 };
 

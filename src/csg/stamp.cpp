@@ -134,16 +134,22 @@ void contour_of(const Octree& t, const std::function<bool(uint32_t)>& active, Pa
   // The polygons first, then their triangles in parallel into a vector sized once: a
   // triangle is 272 bytes, and growing the vector one at a time copied them over and over.
   std::vector<std::array<Vec3, 4>> quads;
-  std::vector<uint8_t> counts;
+  std::vector<uint8_t> counts, rough;
   std::function<void(const DualPolygon&)> emit = [&](const DualPolygon& poly) {
     quads.push_back(poly.pos);
     counts.push_back(uint8_t(poly.count));
+    bool capped = false;
+    for (int k = 0; k < poly.count; ++k) capped = capped || (t.nodes[poly.leaf[k]].flags & kFlagCapped) != 0;
+    rough.push_back(capped);
   };
   dual_walk(t, &active, emit);
   std::vector<uint32_t> first(quads.size() + 1, 0);
   for (size_t i = 0; i < quads.size(); ++i) first[i + 1] = first[i] + (counts[i] == 3 ? 1 : 2);
   const size_t base = x.tris.size();
   x.tris.resize(base + first.back());
+  x.rough.resize(base + first.back());
+  for (size_t i = 0; i < quads.size(); ++i)
+    for (uint32_t k = first[i]; k < first[i + 1]; ++k) x.rough[base + k] = rough[i];
   tbb::parallel_for(size_t{0}, quads.size(), [&](size_t i) {
     const std::array<Vec3, 4>& q = quads[i];
     std::array<I3, 4> g;
