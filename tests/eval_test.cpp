@@ -31,10 +31,10 @@ struct Result {
   double cell = 0;  // finest cell
 };
 
-Result eval_file(const std::string& name, int depth = 8) {
+Result eval_file(const std::string& name, int depth = 8, EvalStats* stats = nullptr) {
   EvalOptions o;
   o.depth = depth;
-  const Octree t = eval_csg_file(kData / name, o);
+  const Octree t = eval_csg_file(kData / name, o, stats);
   Result r;
   r.mesh = unsplit_contour(t);
   split_nonmanifold(r.mesh);
@@ -186,8 +186,10 @@ TEST(Eval, CoarseFacetsKeepTheirShapeWhereABooleanResamplesThem) {
 // a void.
 TEST(Eval, StackedPartsLeaveNoVoidBetweenThem) {
   for (const int depth : {7, 8, 9}) {
-    const Result r = eval_file("stacked_turned_boxes.csg", depth);
+    EvalStats st;
+    const Result r = eval_file("stacked_turned_boxes.csg", depth, &st);
     EXPECT_EQ(test::component_count(r.mesh), 1u) << "depth " << depth;
+    EXPECT_EQ(st.thin_points, 0u) << "depth " << depth;
     // 10 x 10 x 10 + 10 x 3 x 10 + the 7-gon prism (r 2, h 3).
     const double prism = 3 * 0.5 * 7 * 4 * std::sin(2 * std::numbers::pi / 7);
     expect_volume(r, 1300 + prism, 2e-3);
@@ -199,7 +201,9 @@ TEST(Eval, StackedPartsLeaveNoVoidBetweenThem) {
 // fragments): closed, at most two sheets (the outside's and the cavity's), at least the exact
 // walls' volume.
 TEST(Eval, ThinWallsOfADifferenceAreKept) {
-  const Result r = eval_file("hollow_box_thin_walls.csg", 7);
+  EvalStats st;
+  const Result r = eval_file("hollow_box_thin_walls.csg", 7, &st);
+  EXPECT_GT(st.thin_points, 0u);
   EXPECT_TRUE(test::IsClosedManifold(r.mesh));
   EXPECT_LE(test::component_count(r.mesh), 2u);
   EXPECT_GE(r.volume, 1000 - std::pow(9.96, 3));

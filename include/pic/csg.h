@@ -39,6 +39,9 @@ struct CsgStats {
   size_t gray_pairs = 0;         ///< gray/gray evaluations (GraycellCSG)
   size_t forced_subdivisions = 0;
   size_t repaired = 0;           ///< uniform leaves turned gray to keep the surface closed
+  /// Lattice points given the sign of a wall, blade or slot thinner than the finest cell that
+  /// the Boolean made (kept about a cell thick instead of dropped)
+  size_t thin_points = 0;
   uint32_t stamp = 0;            ///< this operation's number in its chain (1 for a single one)
   bool resampled_b = false;      ///< B was re-expressed in A's cube
 };

@@ -67,6 +67,7 @@ void for_each_field(const CsgStats& s, F&& f) {
   f("gray_pairs", s.gray_pairs);
   f("forced_subdivisions", s.forced_subdivisions);
   f("repaired", s.repaired);
+  f("thin_points", s.thin_points);
   f("stamp", s.stamp);
   f("resampled_b", s.resampled_b);
 }
@@ -81,6 +82,7 @@ void for_each_field(const EvalStats& s, F&& f) {
   f("leaves", s.leaves);
   f("leaf_triangles", s.triangles);
   f("booleans", s.booleans);
+  f("thin_points", s.thin_points);
 }
 
 /// Validity of a written mesh: the exact self-intersection count (absent when not checked),

@@ -38,6 +38,7 @@ struct EvalStats {
   size_t leaves = 0;       ///< closed meshes sampled
   size_t triangles = 0;    ///< triangles of all leaves
   size_t booleans = 0;     ///< octree Booleans
+  size_t thin_points = 0;  ///< lattice points the Booleans gave a sub-cell wall's sign (CsgStats)
   double openscad_seconds = 0;  ///< `openscad -o x.csg` (for .scad input)
   double mesh_seconds = 0;      ///< parse, tessellate, extrude, hull
   double octree_seconds = 0;    ///< sampling plus Booleans (wall clock)

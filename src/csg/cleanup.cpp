@@ -136,22 +136,24 @@ void apply_sign_hints(Octree& t, const std::vector<SignHint>& hints, const std::
 /// joined by thin_feature_signs) the feature's sign, the coarser leaves around them split
 /// first. The leaves that change are flagged capped: their vertices stand for a feature
 /// thinner than the cell, not for its exact surface. The points are pinned, as the other
-/// hints' are.
-void keep_thin_features(Octree& t, const std::vector<SignHint>& hints, PinnedPoints& pinned,
-                        const std::function<void(const Lat&)>& refine, const std::function<void(uint32_t)>& touched) {
+/// hints' are. Returns how many points it set.
+size_t keep_thin_features(Octree& t, const std::vector<SignHint>& hints, PinnedPoints& pinned,
+                          const std::function<void(const Lat&)>& refine, const std::function<void(uint32_t)>& touched) {
   std::vector<AskedSign> asked, beside;
   for (const SignHint& h : hints) {
     if (h.kind == SignHint::Kind::Thin) asked.push_back({h.point, h.inside});
     if (h.kind == SignHint::Kind::BesideThin) beside.push_back({h.point, h.inside});
   }
-  if (asked.empty()) return;
-  for (const auto& [p, inside] : thin_feature_signs(asked, beside, int64_t{1} << (kMaxLevel - t.max_depth))) {
+  if (asked.empty()) return 0;
+  const std::vector<AskedSign> set = thin_feature_signs(asked, beside, int64_t{1} << (kMaxLevel - t.max_depth));
+  for (const auto& [p, inside] : set) {
     refine(p);
     set_point_sign(t, p, inside, &touched);
     for (const auto& l : leaves_around(t, p))
       if (t.nodes[l.node].kind == CellKind::Gray) t.nodes[l.node].flags |= kFlagCapped;
     pinned.insert(lattice_key(p));
   }
+  return set.size();
 }
 
 }  // namespace
@@ -172,7 +174,7 @@ void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::ve
   // Islands sit where new geometry meets finer old cells; a flip that makes a leaf hold one
   // component can leave a new island, so the two alternate until both are quiet.
   PinnedPoints pinned;
-  keep_thin_features(a, hints, pinned, refine, stamp_it);
+  stats.thin_points = keep_thin_features(a, hints, pinned, refine, stamp_it);
   apply_sign_hints(a, hints, stamped, pinned, refine);
   SettlePlan plan;
   plan.active = &stamped;

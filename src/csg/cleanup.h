@@ -35,7 +35,7 @@ struct SignHint {
 /// component removed, and specks the Boolean made absorbed (`sign_b`: B's sign at a lattice
 /// point, to tell those from B's own small components). A flip at the corner of a leaf
 /// coarser than the finest level first splits that leaf (resampled with QEF threshold
-/// `error`). Sets stats.repaired.
+/// `error`). Sets stats.repaired and stats.thin_points.
 void clean_up(Octree& a, Stamps& stamps, uint32_t stamp, CsgOp op, const std::vector<SignHint>& hints,
               const std::function<bool(const std::array<int64_t, 3>&)>& sign_b, double error, CsgStats& stats);
 

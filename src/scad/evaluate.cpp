@@ -112,6 +112,7 @@ class Progress {
  public:
   Progress(const EvalOptions& o, size_t leaves) : opt_(o), total_(leaves), t0_(Clock::now()), last_(t0_) {}
   std::atomic<size_t> booleans{0};
+  std::atomic<size_t> thin_points{0};
   std::atomic<size_t> leaves_done{0};
   void report() {
     if (!opt_.progress) return;
@@ -165,7 +166,11 @@ class TreeBuilder {
     co.csg.parallel = opt_.parallel;
     co.compact = false;  // the Booleans compact where it pays; the contour follows the node order
     co.on_leaf = [p = &progress_] { ++p->leaves_done, p->report(); };
-    co.on_step = [p = &progress_](size_t, const CsgStats&) { ++p->booleans, p->report(); };
+    co.on_step = [p = &progress_](size_t, const CsgStats& s) {
+      ++p->booleans;
+      p->thin_points += s.thin_points;
+      p->report();
+    };
     return co;
   }
 
@@ -253,12 +258,15 @@ class TreeBuilder {
 };
 
 std::optional<Octree> evaluate_model(const Solid& model, const EvalOptions& options, const Cube& cube,
-                                     size_t leaves, size_t* booleans) {
+                                     size_t leaves, EvalStats* st) {
   Progress progress(options, leaves);
   TreeBuilder builder(options, cube, progress);
   const CsgTree tree = builder.build(model);
   Octree out = evaluate(tree, builder.chain_options());
-  if (booleans) *booleans = progress.booleans.load();
+  if (st) {
+    st->booleans = progress.booleans.load();
+    st->thin_points = progress.thin_points.load();
+  }
   if (out.vertices.empty()) return std::nullopt;
   return out;
 }
@@ -350,7 +358,7 @@ Octree eval_csg(const std::string& text, const EvalOptions& options, EvalStats* 
     options.progress("sampling " + std::to_string(st.leaves) + " leaves (" + std::to_string(st.triangles) +
                      " triangles) at depth " + std::to_string(options.depth));
   const auto t1 = Clock::now();
-  std::optional<Octree> out = evaluate_model(model, options, st.cube, st.leaves, &st.booleans);
+  std::optional<Octree> out = evaluate_model(model, options, st.cube, st.leaves, &st);
   st.octree_seconds = since(t1);
   st.seconds = since(t0);
   if (!out) throw InvalidInput(source + ": the model is empty");
