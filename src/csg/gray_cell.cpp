@@ -161,64 +161,81 @@ EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Opera
   return v;
 }
 
+namespace {
+
+/// A crossing of the result's surface along a cell edge: where (edge parameter) and which way
+/// the surface faces there.
+struct ShownCrossing {
+  Vec3 normal;
+  double t;
+};
+
+/// The crossings the result shows along the edge from corner c0 (grid point p, `axis`, length
+/// `len`): every crossing of A's and B's partial contours in order, through the 1D Boolean,
+/// crossings within kCoincident of each other taken as one (faces the operands share). Empty
+/// when a crossing's triangle stands beside a capped leaf (PartialContour::rough): its vertex
+/// fits no plane and may lie a cell off, so no gap beside it says anything.
+std::vector<ShownCrossing> shown_crossings(CsgOp op, const Operand& xa, const Side& a, const Operand& xb,
+                                           const Side& b, const Cell& cell, const I3& p, int axis, i64 len, int c0) {
+  struct Crossing {
+    double t;
+    Vec3 normal;  // as the result's surface would face there
+    bool of_b;
+  };
+  std::vector<Crossing> xs;
+  for (uint32_t k : a.idx)
+    if (crosses(xa.tris[k], p, axis, len)) {
+      if (xa.pc.rough[k]) return {};
+      xs.push_back({crossing_param(xa.tris[k], p, axis, len), xa.tris[k].unit_normal, false});
+    }
+  const double flip_b = op == CsgOp::Subtract ? -1 : 1;
+  for (uint32_t k : b.idx)
+    if (crosses(xb.tris[k], p, axis, len)) {
+      if (xb.pc.rough[k]) return {};
+      xs.push_back({crossing_param(xb.tris[k], p, axis, len), scale3(xb.tris[k].unit_normal, flip_b), true});
+    }
+  if (xs.size() < 2) return {};
+  std::sort(xs.begin(), xs.end(), [](const Crossing& u, const Crossing& v) { return u.t < v.t; });
+  bool in_a = (a.signs >> c0) & 1, in_b = (b.signs >> c0) & 1;
+  bool r = apply(op, in_a, in_b);
+  std::vector<ShownCrossing> shown;
+  const double together = kCoincident / cell.size();
+  for (size_t i = 0; i < xs.size();) {
+    const Vec3* normal = nullptr;  // the group's first crossing that changes the result
+    size_t j = i;
+    for (; j < xs.size() && xs[j].t - xs[i].t <= together; ++j) {
+      (xs[j].of_b ? in_b : in_a) = !(xs[j].of_b ? in_b : in_a);
+      if (!normal && apply(op, in_a, in_b) != r) normal = &xs[j].normal;
+    }
+    if (apply(op, in_a, in_b) != r) shown.push_back({*normal, xs[i].t});
+    r = apply(op, in_a, in_b);
+    i = j;
+  }
+  return shown;
+}
+
+}  // namespace
+
 void thin_feature_hints(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b, const Cell& cell,
                         uint8_t sr, double error, std::vector<SignHint>& out) {
   // Each operand's surface may lie up to about sqrt(error) off the solid it stands for (the
   // QEF residual is a squared distance, weighted by area per cell face): a gap narrower than
   // that between A's face and B's is how two coinciding faces show (stacked parts), not a feature.
   const double min_width = std::sqrt(error);
-  struct Crossing {
-    double t;
-    Vec3 normal;  // as the result's surface would face there
-    bool of_b;
-    bool rough;   // the triangle's polygon holds a capped leaf (PartialContour::rough)
-  };
   const I3 lo = lattice_to_grid(cell.lat);
   const i64 len = lattice_to_grid(cell.span());
-  std::vector<Crossing> xs;
-  std::vector<std::pair<Vec3, double>> seen;
   for (int e = 0; e < 12; ++e) {
-    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
+    const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
     const bool end_sign = (sr >> c0) & 1;
     if (end_sign != bool((sr >> c1) & 1)) continue;
     const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
-    xs.clear();
-    for (uint32_t k : a.idx)
-      if (crosses(xa.tris[k], p, axis, len))
-        xs.push_back({crossing_param(xa.tris[k], p, axis, len), xa.tris[k].unit_normal, false, xa.pc.rough[k] != 0});
-    const double flip_b = op == CsgOp::Subtract ? -1 : 1;
-    for (uint32_t k : b.idx)
-      if (crosses(xb.tris[k], p, axis, len))
-        xs.push_back({crossing_param(xb.tris[k], p, axis, len), scale3(xb.tris[k].unit_normal, flip_b), true,
-                      xb.pc.rough[k] != 0});
-    if (xs.size() < 2) continue;
-    std::sort(xs.begin(), xs.end(), [](const Crossing& u, const Crossing& v) { return u.t < v.t; });
-    // A capped leaf's polygons may stand a cell off the solid: a gap beside them is no
-    // evidence of a feature (two coinciding faces near a crease of either operand).
-    if (std::any_of(xs.begin(), xs.end(), [](const Crossing& x) { return x.rough; })) continue;
-    // The 1D Boolean along the edge: a crossing the result shows changes its sign. Crossings
-    // within kCoincident of each other (faces the operands share) pass as one.
-    bool in_a = (a.signs >> c0) & 1, in_b = (b.signs >> c0) & 1;
-    bool r = apply(op, in_a, in_b);
-    seen.clear();
-    const double together = kCoincident / cell.size();
-    for (size_t i = 0; i < xs.size();) {
-      const Vec3* shown = nullptr;
-      size_t j = i;
-      for (; j < xs.size() && xs[j].t - xs[i].t <= together; ++j) {
-        (xs[j].of_b ? in_b : in_a) = !(xs[j].of_b ? in_b : in_a);
-        if (!shown && apply(op, in_a, in_b) != r) shown = &xs[j].normal;
-      }
-      if (apply(op, in_a, in_b) != r) seen.push_back({*shown, xs[i].t});
-      r = apply(op, in_a, in_b);
-      i = j;
-    }
+    const std::vector<ShownCrossing> seen = shown_crossings(op, xa, a, xb, b, cell, p, edge_axis(e), len, c0);
     bool thin = false, twice = false;
     for (size_t i = 0; i < seen.size(); ++i)
       for (size_t j = i + 1; j < seen.size(); ++j) {
-        if (std::abs(seen[i].second - seen[j].second) * cell.size() <= min_width) continue;
+        if (std::abs(seen[i].t - seen[j].t) * cell.size() <= min_width) continue;
         twice = true;
-        thin = thin || dot3(seen[i].first, seen[j].first) < -kThinFeatureTurn;
+        thin = thin || dot3(seen[i].normal, seen[j].normal) < -kThinFeatureTurn;
       }
     if (!twice) continue;
     const auto kind = thin ? SignHint::Kind::Thin : SignHint::Kind::BesideThin;
