@@ -117,11 +117,10 @@ EdgeCrossing edge_crossing(const Operand& x, const Side& s, const I3& a, int axi
 EdgeVerdict edge_verdict(CsgOp op, const Operand& xa, const Side& a, const Operand& xb, const Side& b,
                          const Cell& cell) {
   EdgeVerdict v;
-  const I3 lo = lattice_to_grid(cell.lat);
   const i64 len = lattice_to_grid(cell.span());
   for (int e = 0; e < 12; ++e) {
     const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
-    const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
+    const I3 p = lattice_to_grid(cell.corner(c0));
     const EdgeCrossing ea = edge_crossing(xa, a, p, axis, len, c0, c1);
     const EdgeCrossing eb = edge_crossing(xb, b, p, axis, len, c0, c1);
     if ((!a.real && ea.count >= 2) || (!b.real && eb.count >= 2)) {
@@ -222,13 +221,12 @@ void thin_feature_hints(CsgOp op, const Operand& xa, const Side& a, const Operan
   // QEF residual is a squared distance, weighted by area per cell face): a gap narrower than
   // that between A's face and B's is how two coinciding faces show (stacked parts), not a feature.
   const double min_width = std::sqrt(error);
-  const I3 lo = lattice_to_grid(cell.lat);
   const i64 len = lattice_to_grid(cell.span());
   for (int e = 0; e < 12; ++e) {
     const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1];
     const bool end_sign = (sr >> c0) & 1;
     if (end_sign != bool((sr >> c1) & 1)) continue;
-    const I3 p{lo[0] + (c0 & 1) * len, lo[1] + ((c0 >> 1) & 1) * len, lo[2] + ((c0 >> 2) & 1) * len};
+    const I3 p = lattice_to_grid(cell.corner(c0));
     const std::vector<ShownCrossing> seen = shown_crossings(op, xa, a, xb, b, cell, p, edge_axis(e), len, c0);
     bool thin = false, twice = false;
     for (size_t i = 0; i < seen.size(); ++i)

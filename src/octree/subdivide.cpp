@@ -91,7 +91,7 @@ bool has_double_crossing(const std::vector<ITri>& tris, const std::vector<uint32
     const bool change = ((signs >> c0) ^ (signs >> kEdgeCorners[e][1])) & 1;
     const int needed = change ? 3 : 2;
     if (candidates[e] < needed) continue;
-    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
+    const I3 a = lattice_to_grid(cell.corner(c0));
     if (edge_crossings(tris, idx, a, edge_axis(e), s, memo) >= needed) return true;
   }
   return false;
@@ -109,7 +109,6 @@ constexpr uint8_t kAll = 0xff;
 /// one) and is left as is, unless it lies beside a thin feature (two thin walls at an angle).
 void record_thin_feature(const std::vector<ITri>& tris, const std::vector<uint32_t>& idx, const Cell& cell,
                          uint8_t written, EdgeCountMemo* memo, ThinFeaturePoints& thin) {
-  const I3 lo = lattice_to_grid(cell.lat);
   const int64_t s = lattice_to_grid(cell.span());
   std::vector<std::pair<std::array<int64_t, 3>, bool>> found, beside;
   std::vector<Vec3> normals;
@@ -117,7 +116,7 @@ void record_thin_feature(const std::vector<ITri>& tris, const std::vector<uint32
     const int c0 = kEdgeCorners[e][0], c1 = kEdgeCorners[e][1], axis = edge_axis(e);
     const bool end_sign = (written >> c0) & 1;
     if (end_sign != bool((written >> c1) & 1)) continue;
-    const I3 a{lo[0] + (c0 & 1) * s, lo[1] + ((c0 >> 1) & 1) * s, lo[2] + ((c0 >> 2) & 1) * s};
+    const I3 a = lattice_to_grid(cell.corner(c0));
     if (edge_crossings(tris, idx, a, axis, s, memo) < 2) continue;
     normals.clear();
     for (uint32_t k : idx)
